@@ -1,0 +1,77 @@
+"""The `neurosym` command: train | eval | extract | query | plot | envs.
+
+Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
+as a module with two functions:
+
+* ``configure(parser: argparse.ArgumentParser) -> None`` adds its arguments;
+* ``run(args: argparse.Namespace) -> int`` does the work and returns the exit code.
+
+Only the module of the command being run is imported, so ``neurosym query``
+never pays for importing torch. A :class:`~neurosym.errors.NeurosymError`
+(bad input) is printed as one line and exits with status 1; argparse usage
+errors exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from neurosym import __version__
+from neurosym.errors import NeurosymError
+
+# name -> (module, one-line help)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "train": ("neurosym.agent.cli_train", "Train a PrediNet or MHDPA agent with A3C."),
+    "eval": ("neurosym.agent.cli_eval", "Evaluate a checkpoint: mean return, success rate, outcomes."),
+    "extract": ("neurosym.export.cli_extract", "Record episodes and write the R-vector facts as a Prolog KB."),
+    "query": ("neurosym.prolog.cli_query", "Run a Prolog goal against a knowledge base and print the answers."),
+    "plot": ("neurosym.viz.cli_plot", "Draw attention maps, R-vector heat maps and episode renderings."),
+    "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
+}
+
+
+def _selected_command(argv: Sequence[str]) -> str | None:
+    for token in argv:
+        if token.startswith("-"):
+            continue
+        return token if token in COMMANDS else None
+    return None
+
+
+def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
+    """Build the parser; only the selected subcommand's module is imported."""
+    parser = argparse.ArgumentParser(
+        prog="neurosym",
+        description="Make a reinforcement-learning agent's relational reasoning explicit.",
+    )
+    parser.add_argument("--version", action="version", version=f"neurosym {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    selected = _selected_command(argv)
+    for name, (module_name, help_text) in COMMANDS.items():
+        cmd = sub.add_parser(name, help=help_text, description=help_text)
+        if name == selected:
+            module = importlib.import_module(module_name)
+            module.configure(cmd)
+            cmd.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
+    args = parser.parse_args(argv)
+    try:
+        return int(args._run(args) or 0)
+    except NeurosymError as exc:
+        print(f"neurosym {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"neurosym {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
