@@ -25,7 +25,7 @@ swipl_version() {  # print the numeric version of the swipl binary $1, or nothin
 }
 
 # Already built here?
-if [ -x "$PREFIX/bin/swipl" ]; then
+if [ -x "$PREFIX/bin/swipl" ] && [ -n "$(swipl_version "$PREFIX/bin/swipl")" ]; then
   echo "$PREFIX/bin/swipl"; exit 0
 fi
 
@@ -90,9 +90,14 @@ cmake -S "$src" -B "$work/build" -G Ninja \
   -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_INSTALL_PREFIX="$PREFIX" \
   -DSWIPL_PACKAGE_LIST="clib;plunit;swipy;readline" \
-  -DINSTALL_DOCUMENTATION=OFF -DBUILD_TESTING=OFF -DSWIPL_INSTALL_IN_LIB=ON \
+  -DINSTALL_DOCUMENTATION=OFF -DBUILD_TESTING=OFF \
   -DUSE_TCMALLOC=OFF >"$work/cmake.log" 2>&1 || { tail -n 30 "$work/cmake.log" >&2; exit 1; }
 ninja -C "$work/build" >"$work/build.log" 2>&1 || { tail -n 40 "$work/build.log" >&2; exit 1; }
 ninja -C "$work/build" install >"$work/install.log" 2>&1 || { tail -n 20 "$work/install.log" >&2; exit 1; }
+v=$(swipl_version "$PREFIX/bin/swipl")
+if [ -z "$v" ]; then
+  log "error: the freshly built $PREFIX/bin/swipl does not run"
+  exit 1
+fi
 "$PREFIX/bin/swipl" --version >&2
 echo "$PREFIX/bin/swipl"
