@@ -1,0 +1,95 @@
+"""Recording: schema conformance and the Parquet round trip."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from neurosym.errors import ConfigError
+from neurosym.export.recording import SCHEMA, Recording
+
+
+def small_recording() -> Recording:
+    """Two episodes by hand, with a compound entity name and a float that needs full precision."""
+    return Recording(
+        episodes=pd.DataFrame(
+            {"episode": [0, 1], "steps": [2, 1], "return": [0.9, -1.0], "outcome": ["terminal", "pit"], "seed": [7, 8]}
+        ),
+        steps=pd.DataFrame(
+            {"episode": [0, 0, 1], "t": [0, 1, 0], "action": ["right", "down", "left"], "reward": [-0.1, 1.0, -1.0]}
+        ),
+        positions=pd.DataFrame(
+            {
+                "episode": [0, 0, 0],
+                "t": [0, 1, 2],
+                "object": ["agent", "agent", "agent"],
+                "type": ["agent", "agent", "agent"],
+                "row": [0, 0, 1],
+                "col": [0, 1, 1],
+            }
+        ),
+        holding=pd.DataFrame({"episode": [0], "t": [2], "item": ["key(red)"]}),
+        events=pd.DataFrame({"episode": [0, 1], "t": [1, 0], "event": ["got(key(red))", "fell(pit)"]}),
+        relations=pd.DataFrame(
+            {"episode": [0], "t": [0], "head": [1], "j": [3], "a": ["sword"], "b": ["lock(blue)"], "value": [0.1 + 0.2]}
+        ),
+        meta={"env": "rgw2", "module": "predinet", "heads": 4, "relations": 8, "seed": 7},
+    )
+
+
+def test_missing_tables_are_empty_with_schema_columns() -> None:
+    rec = Recording()
+    for name, cols in SCHEMA.items():
+        table = getattr(rec, name)
+        assert list(table.columns) == [c for c, _ in cols]
+        assert [str(t) for t in table.dtypes] == [d for _, d in cols]
+        assert table.empty
+
+
+def test_tables_are_brought_to_schema_order_and_dtypes() -> None:
+    steps = pd.DataFrame({"reward": [1], "action": ["up"], "t": [np.int32(0)], "episode": [np.int16(3)], "extra": [1]})
+    rec = Recording(steps=steps)
+    assert list(rec.steps.columns) == ["episode", "t", "action", "reward"]
+    assert rec.steps["reward"].dtype == np.float64
+    assert rec.steps["episode"].dtype == np.int64
+
+
+def test_missing_column_is_a_one_line_error() -> None:
+    with pytest.raises(ConfigError, match=r"recording table 'events' lacks column\(s\) event; expected episode, t, event"):
+        Recording(events=pd.DataFrame({"episode": [0], "t": [0]}))
+
+
+def test_parquet_round_trip(tmp_path: Path) -> None:
+    rec = small_recording()
+    rec.save(tmp_path / "rec")
+    back = Recording.load(tmp_path / "rec")
+    assert back == rec
+    assert back.relations["value"].iloc[0] == 0.1 + 0.2  # full precision
+    assert back.meta == rec.meta
+    assert sorted(p.name for p in (tmp_path / "rec").iterdir()) == sorted(
+        [f"{n}.parquet" for n in SCHEMA] + ["meta.json"]
+    )
+
+
+def test_save_overwrites_and_leaves_no_temp_files(tmp_path: Path) -> None:
+    rec = small_recording()
+    rec.save(tmp_path)
+    rec.save(tmp_path)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_load_refuses_a_directory_that_is_not_a_recording(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="is not a neurosym recording"):
+        Recording.load(tmp_path)
+    (tmp_path / "meta.json").write_text('{"format": "something-else"}')
+    with pytest.raises(ConfigError, match="no format tag"):
+        Recording.load(tmp_path)
+
+
+def test_counts() -> None:
+    rec = small_recording()
+    assert rec.n_episodes == 2
+    assert rec.n_steps == 3
