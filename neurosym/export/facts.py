@@ -197,6 +197,8 @@ class FactSet:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         for name, df in self.tables.items():
+            if name == "kb_meta":  # mixed values (atoms, numbers): Parquet needs one type per column
+                df = df.assign(value=df["value"].map(str))
             _atomic_write_bytes(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         text = json.dumps({"meta": self.meta, "threshold": str(self.threshold)}, indent=2, default=str) + "\n"
         _atomic_write_bytes(out / "meta.json", lambda p: Path(p).write_text(text))

@@ -8,8 +8,8 @@
 :- dynamic kb_meta/2, object/2, episode/4, step/4, at/5, holding/3, event/3,
            attends/8, relation/7, holds/5, threshold/2, attention/6.
 
-threshold(0, 0.375).
-threshold(1, 0.25).
+threshold(0, 0.3).
+threshold(1, 0.3).
 
 %        E  T  Head J  A      B      Value
 relation(0, 0, 0, 0, sword, enemy,  1.0).

@@ -1,0 +1,397 @@
+"""Record an agent's episodes with introspection into a :class:`Recording`.
+
+The environments run batched (``make_batched``) and the model acts on the whole
+batch at once with ``introspect=True``. Per step the recorder keeps a few numpy
+arrays (which sub-environments are live, the argmax cells of each head, the
+relation values); the tables are built from them with array operations once,
+at the end.
+
+Seeding: episode k is played from ``reset(seed=seed + k)``, whichever
+sub-environment plays it (the recorder resets finished sub-environments with
+``reset_mask``), so ``make(env).reset(seed=episodes.seed[k])`` followed by the
+recorded actions replays episode k exactly. With ``greedy=False`` actions are
+sampled from a torch generator seeded with ``seed``; the result then depends
+on the batch size too (the draws are shared out over the batch).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from neurosym.errors import CheckpointError, ConfigError
+from neurosym.export.recording import Recording
+
+DEFAULT_BATCH = 64
+"""Sub-environments stepped together (fewer when fewer episodes are asked for)."""
+
+# Entities that are never MHDPA queries in the attention table (too many, too dull).
+_BACKGROUND = ("empty", "wall")
+
+
+def _meta(agent: Any, env_name: str, seed: int, greedy: bool) -> dict[str, Any]:
+    from neurosym import __version__
+
+    config = agent.config
+    return {
+        "checkpoint": str(getattr(agent, "path", "") or ""),
+        "env": env_name,
+        "module": config.module,
+        "heads": int(config.heads),
+        "relations": int(config.relations) if config.module == "predinet" else 0,
+        "seed": int(seed),
+        "greedy": bool(greedy),
+        "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
+        "version": __version__,
+    }
+
+
+class _Columns:
+    """Column chunks appended per step and concatenated once."""
+
+    def __init__(self) -> None:
+        self.chunks: dict[str, list[np.ndarray]] = {}
+
+    def add(self, **cols: np.ndarray) -> None:
+        for name, arr in cols.items():
+            self.chunks.setdefault(name, []).append(np.asarray(arr))
+
+    def get(self, name: str) -> np.ndarray:
+        parts = self.chunks.get(name, [])
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+
+class _Trace:
+    """The symbolic side of the episodes (positions, holding, events), from decoded infos."""
+
+    def __init__(self) -> None:
+        self.pos: list[tuple[int, int, str, str, int, int]] = []
+        self.holding: list[tuple[int, int, str]] = []
+        self.events: list[tuple[int, int, str]] = []
+
+    def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
+        """Positions and held items of state t (the agent first, then the map's objects)."""
+        row, col = info["agent"]
+        self.pos.append((episode, t, "agent", "agent", int(row), int(col)))
+        self.pos.extend((episode, t, oid, otype, r, c) for oid, otype, r, c in info["objects"])
+        self.holding.extend((episode, t, item) for item in info["holding"])
+
+    def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
+        self.events.extend((episode, t, ev) for ev in info["events"])
+
+
+def _resolve_env(agent: Any, env: Any) -> str:
+    from neurosym.envs import canonical_name
+
+    trained = canonical_name(agent.env_name)
+    if env is None:
+        return trained
+    if not isinstance(env, str):
+        raise ConfigError(f"env must be an environment name such as {trained!r}, got {type(env).__name__}")
+    name = canonical_name(env)
+    if name != trained:
+        where = getattr(agent, "path", None) or "the agent"
+        raise CheckpointError(f"{where} was trained on {trained}, not {name}; record it on --env {trained}")
+    return name
+
+
+def record(
+    agent: Any,
+    env: str | None = None,
+    episodes: int = 20,
+    seed: int = 0,
+    greedy: bool = True,
+    batch: int | None = None,
+    *,
+    progress: bool = False,
+    top_keys: int = 1,
+    max_steps: int = 100_000,
+) -> Recording:
+    """Play ``episodes`` episodes of ``agent`` on ``env`` (default: the env it was trained on).
+
+    Returns a :class:`Recording` with the trace (episodes, steps, positions,
+    holding, events) and what the relational module showed at every state the
+    agent acted in: PrediNet's attended cells, relation values and R vectors,
+    or MHDPA's ``top_keys`` strongest keys for every query cell that is not
+    empty or wall. ``progress`` shows a rich progress bar on stderr.
+    ``max_steps`` guards against an env without a time limit.
+    """
+    from neurosym.envs import make_batched
+
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    if batch is not None and (isinstance(batch, bool) or not isinstance(batch, int) or batch < 1):
+        raise ConfigError(f"batch must be a positive integer, got {batch!r}")
+    if top_keys < 1:
+        raise ConfigError(f"top_keys must be at least 1, got {top_keys}")
+    name = _resolve_env(agent, env)
+    n = min(batch or DEFAULT_BATCH, episodes)
+    venv = make_batched(name, n, seed=seed, **dict(getattr(agent, "env_kwargs", {}) or {}))
+    try:
+        with _progress_bar(progress, episodes) as advance:
+            rec = _Recorder(agent, venv, episodes, seed, greedy, top_keys, max_steps, advance).run()
+    finally:
+        venv.close()
+    rec.meta.update(_meta(agent, name, seed, greedy))
+    return rec
+
+
+class _progress_bar:
+    """Context manager yielding ``advance(k)``; a rich bar on stderr when enabled."""
+
+    def __init__(self, enabled: bool, total: int) -> None:
+        self.enabled, self.total = enabled, total
+        self._progress: Any = None
+
+    def __enter__(self) -> Callable[[int], None]:
+        if not self.enabled:
+            return lambda k: None
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self._progress = Progress(
+            TextColumn("recording"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        )
+        self._progress.start()
+        task = self._progress.add_task("episodes", total=self.total)
+        return lambda k: self._progress.advance(task, k)
+
+    def __exit__(self, *exc: object) -> None:
+        if self._progress is not None:
+            self._progress.stop()
+
+
+class _Recorder:
+    """One recording run: the stepping loop and the table building."""
+
+    def __init__(
+        self,
+        agent: Any,
+        venv: Any,
+        episodes: int,
+        seed: int,
+        greedy: bool,
+        top_keys: int,
+        max_steps: int,
+        advance: Callable[[int], None],
+    ) -> None:
+        self.agent, self.venv = agent, venv
+        self.episodes, self.seed, self.greedy = episodes, seed, greedy
+        self.top_keys, self.max_steps, self.advance = top_keys, max_steps, advance
+        self.n = venv.num_envs
+        self.names = np.asarray(venv.entity_names, dtype=object)
+        self.module = agent.config.module
+        self.trace = _Trace()
+        self.model = _Columns()  # model outputs per (episode, t)
+        self.step_cols = _Columns()  # steps table
+        self.ep_rows: list[tuple[int, int, float, str, int]] = []
+        self.generator = None
+        if not greedy:
+            import torch
+
+            self.generator = torch.Generator().manual_seed(seed)
+
+    # -------------------------------------------------------------- stepping
+
+    def run(self) -> Recording:
+        from neurosym.envs import ACTION_NAMES
+
+        action_names = np.asarray(ACTION_NAMES, dtype=object)
+        n, venv = self.n, self.venv
+        episode = np.full(n, -1, dtype=np.int64)  # episode each sub-env plays, -1 idle
+        t = np.zeros(n, dtype=np.int64)
+        ret = np.zeros(n, dtype=np.float64)
+        first = np.arange(n)
+        episode[first] = first
+        next_episode = n
+        obs, info = venv.reset(seed=[self.seed + int(k) for k in first])
+        for i in first:
+            self.trace.state(int(episode[i]), 0, venv.decode_info(info, int(i)))
+        while (live := np.flatnonzero(episode >= 0)).size:
+            grid = venv.entity_grid().reshape(n, -1)  # (n, N) entity codes of the current states
+            actions, intro = self.agent.act(obs, greedy=self.greedy, introspect=True, generator=self.generator)
+            actions = np.asarray(actions)
+            self._model_outputs(episode[live], t[live], grid[live], intro, live)
+            obs, reward, terminated, truncated, info = venv.step(actions.astype(np.int64))
+            self.step_cols.add(
+                episode=episode[live], t=t[live], action=action_names[actions[live]], reward=reward[live]
+            )
+            ret[live] += reward[live]
+            done = np.zeros(n, dtype=bool)
+            for i in live.tolist():
+                d = venv.decode_info(info, i)
+                e, s = int(episode[i]), int(t[i])
+                self.trace.transition(e, s, d)
+                self.trace.state(e, s + 1, d)
+                if terminated[i] or truncated[i]:
+                    done[i] = True
+                    outcome = d["outcome"] or ("timeout" if truncated[i] else "terminal")
+                    self.ep_rows.append((e, s + 1, float(ret[i]), str(outcome), self.seed + e))
+                elif s + 1 >= self.max_steps:
+                    raise ConfigError(
+                        f"episode {e} ran {self.max_steps} steps without ending; the env has no time limit"
+                    )
+            t[live] += 1
+            if not done.any():
+                continue
+            ended = np.flatnonzero(done)
+            self.advance(len(ended))
+            restart = ended[: max(0, self.episodes - next_episode)]
+            episode[ended] = -1
+            if restart.size:
+                episode[restart] = next_episode + np.arange(restart.size)
+                next_episode += restart.size
+                t[restart] = 0
+                ret[restart] = 0.0
+                mask = np.zeros(n, dtype=bool)
+                mask[restart] = True
+                seeds = [self.seed + int(e) if e >= 0 else self.seed for e in episode]
+                obs, info = venv.reset(seed=seeds, options={"reset_mask": mask})
+                for i in restart.tolist():
+                    self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
+        return self._tables()
+
+    def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any, live: np.ndarray) -> None:
+        """Keep the live rows' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
+        if self.module == "predinet":
+            a1 = np.asarray(intro.attention1)[live]  # (m, H, N)
+            a2 = np.asarray(intro.attention2)[live]
+            i1, i2 = a1.argmax(-1), a2.argmax(-1)  # (m, H)
+            self.model.add(
+                ep=ep,
+                t=t,
+                i1=i1,
+                i2=i2,
+                w1=np.take_along_axis(a1, i1[..., None], -1)[..., 0],
+                w2=np.take_along_axis(a2, i2[..., None], -1)[..., 0],
+                e1=np.take_along_axis(grid, i1, 1),
+                e2=np.take_along_axis(grid, i2, 1),
+                rel=np.asarray(intro.relations)[live],  # (m, H, J)
+                rvec=np.asarray(intro.r_vectors())[live],  # (m, H, J + 4)
+            )
+        else:
+            att = np.asarray(intro.attention)[live]  # (m, H, N, N) query x key
+            k = min(self.top_keys, att.shape[-1])
+            if k == 1:
+                top = att.argmax(-1)[..., None]  # (m, H, N, 1)
+            else:  # the k largest, strongest first
+                part = np.argpartition(-att, k - 1, axis=-1)[..., :k]
+                order = np.argsort(-np.take_along_axis(att, part, -1), axis=-1, kind="stable")
+                top = np.take_along_axis(part, order, -1)  # (m, H, N, k)
+            weight = np.take_along_axis(att, top, -1)
+            self.model.add(ep=ep, t=t, top=top, weight=weight, grid=grid)
+
+    # -------------------------------------------------------------- tables
+
+    def _tables(self) -> Recording:
+        W = self.venv.entity_grid().shape[-1]
+        eps = pd.DataFrame(self.ep_rows, columns=["episode", "steps", "return", "outcome", "seed"])
+        eps = eps.sort_values("episode", kind="stable")
+        sc = self.step_cols
+        steps = pd.DataFrame(
+            {"episode": sc.get("episode"), "t": sc.get("t"), "action": sc.get("action"), "reward": sc.get("reward")}
+        )
+        positions = pd.DataFrame(self.trace.pos, columns=["episode", "t", "object", "type", "row", "col"])
+        holding = pd.DataFrame(self.trace.holding, columns=["episode", "t", "item"])
+        events = pd.DataFrame(self.trace.events, columns=["episode", "t", "event"])
+        tables: dict[str, pd.DataFrame] = {}
+        if self.module == "predinet":
+            tables.update(self._predinet_tables(W))
+        else:
+            tables["attention"] = self._attention_table(W)
+        order = ["episode", "t"]
+        rec = Recording(
+            episodes=eps,
+            steps=steps.sort_values(order, kind="stable"),
+            positions=positions.sort_values(order, kind="stable"),
+            holding=holding.sort_values(order, kind="stable"),
+            events=events.sort_values(order, kind="stable"),
+            **{k: v.sort_values(order, kind="stable") for k, v in tables.items()},
+        )
+        return rec
+
+    def _predinet_tables(self, W: int) -> dict[str, pd.DataFrame]:
+        m = self.model
+        ep, t = m.get("ep"), m.get("t")  # (S,)
+        i1, i2 = m.get("i1"), m.get("i2")  # (S, H)
+        S, H = i1.shape
+        rel = m.get("rel")  # (S, H, J)
+        rvec = m.get("rvec")  # (S, H, J + 4)
+        J = rel.shape[-1]
+        names = self.names
+        # attends: per (state, head, arg); arg 1 rows then arg 2 rows, sorted later
+        idx = np.stack([i1, i2], axis=-1)  # (S, H, 2)
+        ent = np.stack([m.get("e1"), m.get("e2")], axis=-1)
+        wgt = np.stack([m.get("w1"), m.get("w2")], axis=-1)
+        attends = pd.DataFrame(
+            {
+                "episode": np.repeat(ep, H * 2),
+                "t": np.repeat(t, H * 2),
+                "head": np.tile(np.repeat(np.arange(H), 2), S),
+                "arg": np.tile(np.array([1, 2]), S * H),
+                "entity": names[ent.reshape(-1)],
+                "row": idx.reshape(-1) // W,
+                "col": idx.reshape(-1) % W,
+                "weight": wgt.reshape(-1).astype(np.float64),
+            }
+        )
+        relations = pd.DataFrame(
+            {
+                "episode": np.repeat(ep, H * J),
+                "t": np.repeat(t, H * J),
+                "head": np.tile(np.repeat(np.arange(H), J), S),
+                "j": np.tile(np.arange(J), S * H),
+                "a": names[np.repeat(m.get("e1").reshape(-1), J)],
+                "b": names[np.repeat(m.get("e2").reshape(-1), J)],
+                "value": rel.reshape(-1).astype(np.float64),
+            }
+        )
+        R = rvec.shape[-1]
+        r_vectors = pd.DataFrame(
+            {
+                "episode": np.repeat(ep, H * R),
+                "t": np.repeat(t, H * R),
+                "head": np.tile(np.repeat(np.arange(H), R), S),
+                "j": np.tile(np.arange(R), S * H),
+                "value": rvec.reshape(-1).astype(np.float64),
+            }
+        )
+        return {"attends": attends, "relations": relations, "r_vectors": r_vectors}
+
+    def _attention_table(self, W: int) -> pd.DataFrame:
+        m = self.model
+        ep, t = m.get("ep"), m.get("t")  # (S,)
+        top, weight, grid = m.get("top"), m.get("weight"), m.get("grid")  # (S, H, N, k), (S, N)
+        S, H, N, k = top.shape
+        query_code = np.broadcast_to(grid[:, None, :, None], (S, H, N, k))
+        key_code = np.take_along_axis(np.broadcast_to(grid[:, None, :], (S, H, N)), top.reshape(S, H, N * k), -1)
+        query_cell = np.broadcast_to(np.arange(N)[None, None, :, None], (S, H, N, k))
+        background = np.isin(self.names, _BACKGROUND)
+        keep = ~background[query_code].reshape(-1)
+        flat_q = query_cell.reshape(-1)[keep]
+        flat_k = top.reshape(-1)[keep]
+        return pd.DataFrame(
+            {
+                "episode": np.repeat(ep, H * N * k)[keep],
+                "t": np.repeat(t, H * N * k)[keep],
+                "head": np.tile(np.repeat(np.arange(H), N * k), S)[keep],
+                "query": self.names[query_code.reshape(-1)[keep]],
+                "key": self.names[key_code.reshape(-1)[keep]],
+                "weight": weight.reshape(-1)[keep].astype(np.float64),
+                "query_row": flat_q // W,
+                "query_col": flat_q % W,
+                "key_row": flat_k // W,
+                "key_col": flat_k % W,
+            }
+        )
