@@ -1,0 +1,78 @@
+"""The actor-critic network: encoder -> PrediNet | MHDPA -> MLP -> policy logits and value.
+
+Table 4: the relational module's 26-wide output goes through 26 -> 256 -> 128
+-> 64 (ReLU) and then two linear heads, 4 policy logits and 1 value. The
+policy head starts with small weights (std 0.01 orthogonal) so the initial
+policy is close to uniform, which is what exploration on RGW needs.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from neurosym.agent.config import ModelConfig
+from neurosym.agent.encoder import Encoder
+from neurosym.agent.introspection import Introspection
+from neurosym.agent.mhdpa import MHDPA
+from neurosym.agent.predinet import PrediNet
+from neurosym.errors import ConfigError
+
+
+def build_relational(config: ModelConfig) -> nn.Module:
+    """The relational module named by ``config.module``."""
+    if config.module == "predinet":
+        return PrediNet(
+            config.n_entities,
+            config.entity_size,
+            config.heads,
+            config.key_size,
+            config.relations,
+            config.output_size,
+        )
+    return MHDPA(
+        config.entity_size, config.heads, config.key_size, config.value_size, config.output_size
+    )
+
+
+class ActorCritic(nn.Module):
+    """``forward(obs, introspect=False)`` per docs/interfaces.md."""
+
+    def __init__(self, config: ModelConfig) -> None:
+        super().__init__()
+        self.config = config
+        C, H, W = config.obs_shape
+        self.encoder = Encoder(C, H, W, config.conv_channels, config.kernel_size)
+        self.relational = build_relational(config)
+        layers: list[nn.Module] = []
+        width = config.output_size
+        for size in config.hidden_sizes:
+            layers += [nn.Linear(width, size), nn.ReLU()]
+            width = size
+        self.body = nn.Sequential(*layers)
+        self.policy = nn.Linear(width, config.n_actions)
+        self.value = nn.Linear(width, 1)
+        nn.init.orthogonal_(self.policy.weight, gain=0.01)
+        nn.init.zeros_(self.policy.bias)
+
+    def forward(
+        self, obs: torch.Tensor, introspect: bool = False
+    ) -> tuple[torch.Tensor, torch.Tensor] | tuple[torch.Tensor, torch.Tensor, Introspection]:
+        """obs (B, C, H, W), uint8 or float in the env's raw scale -> logits (B, 4), value (B,)[, intro]."""
+        if obs.dim() != 4 or tuple(obs.shape[1:]) != self.config.obs_shape:
+            raise ConfigError(
+                f"observation batch must have shape (B, {', '.join(map(str, self.config.obs_shape))}), "
+                f"got {tuple(obs.shape)}"
+            )
+        x = obs.to(torch.float32) * self.config.obs_scale  # (B, C, H, W)
+        entities = self.encoder(x)  # (B, N, F)
+        features, intro = self.relational(entities, introspect)  # (B, output_size)
+        h = self.body(features)  # (B, hidden[-1])
+        logits = self.policy(h)  # (B, n_actions)
+        value = self.value(h).squeeze(-1)  # (B,)
+        if introspect:
+            return logits, value, intro
+        return logits, value
+
+    def parameter_count(self) -> int:
+        return sum(p.numel() for p in self.parameters())

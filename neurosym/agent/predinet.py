@@ -1,0 +1,80 @@
+"""PrediNet (Shanahan et al. 2020) as DESIGN.md describes it.
+
+With L the (B, N, F) entities (F = features + 2 coordinates):
+
+* K = L W_K, shared by all heads;
+* per head h: Q1 = flat(L) W_Q1^h, Q2 = flat(L) W_Q2^h;
+* a1 = softmax(Q1 K^T / sqrt(d)), a2 = softmax(Q2 K^T / sqrt(d)) over entities;
+* E1 = a1 L, E2 = a2 L;
+* D^h = E1 W_S - E2 W_S, W_S shared by all heads so that relation j means the
+  same thing in every head;
+* R^h = [D^h, pos(E1), pos(E2)].
+
+Choices made here (DESIGN.md leaves them open):
+
+* The 1/sqrt(d) in the softmax is the usual attention temperature. It is the
+  same function class as DESIGN's softmax(Q K^T) (W_Q absorbs the factor) and
+  only makes the initial attention softer.
+* W_S reads the feature channels of E1 and E2, not their two coordinate
+  channels: as in the thesis (section 3.2.4), D carries no position
+  information; the positions are in R as pos(E1), pos(E2). D is computed as
+  (E1 - E2) W_S, which equals E1 W_S - E2 W_S and is exactly antisymmetric in
+  floating point.
+* The heads' R vectors are concatenated, (B, H * (J + 4)), and a linear layer
+  projects them to Table 4's output size (26). It is linear so that the
+  output is a plain read-out of R and the R vectors stay the only relational
+  features.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+
+from neurosym.agent.introspection import PrediNetIntrospection
+
+
+class PrediNet(nn.Module):
+    """(B, N, F) entities -> (B, output_size), optionally with the per-head internals."""
+
+    def __init__(
+        self,
+        n_entities: int,
+        entity_size: int,
+        heads: int,
+        key_size: int,
+        relations: int,
+        output_size: int,
+    ) -> None:
+        super().__init__()
+        assert entity_size > 2, "entities need features besides the 2 coordinates"
+        self.heads, self.key_size, self.relations = heads, key_size, relations
+        self.key = nn.Linear(entity_size, key_size, bias=False)  # W_K, shared
+        self.query1 = nn.Linear(
+            n_entities * entity_size, heads * key_size, bias=False
+        )  # W_Q1^h, all heads
+        self.query2 = nn.Linear(n_entities * entity_size, heads * key_size, bias=False)  # W_Q2^h
+        self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
+        self.out = nn.Linear(heads * (relations + 4), output_size)
+        self.scale = 1.0 / math.sqrt(key_size)
+
+    def forward(self, L: torch.Tensor, introspect: bool = False):
+        B, N, F = L.shape
+        H, D = self.heads, self.key_size
+        keys = self.key(L)  # (B, N, D)
+        flat = L.reshape(B, N * F)  # (B, N * F)
+        q1 = self.query1(flat).view(B, H, D)  # (B, H, D)
+        q2 = self.query2(flat).view(B, H, D)
+        a1 = torch.softmax(q1 @ keys.transpose(1, 2) * self.scale, dim=-1)  # (B, H, N)
+        a2 = torch.softmax(q2 @ keys.transpose(1, 2) * self.scale, dim=-1)  # (B, H, N)
+        e1 = a1 @ L  # (B, H, F)
+        e2 = a2 @ L  # (B, H, F)
+        rel = self.embed(e1[..., :-2] - e2[..., :-2])  # (B, H, J)  D^h
+        pos1, pos2 = e1[..., -2:], e2[..., -2:]  # (B, H, 2)
+        r = torch.cat([rel, pos1, pos2], dim=-1)  # (B, H, J + 4)
+        out = self.out(r.reshape(B, H * (self.relations + 4)))  # (B, output_size)
+        if not introspect:
+            return out, None
+        return out, PrediNetIntrospection(a1, a2, rel, pos1, pos2)

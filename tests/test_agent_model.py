@@ -1,0 +1,182 @@
+"""The agent network: shapes, batch size 1, introspection, PrediNet antisymmetry, MHDPA attention."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+
+from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.encoder import Encoder, coordinates
+from neurosym.agent.introspection import MHDPAIntrospection, PrediNetIntrospection
+from neurosym.agent.model import ActorCritic
+from neurosym.errors import ConfigError
+
+RGW = ((9, 10, 10), "rgw", 1.0)
+BW = ((3, 14, 14), "boxworld", 1 / 255)
+
+
+def make(
+    module: str, shape=RGW[0], family: str = "rgw", scale: float = 1.0, seed: int = 0, **kw
+) -> ActorCritic:
+    torch.manual_seed(seed)
+    return ActorCritic(ModelConfig.for_family(family, module, shape, scale, **kw))
+
+
+def obs_batch(batch: int, shape, seed: int = 1) -> torch.Tensor:
+    g = torch.Generator().manual_seed(seed)
+    high = 2 if shape[0] > 3 else 256
+    return torch.randint(0, high, (batch, *shape), generator=g, dtype=torch.uint8)
+
+
+@pytest.mark.parametrize("module", ["predinet", "mhdpa"])
+@pytest.mark.parametrize("env", [RGW, BW], ids=["rgw", "boxworld"])
+@pytest.mark.parametrize("batch", [1, 3])
+def test_forward_shapes(module: str, env, batch: int) -> None:
+    shape, family, scale = env
+    net = make(module, shape, family, scale)
+    N = shape[1] * shape[2]
+    logits, value = net(obs_batch(batch, shape))
+    assert logits.shape == (batch, 4) and value.shape == (batch,)
+    logits, value, intro = net(obs_batch(batch, shape), introspect=True)
+    H = net.config.heads
+    if module == "predinet":
+        J = net.config.relations
+        assert isinstance(intro, PrediNetIntrospection)
+        assert intro.attention1.shape == intro.attention2.shape == (batch, H, N)
+        assert intro.relations.shape == (batch, H, J)
+        assert intro.positions1.shape == intro.positions2.shape == (batch, H, 2)
+        assert intro.r_vectors().shape == (batch, H, J + 4)
+        assert intro.numpy().r_vectors().shape == (batch, H, J + 4)
+    else:
+        assert isinstance(intro, MHDPAIntrospection)
+        assert intro.attention.shape == (batch, H, N, N)
+
+
+def test_table4_defaults_per_family() -> None:
+    rgw = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
+    bw = ModelConfig.for_family("boxworld", "mhdpa", (3, 14, 14), 1 / 255)
+    assert (rgw.heads, rgw.key_size, rgw.relations, rgw.output_size) == (4, 32, 8, 26)
+    assert (bw.key_size, bw.value_size, bw.conv_channels, bw.hidden_sizes) == (
+        64,
+        64,
+        (12, 24),
+        (256, 128, 64),
+    )
+    assert rgw.entity_size == 26
+    assert (TrainConfig.for_family("rgw").lr, TrainConfig.for_family("rgw").entropy) == (2e-3, 0.02)
+    assert (TrainConfig.for_family("boxworld").lr, TrainConfig.for_family("boxworld").entropy) == (
+        2e-4,
+        0.01,
+    )
+    assert ModelConfig.for_family("rgw", "predinet", (9, 10, 10), relations=4).relations == 4
+
+
+def test_config_round_trip_and_errors() -> None:
+    cfg = ModelConfig.for_family("boxworld", "mhdpa", (3, 14, 14), 1 / 255, heads=2)
+    data = cfg.to_dict()
+    assert all(not isinstance(v, tuple) for v in data.values())
+    assert ModelConfig.from_dict(data) == cfg
+    with pytest.raises(ConfigError, match="unknown module 'lstm'"):
+        ModelConfig(module="lstm", obs_shape=(1, 2, 2))
+    with pytest.raises(ConfigError, match="unknown ModelConfig keys: colour"):
+        ModelConfig.from_dict({**data, "colour": 1})
+    with pytest.raises(ConfigError, match="heads must be a positive integer"):
+        ModelConfig(module="predinet", obs_shape=(1, 4, 4), heads=0)
+    with pytest.raises(ConfigError, match="unknown env family"):
+        TrainConfig.for_family("atari")
+
+
+def test_wrong_observation_shape_is_one_clear_error() -> None:
+    net = make("predinet")
+    with pytest.raises(ConfigError, match=r"shape \(B, 9, 10, 10\), got \(2, 3, 14, 14\)"):
+        net(obs_batch(2, (3, 14, 14)))
+
+
+@pytest.mark.parametrize("module", ["predinet", "mhdpa"])
+def test_introspection_does_not_change_logits(module: str) -> None:
+    net = make(module)
+    obs = obs_batch(4, RGW[0])
+    logits, value = net(obs)
+    logits_i, value_i, _ = net(obs, introspect=True)
+    assert torch.equal(logits, logits_i) and torch.equal(value, value_i)
+    # batch size 1 gives the same numbers as the same row inside a batch
+    one, _ = net(obs[2:3])
+    torch.testing.assert_close(one, logits[2:3], rtol=1e-5, atol=1e-6)
+
+
+def test_predinet_relations_antisymmetric_when_attentions_swap() -> None:
+    net = make("predinet")
+    obs = obs_batch(3, RGW[0])
+    _, _, a = net(obs, introspect=True)
+    rel = net.relational
+    with torch.no_grad():
+        w1, w2 = rel.query1.weight.clone(), rel.query2.weight.clone()
+        rel.query1.weight.copy_(w2)
+        rel.query2.weight.copy_(w1)
+    _, _, b = net(obs, introspect=True)
+    assert torch.equal(b.attention1, a.attention2) and torch.equal(b.attention2, a.attention1)
+    assert torch.equal(b.relations, -a.relations)
+    assert torch.equal(b.positions1, a.positions2) and torch.equal(b.positions2, a.positions1)
+    assert a.relations.abs().max() > 0
+
+
+def test_predinet_attention_and_positions() -> None:
+    net = make("predinet")
+    _, _, intro = net(obs_batch(2, RGW[0]), introspect=True)
+    for att in (intro.attention1, intro.attention2):
+        torch.testing.assert_close(att.sum(-1), torch.ones(2, 4))
+    # positions are the attention-weighted cell coordinates
+    coords = coordinates(10, 10)
+    torch.testing.assert_close(intro.positions1, intro.attention1 @ coords)
+    assert (
+        float(intro.positions2.min().detach()) >= 0 and float(intro.positions2.max().detach()) <= 1
+    )
+
+
+def test_mhdpa_attention_rows_sum_to_one_and_fold_is_exact() -> None:
+    net = make("mhdpa")
+    obs = obs_batch(2, RGW[0])
+    logits, _, intro = net(obs, introspect=True)
+    torch.testing.assert_close(intro.attention.sum(-1), torch.ones(2, 4, 100))
+    # the folded weights compute the textbook multi-head attention of the same parameters
+    m = net.relational
+    x = net.encoder(obs.float())
+    B, N, F = x.shape
+    H, D, V = m.heads, m.key_size, m.value_size
+    q = m.query(x).view(B, N, H, D).transpose(1, 2)
+    k = m.key(x).view(B, N, H, D).transpose(1, 2)
+    v = m.value(x).view(B, N, H, V).transpose(1, 2)
+    att = torch.softmax(q @ k.transpose(-1, -2) / D**0.5, dim=-1)
+    torch.testing.assert_close(att, intro.attention, rtol=1e-4, atol=1e-6)
+    y = m.norm1(x + m.proj((att @ v).transpose(1, 2).reshape(B, N, H * V)))
+    y = m.norm2(y + m.mlp(y)).amax(dim=1)
+    ref = net.policy(net.body(y))
+    torch.testing.assert_close(ref, logits, rtol=1e-4, atol=1e-6)
+
+
+def test_encoder_entity_k_is_cell_k() -> None:
+    enc = Encoder(1, 5, 7, (12, 24), 2)
+    torch.nn.init.constant_(enc.convs[0].bias, 0.0)
+    torch.nn.init.constant_(enc.convs[1].bias, 0.0)
+    for conv in enc.convs:
+        torch.nn.init.constant_(conv.weight, 1.0)
+    x = torch.zeros(1, 1, 5, 7)
+    x[0, 0, 2, 3] = 1.0
+    out = enc(x)
+    assert out.shape == (1, 35, 26)
+    lit = (out[0, :, :24].abs().sum(-1) > 0).view(5, 7).nonzero().tolist()
+    # one lit cell reaches exactly its 3 x 3 neighbourhood, centred on itself
+    assert lit == [[r, c] for r in (1, 2, 3) for c in (2, 3, 4)]
+    # coordinate channels: entity k = (k // W, k % W), scaled to [0, 1]
+    torch.testing.assert_close(out[0, 17, 24:], torch.tensor([2 / 4, 3 / 6]))
+
+
+def test_gradients_reach_every_parameter() -> None:
+    for module in ("predinet", "mhdpa"):
+        net = make(module)
+        logits, value = net(obs_batch(2, RGW[0]))
+        (logits.logsumexp(-1).sum() + value.sum()).backward()
+        missing = [
+            n for n, p in net.named_parameters() if p.grad is None or not p.grad.abs().sum() > 0
+        ]
+        assert missing == [], module
