@@ -1,1 +1,45 @@
-"""viz"""
+"""Pictures of what the agent relates: attention maps, R vectors, relation values, episodes.
+
+Each function takes a :class:`~neurosym.export.recording.Recording`, an
+:class:`~neurosym.agent.checkpoint.Agent` (played greedily on ``env`` from
+``reset(seed)``) or an :class:`EpisodeTrace`, and returns a matplotlib Figure
+(headless, no pyplot); :func:`save_figure` writes PNG or SVG reproducibly.
+
+    >>> from neurosym.viz import predinet_figure, save_figure
+    >>> fig = predinet_figure(load_agent("checkpoints/rgw2-predinet.pt"), "rgw2", step=3)
+    >>> save_figure(fig, "heads.png")
+
+Names are imported lazily so that ``neurosym plot --help`` does not load matplotlib.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_LAZY = {
+    "mhdpa_figure": "neurosym.viz.attention",
+    "predinet_figure": "neurosym.viz.predinet",
+    "r_vectors_figure": "neurosym.viz.predinet",
+    "relations_figure": "neurosym.viz.predinet",
+    "relation_values": "neurosym.viz.predinet",
+    "episode_figure": "neurosym.viz.episode",
+    "episode_frames": "neurosym.viz.episode",
+    "save_episode_gif": "neurosym.viz.episode",
+    "save_figure": "neurosym.viz.output",
+    "save_gif": "neurosym.viz.output",
+    "EpisodeTrace": "neurosym.viz.trace",
+    "load_trace": "neurosym.viz.sources",
+    "trace_from_recording": "neurosym.viz.sources",
+    "trace_from_agent": "neurosym.viz.sources",
+}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'neurosym.viz' has no attribute {name!r}")

@@ -1,0 +1,301 @@
+"""PrediNet pictures: where each head looks, its R vectors over time, and the relation values.
+
+* :func:`predinet_figure` -- per head, the two attention maps a1 and a2 over the
+  grid at one step, the attended objects named and framed, D^h in the note.
+* :func:`r_vectors_figure` -- R^h of every head over an episode as a heat map:
+  the J relation values (diverging colours, one scale for all heads, since W_S
+  is shared) above the four position values of E1 and E2 (0..1).
+* :func:`relations_figure` -- each relation's distribution of values over all
+  heads and steps, with the threshold that ``neurosym extract`` would apply
+  drawn at +/- its value (|D_j| above it becomes a ``holds/5`` fact).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from neurosym.errors import ConfigError
+from neurosym.viz.panels import Panel, heat_map_figure
+from neurosym.viz.sources import load_trace, require_source_module, trace_from_agent
+from neurosym.viz.style import head_colour
+from neurosym.viz.trace import EpisodeTrace
+
+DEFAULT_THRESHOLD = "quantile:0.9"
+"""the threshold spec ``neurosym extract`` uses by default"""
+
+NOT_RECORDED = "grey cells: weight not recorded (the recording keeps only each head's strongest cell)"
+
+R_WIDTH_INCHES = 8.0
+"""width of the R-vector heat map"""
+
+R_HEAD_INCHES = 1.6
+"""height of one head's block in the R-vector heat map"""
+
+HIST_PANEL_INCHES = (2.6, 2.2)
+"""(width, height) of one relation's histogram"""
+
+HIST_COLUMNS = 4
+"""relations per row of the histogram figure"""
+
+_BINS = 40
+
+
+# ---------------------------------------------------------------------------
+# attention maps at one step
+
+
+def predinet_figure(
+    source: Any,
+    env: Any = None,
+    *,
+    step: int = 0,
+    head: int | None = None,
+    episode: int | None = None,
+    seed: int = 0,
+) -> Figure:
+    """Per head, the attention maps a1 and a2 over the grid at ``step``, attended objects named."""
+    require_source_module(source, "predinet", "a PrediNet attention plot")
+    trace = load_trace(source, env, episode=episode, seed=seed, max_steps=step + 1)
+    return predinet_trace_figure(trace, step=step, head=head)
+
+
+def predinet_trace_figure(trace: EpisodeTrace, *, step: int = 0, head: int | None = None) -> Figure:
+    """:func:`predinet_figure` for a trace already built."""
+    trace.require("predinet", "a PrediNet attention plot")
+    trace.check_state(step)
+    assert trace.attention1 is not None and trace.attention2 is not None and trace.r_vectors is not None
+    heads = trace.heads if head is None else (trace.heads[trace.head_index(head)],)
+    h, w = trace.shape
+    names = trace.grids[step]
+    rows: list[list[Panel]] = [[], []]
+    notes = []
+    for hd in heads:
+        i = trace.head_index(hd)
+        colour = head_colour(i)
+        attended = []
+        for arg, maps in ((1, trace.attention1), (2, trace.attention2)):
+            weights = maps[step, i]  # (N,)
+            cell = int(np.nanargmax(weights)) if np.isfinite(weights).any() else -1
+            if cell < 0:
+                rows[arg - 1].append(Panel(weights.reshape(h, w), f"head {hd} · E{arg}: not recorded"))
+                attended.append("?")
+                continue
+            r, c = divmod(cell, w)
+            name = str(names[r, c])
+            attended.append(name)
+            title = f"head {hd} · E{arg} = {name} ({r},{c}) {weights[cell]:.2f}"
+            rows[arg - 1].append(Panel(weights.reshape(h, w), title, ((r, c, colour),)))
+        d = trace.r_vectors[step, i, : trace.relations]
+        values = " ".join(f"{v:+.2f}" for v in d)
+        notes.append(f"head {hd}: D({attended[0]}, {attended[1]}) = [{values}]")
+    if not trace.complete:
+        notes.append(NOT_RECORDED)
+    title = f"PrediNet attention a1 (top) and a2 (bottom) at step {step}\n{trace.title_name}"
+    return heat_map_figure(
+        rows,
+        names,
+        title=title,
+        colourbar_labels=("a1: weight of the cell", "a2: weight of the cell"),
+        note="\n".join(_pairs(notes)),
+    )
+
+
+def _pairs(lines: list[str]) -> list[str]:
+    """Two short lines per printed line, so four heads take two lines of the note."""
+    out = []
+    for i in range(0, len(lines), 2):
+        out.append("      ".join(lines[i : i + 2]))
+    return out
+
+
+# ---------------------------------------------------------------------------
+# R vectors over an episode
+
+
+def r_vectors_figure(
+    source: Any,
+    env: Any = None,
+    *,
+    head: int | None = None,
+    episode: int | None = None,
+    seed: int = 0,
+    max_steps: int | None = None,
+) -> Figure:
+    """R^h of every head (or one) at every step of an episode as a heat map."""
+    require_source_module(source, "predinet", "an R-vector plot")
+    trace = load_trace(source, env, episode=episode, seed=seed, max_steps=max_steps)
+    return r_vectors_trace_figure(trace, head=head)
+
+
+def r_vectors_trace_figure(trace: EpisodeTrace, *, head: int | None = None) -> Figure:
+    """:func:`r_vectors_figure` for a trace already built.
+
+    Size: 8.0 x (1.0 + 1.6 * heads shown) inches.
+    """
+    trace.require("predinet", "an R-vector plot")
+    if trace.steps == 0:
+        raise ConfigError(f"episode {trace.episode} has no steps: nothing to draw")
+    assert trace.r_vectors is not None
+    heads = trace.heads if head is None else (trace.heads[trace.head_index(head)],)
+    j = trace.relations
+    r = trace.r_vectors  # (S, heads, J + 4)
+    fig = Figure(figsize=(R_WIDTH_INCHES, 1.0 + R_HEAD_INCHES * len(heads)), layout="constrained")
+    fig.get_layout_engine().set(h_pad=0.02, hspace=0.0)
+    ratios = [v for _ in heads for v in (max(j, 1), 4)]
+    axes = fig.subplots(2 * len(heads), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
+    rel = r[:, [trace.head_index(hd) for hd in heads], :j]
+    top = float(np.nanmax(np.abs(rel))) if np.isfinite(rel).any() else 1.0
+    d_norm = Normalize(-top, top) if top > 0 else Normalize(-1, 1)
+    p_norm = Normalize(0.0, 1.0)
+    extent = (-0.5, trace.steps - 0.5, None, None)
+    d_image = p_image = None
+    for k, hd in enumerate(heads):
+        i = trace.head_index(hd)
+        ax_d, ax_p = axes[2 * k], axes[2 * k + 1]
+        d_image = ax_d.imshow(r[:, i, :j].T, aspect="auto", cmap="RdBu_r", norm=d_norm, interpolation="nearest",
+                              extent=(extent[0], extent[1], j - 0.5, -0.5))  # fmt: skip
+        ax_d.set_yticks(range(j), [f"r({x})" for x in range(j)], fontsize=6)
+        ax_d.set_ylabel(f"head {hd}", fontsize=8, color=head_colour(i), fontweight="bold")
+        p_image = ax_p.imshow(r[:, i, j:].T, aspect="auto", cmap="cividis", norm=p_norm, interpolation="nearest",
+                              extent=(extent[0], extent[1], 3.5, -0.5))  # fmt: skip
+        ax_p.set_yticks(range(4), ["E1 row", "E1 col", "E2 row", "E2 col"], fontsize=6)
+        for ax in (ax_d, ax_p):
+            ax.tick_params(axis="x", labelsize=7, length=2)
+            ax.tick_params(axis="y", length=0)
+    _mark_events(axes, trace)
+    axes[-1].set_xlabel("step t", fontsize=8)
+    axes[-1].xaxis.set_major_locator(MaxNLocator(integer=True))
+    # both bars beside all panels (side by side): bars over interleaved panels would overlap
+    d_bar = fig.colorbar(d_image, ax=list(axes), shrink=0.7, pad=0.01, fraction=0.03)
+    d_bar.set_label(r"relations r(j): $D^h_j = (E_1 - E_2)\,W_S$", fontsize=8)
+    p_bar = fig.colorbar(p_image, ax=list(axes), shrink=0.7, pad=0.01, fraction=0.03)
+    p_bar.set_label("position in [0, 1]", fontsize=8)
+    for bar in (d_bar, p_bar):
+        bar.ax.tick_params(labelsize=7)
+    outcome = f", outcome {trace.outcome}" if trace.outcome else ""
+    fig.suptitle(
+        f"PrediNet R vectors over {trace.steps} steps{outcome}\n{trace.title_name}", fontsize=10
+    )
+    return fig
+
+
+def _mark_events(axes: Sequence[Any], trace: EpisodeTrace) -> None:
+    """Dashed lines between state t and t+1 for each event, named above the first panel."""
+    if trace.events.empty:
+        return
+    grouped = trace.events.groupby("t")["event"].apply(lambda e: ", ".join(map(str, e)))
+    for t, text in grouped.items():
+        x = float(t) + 0.5
+        for ax in axes:
+            ax.axvline(x, color="black", linewidth=0.6, linestyle="--", alpha=0.6)
+        label = axes[0].annotate(text, (x, 1), xycoords=("data", "axes fraction"), xytext=(1, 1),
+                                 textcoords="offset points", fontsize=6, rotation=30, ha="left", va="bottom")  # fmt: skip
+        label.set_in_layout(False)
+
+
+# ---------------------------------------------------------------------------
+# distributions of relation values
+
+
+def relation_values(source: Any, env: Any = None, *, episodes: int = 1, seed: int = 0) -> tuple[pd.DataFrame, str]:
+    """The relation table (episode, t, head, j, value) and a phrase saying where it came from.
+
+    A Recording gives its ``relations`` table; an Agent plays ``episodes``
+    episodes from seeds ``seed, seed + 1, ...``; an EpisodeTrace gives its own.
+    """
+    require_source_module(source, "predinet", "a relation-value plot")
+    if isinstance(source, EpisodeTrace):
+        return _trace_relations([source]), source.title_name
+    if hasattr(source, "episodes") and hasattr(source, "relations"):
+        table = source.relations.loc[:, ["episode", "t", "head", "j", "value"]]
+        name = str(source.meta.get("checkpoint", "")) or "recording"
+        n = int(source.episodes["episode"].nunique())
+        return table, f"{_base(name)} on {source.meta.get('env', '?')}, {n} recorded episode{'s' * (n != 1)}"
+    if episodes < 1:
+        raise ConfigError(f"--episodes must be at least 1, got {episodes}")
+    traces = [trace_from_agent(source, env, seed=seed + e) for e in range(episodes)]
+    traces = [replace(t, episode=e) for e, t in enumerate(traces)]  # number the episodes 0..n-1
+    seeds = f"seed {seed}" if episodes == 1 else f"seeds {seed}..{seed + episodes - 1}"
+    env_name = traces[0].env
+    return _trace_relations(traces), f"{_base(str(source.path))} on {env_name}, {episodes} greedy episode{'s' * (episodes != 1)} ({seeds})"
+
+
+def _base(path: str) -> str:
+    return Path(path).name or path
+
+
+def _trace_relations(traces: Sequence[EpisodeTrace]) -> pd.DataFrame:
+    frames = []
+    for tr in traces:
+        assert tr.r_vectors is not None
+        d = tr.r_vectors[:, :, : tr.relations]  # (S, heads, J)
+        s, h, j = d.shape
+        t_idx, h_idx, j_idx = np.meshgrid(np.arange(s), np.asarray(tr.heads), np.arange(j), indexing="ij")
+        frames.append(pd.DataFrame({
+            "episode": tr.episode, "t": t_idx.ravel(), "head": h_idx.ravel(), "j": j_idx.ravel(), "value": d.ravel(),
+        }))  # fmt: skip
+    table = pd.concat(frames, ignore_index=True)
+    return table.loc[np.isfinite(table["value"].to_numpy())]
+
+
+def relations_figure(
+    source: Any,
+    env: Any = None,
+    *,
+    threshold: Any = DEFAULT_THRESHOLD,
+    episodes: int = 1,
+    seed: int = 0,
+) -> Figure:
+    """Histogram of each relation's values, per head and together, with its threshold marked.
+
+    Size: (2.6 * columns + 0.4) x (2.2 * rows + 1.0) inches, 4 relations per row.
+    """
+    from neurosym.export.thresholds import parse_threshold
+
+    rule = parse_threshold(threshold)
+    table, where = relation_values(source, env, episodes=episodes, seed=seed)
+    if table.empty:
+        raise ConfigError("there are no relation values to plot (the episodes have no steps)")
+    per_j = rule.per_relation(table)
+    js = sorted(int(j) for j in table["j"].unique())
+    heads = sorted(int(h) for h in table["head"].unique())
+    n_cols = min(HIST_COLUMNS, len(js))
+    n_rows = -(-len(js) // n_cols)
+    fig = Figure(figsize=(HIST_PANEL_INCHES[0] * n_cols + 0.4, HIST_PANEL_INCHES[1] * n_rows + 1.0), layout="constrained")
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    values = table["value"].to_numpy()
+    j_col = table["j"].to_numpy()
+    h_col = table["head"].to_numpy()
+    for k, ax in enumerate(axes.ravel()):
+        if k >= len(js):
+            ax.set_axis_off()
+            continue
+        j = js[k]
+        mine = j_col == j
+        v = values[mine]
+        edges = np.histogram_bin_edges(v, bins=_BINS)
+        ax.hist(v, bins=edges, color="#d0d0d0", label="all heads")
+        for i, hd in enumerate(heads):
+            ax.hist(v[h_col[mine] == hd], bins=edges, histtype="step", color=head_colour(i), linewidth=1.0,
+                    label=f"head {hd}")  # fmt: skip
+        thr = float(per_j.get(j, np.nan))
+        kept = int(np.sum(np.abs(v) > thr)) if np.isfinite(thr) else 0
+        if np.isfinite(thr):
+            for x in (-thr, thr):
+                ax.axvline(x, color="black", linestyle="--", linewidth=1.0)
+        ax.set_title(f"r({j}): threshold ±{thr:.3g}, {kept} of {len(v)} kept", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7)
+    axes[0, 0].set_ylabel("steps x heads", fontsize=7)
+    axes[0, 0].legend(fontsize=6, frameon=False, loc="upper left")
+    fig.suptitle(f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}", fontsize=10)
+    return fig

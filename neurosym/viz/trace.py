@@ -1,0 +1,160 @@
+"""One episode as the plots see it, whether it was recorded or played from a checkpoint.
+
+Every picture needs the same few things: what occupies each cell at each state,
+where the agent went, and what the relational module computed at each step.
+A saved :class:`~neurosym.export.recording.Recording` keeps only the strongest
+cells of each attention map, while a checkpoint played live gives the full
+maps; :class:`EpisodeTrace` holds both kinds, with ``NaN`` marking the weights
+that were not recorded (``complete`` says which kind it is), so one set of
+drawing functions serves both sources.
+
+Time follows the recording's convention: states 0..S, state 0 after reset, the
+action of step t taken in state t; model outputs exist for states 0..S-1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from neurosym.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class EpisodeTrace:
+    """One episode: the grid at every state plus the relational module's outputs."""
+
+    checkpoint: str
+    """name of the checkpoint that acted (used in titles)"""
+    env: str
+    """short environment name"""
+    module: str
+    """``"predinet"`` or ``"mhdpa"``"""
+    episode: int
+    """episode number in its recording (0 for a live run)"""
+    seed: int | None
+    """seed the episode's environment was reset with"""
+    grids: np.ndarray
+    """(S+1, H, W) object array of entity names, what occupies each cell at each state"""
+    actions: tuple[str, ...]
+    """(S,) action atoms"""
+    rewards: np.ndarray
+    """(S,) reward of each step"""
+    events: pd.DataFrame
+    """columns t, event: events of the transition out of state t"""
+    outcome: str | None
+    """how the episode ended (terminal, pit, timeout, gem, distractor), None if cut short"""
+    heads: tuple[int, ...]
+    """head numbers as the tables name them"""
+    relations: int
+    """J, number of PrediNet relations (0 for MHDPA)"""
+    complete: bool
+    """True when attention maps are full (live run), False when only the strongest cells were kept"""
+    attention1: np.ndarray | None = None
+    """PrediNet (S, heads, N) weights of a1 over cells; NaN where not recorded"""
+    attention2: np.ndarray | None = None
+    """PrediNet (S, heads, N) weights of a2 over cells; NaN where not recorded"""
+    r_vectors: np.ndarray | None = None
+    """PrediNet (S, heads, J + 4): D^h then (row, col) of E1 and of E2"""
+    mhdpa: dict[int, np.ndarray] = field(default_factory=dict)
+    """MHDPA state t -> (heads, N, N) query x key weights; NaN where not recorded"""
+    mhdpa_focus: np.ndarray | None = None
+    """MHDPA (S, heads) cell the agent's cell attends to most; -1 where unknown"""
+
+    @property
+    def steps(self) -> int:
+        """S, the number of steps taken."""
+        return len(self.actions)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(H, W) of the grid."""
+        return self.grids.shape[1], self.grids.shape[2]
+
+    @property
+    def title_name(self) -> str:
+        """``rgw2-predinet.pt on rgw2, episode 0 (seed 3)`` for figure titles."""
+        name = Path(self.checkpoint).name if self.checkpoint else "untitled agent"
+        seed = f" (seed {self.seed})" if self.seed is not None else ""
+        return f"{name} on {self.env}, episode {self.episode}{seed}"
+
+    @cached_property
+    def agent_path(self) -> np.ndarray:
+        """(S+1, 2) (row, col) of the agent at each state; (-1, -1) where it is not on the grid."""
+        is_agent = self.grids == "agent"  # (S+1, H, W)
+        flat = is_agent.reshape(len(self.grids), -1)
+        cell = flat.argmax(axis=1)
+        w = self.shape[1]
+        path = np.stack([cell // w, cell % w], axis=1)
+        path[~flat.any(axis=1)] = -1
+        return path
+
+    def head_index(self, head: int) -> int:
+        """Position of head number ``head`` in the arrays, or a one-line error."""
+        if head not in self.heads:
+            raise ConfigError(f"--head {head} is out of range: this agent has heads {_span(self.heads)}")
+        return self.heads.index(head)
+
+    def check_state(self, t: int, *, acted: bool = True) -> None:
+        """Refuse a state the episode does not have (``acted``: the model must have seen it)."""
+        last = self.steps - 1 if acted else self.steps
+        if last < 0:
+            raise ConfigError("the episode has no steps to show")
+        if not 0 <= t <= last:
+            raise ConfigError(f"--step {t} is out of range: episode {self.episode} has steps 0..{last}")
+
+    def require(self, module: str, what: str) -> None:
+        """Refuse a plot that needs the other relational module."""
+        require_module(self.module, module, what, self.checkpoint)
+
+    def locate(self, t: int, name: str | None = None, cell: tuple[int, int] | None = None) -> tuple[int, int, str]:
+        """(row, col, entity) of the object a picture is about, by name or by cell, at state t.
+
+        A name held by several cells (walls, pits) needs a cell to pick one.
+        """
+        grid = self.grids[t]
+        h, w = self.shape
+        if cell is not None:
+            row, col = cell
+            if not (0 <= row < h and 0 <= col < w):
+                raise ConfigError(f"--cell {row},{col} is outside the {h} x {w} grid")
+            return row, col, str(grid[row, col])
+        name = name or "agent"
+        hits = np.argwhere(grid == name)
+        if len(hits) == 1:
+            return int(hits[0][0]), int(hits[0][1]), name
+        if len(hits) == 0:
+            present = ", ".join(sorted(set(grid.ravel().tolist()) - {"empty"}))
+            raise ConfigError(f"--object {name}: no {name} on the grid at step {t} (there are: {present})")
+        where = " ".join(f"{r},{c}" for r, c in hits[:4].tolist()) + (" ..." if len(hits) > 4 else "")
+        raise ConfigError(f"--object {name}: {len(hits)} cells hold {name} at step {t}; pick one with --cell ({where})")
+
+    def event_text(self, t: int) -> str:
+        """Events of the transition out of state t, comma separated."""
+        if self.events.empty:
+            return ""
+        return ", ".join(self.events.loc[self.events["t"] == t, "event"].astype(str))
+
+
+_MODULE_TEXT = {"predinet": "a PrediNet", "mhdpa": "an MHDPA"}
+
+
+def require_module(found: str, wanted: str, what: str, checkpoint: str) -> None:
+    """One-line refusal when a plot for ``wanted`` is asked of an agent with module ``found``."""
+    if found == wanted:
+        return
+    name = Path(checkpoint).name if checkpoint else "this agent"
+    found_text = _MODULE_TEXT.get(found, f"a {found!r}")
+    raise ConfigError(f"{what} needs {_MODULE_TEXT[wanted]} agent, but {name} is {found_text} agent")
+
+
+def _span(values: tuple[int, ...]) -> str:
+    if not values:
+        return "none"
+    if list(values) == list(range(values[0], values[-1] + 1)):
+        return f"{values[0]}..{values[-1]}"
+    return ", ".join(map(str, values))
