@@ -21,7 +21,9 @@ from neurosym.viz.trace import EpisodeTrace
 OBJECT_FRAME = "#ff2d2d"
 """colour of the frame around the object a map is about"""
 
-NOT_RECORDED = "grey cells: weight not recorded (the recording keeps only the strongest keys of each query)"
+NOT_RECORDED = (
+    "grey cells: weight not recorded (the recording keeps only the strongest keys of each query)"
+)
 
 
 def mhdpa_figure(
@@ -42,7 +44,9 @@ def mhdpa_figure(
     position instead of by name; ``head`` draws one head instead of all.
     """
     require_source_module(source, "mhdpa", "an MHDPA attention plot")
-    trace = load_trace(source, env, episode=episode, seed=seed, max_steps=step + 1, keep_attention={step})
+    trace = load_trace(
+        source, env, episode=episode, seed=seed, max_steps=step + 1, keep_attention={step}
+    )
     return mhdpa_trace_figure(trace, step=step, object=object, cell=cell, head=head)
 
 
@@ -65,11 +69,19 @@ def mhdpa_trace_figure(
     where = f"{name} ({row},{col})"
     frame = ((row, col, OBJECT_FRAME),)
     outgoing = [
-        Panel(weights[trace.head_index(hd), q, :].reshape(h, w), f"head {hd}: {where} attends to", frame)
+        Panel(
+            weights[trace.head_index(hd), q, :].reshape(h, w),
+            f"head {hd}: {where} attends to",
+            frame,
+        )
         for hd in heads
     ]
     incoming = [
-        Panel(weights[trace.head_index(hd), :, q].reshape(h, w), f"head {hd}: attention on {where}", frame)
+        Panel(
+            weights[trace.head_index(hd), :, q].reshape(h, w),
+            f"head {hd}: attention on {where}",
+            frame,
+        )
         for hd in heads
     ]
     top = _strongest(weights, heads, trace, q, step)
@@ -84,7 +96,9 @@ def mhdpa_trace_figure(
     )
 
 
-def _strongest(weights: np.ndarray, heads: tuple[int, ...], trace: EpisodeTrace, q: int, step: int) -> str:
+def _strongest(
+    weights: np.ndarray, heads: tuple[int, ...], trace: EpisodeTrace, q: int, step: int
+) -> str:
     """``head 0 -> enemy (9,1) 0.41`` for each head: the cell the object attends to most."""
     names = trace.grids[step].ravel()
     w = trace.shape[1]

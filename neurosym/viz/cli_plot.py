@@ -36,41 +36,86 @@ def configure(parser: argparse.ArgumentParser) -> None:
             cmd.add_argument("--step", type=int, default=0, help="state to show (default: 0)")
         if name == "mhdpa":
             which = cmd.add_mutually_exclusive_group()
-            which.add_argument("--object", default=None,
-                               help="entity whose attention to draw, e.g. agent, enemy, key(red) (default: agent)")  # fmt: skip
-            which.add_argument("--cell", type=_cell, default=None, metavar="ROW,COL",
-                               help="pick the object by its cell instead (for walls, pits, ...)")  # fmt: skip
+            which.add_argument(
+                "--object",
+                default=None,
+                help="entity whose attention to draw, e.g. agent, enemy, key(red) (default: agent)",
+            )
+            which.add_argument(
+                "--cell",
+                type=_cell,
+                default=None,
+                metavar="ROW,COL",
+                help="pick the object by its cell instead (for walls, pits, ...)",
+            )
         if name != "relations":
             cmd.add_argument("--head", type=int, default=None, help="draw one head (default: all)")
         if name in ("rvectors", "episode"):
-            cmd.add_argument("--max-steps", type=int, default=None,
-                             help="with --checkpoint: stop the episode after this many steps (default: the env's limit)")  # fmt: skip
+            cmd.add_argument(
+                "--max-steps",
+                type=int,
+                default=None,
+                help="with --checkpoint: stop the episode after this many steps (default: the env's limit)",
+            )
         if name == "relations":
-            cmd.add_argument("--threshold", default="quantile:0.9",
-                             help="abs:X, quantile:Q or z:K, as for extract (default: quantile:0.9)")  # fmt: skip
-            cmd.add_argument("--episodes", type=int, default=1,
-                             help="with --checkpoint: episodes to play, seeds S, S+1, ... (default: 1)")  # fmt: skip
+            cmd.add_argument(
+                "--threshold",
+                default="quantile:0.9",
+                help="abs:X, quantile:Q or z:K, as for extract (default: quantile:0.9)",
+            )
+            cmd.add_argument(
+                "--episodes",
+                type=int,
+                default=1,
+                help="with --checkpoint: episodes to play, seeds S, S+1, ... (default: 1)",
+            )
         if name == "episode":
-            cmd.add_argument("--steps", default=None, metavar="START:STOP",
-                             help="states to draw, inclusive, e.g. 0:20 (default: all)")  # fmt: skip
-            cmd.add_argument("--frames", type=int, default=12,
-                             help="PNG/SVG strip: states shown, evenly spaced (default: 12)")  # fmt: skip
-            cmd.add_argument("--every", type=int, default=1, help="GIF: draw every k-th state (default: 1)")
-            cmd.add_argument("--fps", type=float, default=4.0, help="GIF: frames per second (default: 4)")
+            cmd.add_argument(
+                "--steps",
+                default=None,
+                metavar="START:STOP",
+                help="states to draw, inclusive, e.g. 0:20 (default: all)",
+            )
+            cmd.add_argument(
+                "--frames",
+                type=int,
+                default=12,
+                help="PNG/SVG strip: states shown, evenly spaced (default: 12)",
+            )
+            cmd.add_argument(
+                "--every", type=int, default=1, help="GIF: draw every k-th state (default: 1)"
+            )
+            cmd.add_argument(
+                "--fps", type=float, default=4.0, help="GIF: frames per second (default: 4)"
+            )
 
 
 def _source_options(cmd: argparse.ArgumentParser, *, gif: bool) -> None:
     source = cmd.add_mutually_exclusive_group(required=True)
     source.add_argument("--checkpoint", metavar="FILE", help="play this checkpoint (greedy)")
     source.add_argument("--recording", metavar="DIR", help="read this saved recording")
-    cmd.add_argument("--env", default=None, help="with --checkpoint: environment (default: the checkpoint's)")
-    cmd.add_argument("--episode-seed", type=int, default=None, metavar="S",
-                     help="with --checkpoint: reset seed of the episode (default: 0)")  # fmt: skip
-    cmd.add_argument("--episode", type=int, default=None, metavar="E",
-                     help="with --recording: episode number (default: the first)")  # fmt: skip
+    cmd.add_argument(
+        "--env", default=None, help="with --checkpoint: environment (default: the checkpoint's)"
+    )
+    cmd.add_argument(
+        "--episode-seed",
+        type=int,
+        default=None,
+        metavar="S",
+        help="with --checkpoint: reset seed of the episode (default: 0)",
+    )
+    cmd.add_argument(
+        "--episode",
+        type=int,
+        default=None,
+        metavar="E",
+        help="with --recording: episode number (default: the first)",
+    )
     kinds = ".png, .svg or .gif" if gif else ".png or .svg"
     cmd.add_argument("--out", required=True, metavar="FILE", help=f"image to write ({kinds})")
-    cmd.add_argument("--dpi", type=float, default=100.0, help="resolution of PNG output (default: 100)")
+    cmd.add_argument(
+        "--dpi", type=float, default=100.0, help="resolution of PNG output (default: 100)"
+    )
 
 
 def _cell(text: str) -> tuple[int, int]:
@@ -107,7 +152,9 @@ def _load_source(args: argparse.Namespace) -> Any:
 
         return Recording.load(args.recording)
     if args.episode is not None:
-        raise ConfigError("--episode goes with --recording; with --checkpoint pick the episode by --episode-seed")
+        raise ConfigError(
+            "--episode goes with --recording; with --checkpoint pick the episode by --episode-seed"
+        )
     from neurosym.agent.checkpoint import load_agent
 
     return load_agent(args.checkpoint)
@@ -120,22 +167,48 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
 
     where = {"episode": args.episode, "seed": args.episode_seed or 0}
     if args.plot == "mhdpa":
-        fig = attention.mhdpa_figure(source, args.env, step=args.step, object=args.object, cell=args.cell,
-                                     head=args.head, **where)  # fmt: skip
+        fig = attention.mhdpa_figure(
+            source,
+            args.env,
+            step=args.step,
+            object=args.object,
+            cell=args.cell,
+            head=args.head,
+            **where,
+        )
     elif args.plot == "predinet":
         fig = predinet.predinet_figure(source, args.env, step=args.step, head=args.head, **where)
     elif args.plot == "rvectors":
-        fig = predinet.r_vectors_figure(source, args.env, head=args.head, max_steps=_positive(args.max_steps), **where)
+        fig = predinet.r_vectors_figure(
+            source, args.env, head=args.head, max_steps=_positive(args.max_steps), **where
+        )
     elif args.plot == "relations":
-        fig = predinet.relations_figure(source, args.env, threshold=args.threshold, episodes=args.episodes,
-                                        seed=where["seed"])  # fmt: skip
+        fig = predinet.relations_figure(
+            source, args.env, threshold=args.threshold, episodes=args.episodes, seed=where["seed"]
+        )
     elif fmt == "gif":
-        path = episode.save_episode_gif(source, args.out, args.env, head=args.head, steps=episode.parse_steps(args.steps),
-                                        every=args.every, fps=args.fps, max_steps=_positive(args.max_steps), **where)  # fmt: skip
+        path = episode.save_episode_gif(
+            source,
+            args.out,
+            args.env,
+            head=args.head,
+            steps=episode.parse_steps(args.steps),
+            every=args.every,
+            fps=args.fps,
+            max_steps=_positive(args.max_steps),
+            **where,
+        )
         return _pixels(path)
     else:
-        fig = episode.episode_figure(source, args.env, head=args.head, steps=episode.parse_steps(args.steps),
-                                     frames=args.frames, max_steps=_positive(args.max_steps), **where)  # fmt: skip
+        fig = episode.episode_figure(
+            source,
+            args.env,
+            head=args.head,
+            steps=episode.parse_steps(args.steps),
+            frames=args.frames,
+            max_steps=_positive(args.max_steps),
+            **where,
+        )
     path = save_figure(fig, args.out, dpi=args.dpi)
     return _pixels(path) if fmt == "png" else "svg"
 

@@ -59,13 +59,17 @@ def parse_steps(text: str | None) -> tuple[int, int | None] | None:
     return lo, hi
 
 
-def choose_states(trace: EpisodeTrace, steps: tuple[int, int | None] | None, frames: int | None) -> list[int]:
+def choose_states(
+    trace: EpisodeTrace, steps: tuple[int, int | None] | None, frames: int | None
+) -> list[int]:
     """States to draw: those in ``steps`` (inclusive), thinned evenly to ``frames`` keeping both ends."""
     last = trace.steps
     lo, hi = steps if steps is not None else (0, None)
     hi = last if hi is None else hi
     if lo > last:
-        raise ConfigError(f"--steps starts at {lo}, but episode {trace.episode} has states 0..{last}")
+        raise ConfigError(
+            f"--steps starts at {lo}, but episode {trace.episode} has states 0..{last}"
+        )
     hi = min(hi, last)
     states = np.arange(lo, hi + 1)
     if frames is not None:
@@ -96,15 +100,23 @@ def head_pairs(trace: EpisodeTrace, t: int, heads: Sequence[int]) -> list[tuple[
     return out
 
 
-def draw_state(ax: Axes, trace: EpisodeTrace, t: int, heads: Sequence[int], *, panel_inches: float) -> None:
+def draw_state(
+    ax: Axes, trace: EpisodeTrace, t: int, heads: Sequence[int], *, panel_inches: float
+) -> None:
     """One state: grid, route so far, head arrows, and a title with the step's action."""
     w = trace.shape[1]
     fontsize = label_size(panel_inches, w)
     draw_entities(ax, trace.grids[t], fontsize=fontsize)
     draw_route(ax, trace.agent_path[: t + 1])
     for i, a, b in head_pairs(trace, t, heads):
-        head_arrow(ax, cell_xy(a, w), cell_xy(b, w), colour=head_colour(i), label=str(trace.heads[i]),
-                   fontsize=fontsize * 0.9)  # fmt: skip
+        head_arrow(
+            ax,
+            cell_xy(a, w),
+            cell_xy(b, w),
+            colour=head_colour(i),
+            label=str(trace.heads[i]),
+            fontsize=fontsize * 0.9,
+        )
     ax.set_title(state_title(trace, t), fontsize=7)
 
 
@@ -146,7 +158,9 @@ def episode_figure(
     max_steps: int | None = None,
 ) -> Figure:
     """A strip of states of one episode (``frames`` of them, evenly spaced over ``steps``)."""
-    trace = load_trace(source, env, episode=episode, seed=seed, max_steps=max_steps, keep_attention=set())
+    trace = load_trace(
+        source, env, episode=episode, seed=seed, max_steps=max_steps, keep_attention=set()
+    )
     return episode_trace_figure(trace, head=head, steps=steps, frames=frames)
 
 
@@ -178,10 +192,15 @@ def episode_trace_figure(
     outcome = f", outcome {trace.outcome}" if trace.outcome else ""
     total = float(np.sum(trace.rewards))
     fig.suptitle(
-        f"Episode of {trace.steps} steps, return {total:+.1f}{outcome}\n{trace.title_name}", fontsize=10
+        f"Episode of {trace.steps} steps, return {total:+.1f}{outcome}\n{trace.title_name}",
+        fontsize=10,
     )
-    fig.supxlabel(legend_text(np.concatenate([trace.grids[t].ravel() for t in states])) + "\n"
-                  + _arrow_note(trace, heads), fontsize=7)  # fmt: skip
+    fig.supxlabel(
+        legend_text(np.concatenate([trace.grids[t].ravel() for t in states]))
+        + "\n"
+        + _arrow_note(trace, heads),
+        fontsize=7,
+    )
     return fig
 
 
@@ -230,5 +249,7 @@ def save_episode_gif(
     max_steps: int | None = None,
 ) -> Path:
     """Write the episode as an animated GIF (320 x 368 pixels per frame), one state per frame."""
-    trace = load_trace(source, env, episode=episode, seed=seed, max_steps=max_steps, keep_attention=set())
+    trace = load_trace(
+        source, env, episode=episode, seed=seed, max_steps=max_steps, keep_attention=set()
+    )
     return save_gif(episode_frames(trace, head=head, steps=steps, every=every), path, fps=fps)

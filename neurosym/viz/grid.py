@@ -43,8 +43,12 @@ def _frame(ax: Axes, shape: tuple[int, int]) -> None:
     ax.set_yticks([])
     ax.set_aspect("equal")
     # one collection per direction: tick machinery per cell is slow
-    ax.vlines(np.arange(0.5, w - 1), -0.5, h - 0.5, colors="white", linewidth=0.4).set_in_layout(False)
-    ax.hlines(np.arange(0.5, h - 1), -0.5, w - 0.5, colors="white", linewidth=0.4).set_in_layout(False)
+    ax.vlines(np.arange(0.5, w - 1), -0.5, h - 0.5, colors="white", linewidth=0.4).set_in_layout(
+        False
+    )
+    ax.hlines(np.arange(0.5, h - 1), -0.5, w - 0.5, colors="white", linewidth=0.4).set_in_layout(
+        False
+    )
 
 
 def _patch(ax: Axes, patch: Patch) -> None:
@@ -71,8 +75,15 @@ def draw_entities(ax: Axes, names: np.ndarray, *, fontsize: float) -> AxesImage:
     for (r, c), name in np.ndenumerate(names):
         label = entity_label(name)
         if label:
-            _cell_text(ax, c, r, label, fontsize=fontsize, color=text_colour_on(entity_colour(name)),
-                       fontweight="bold")  # fmt: skip
+            _cell_text(
+                ax,
+                c,
+                r,
+                label,
+                fontsize=fontsize,
+                color=text_colour_on(entity_colour(name)),
+                fontweight="bold",
+            )
     return image
 
 
@@ -101,18 +112,45 @@ def label_entities(ax: Axes, names: np.ndarray, *, fontsize: float) -> None:
             continue
         _, colour = split_entity(name)
         if colour is not None:
-            _patch(ax, Rectangle((c - 0.45, r - 0.45), 0.35, 0.35, facecolor=entity_colour(name),
-                                   edgecolor="black", linewidth=0.3))  # fmt: skip
-        _cell_text(ax, c, r, label, fontsize=fontsize, color="black", fontweight="bold", path_effects=_STROKE)
+            _patch(
+                ax,
+                Rectangle(
+                    (c - 0.45, r - 0.45),
+                    0.35,
+                    0.35,
+                    facecolor=entity_colour(name),
+                    edgecolor="black",
+                    linewidth=0.3,
+                ),
+            )
+        _cell_text(
+            ax,
+            c,
+            r,
+            label,
+            fontsize=fontsize,
+            color="black",
+            fontweight="bold",
+            path_effects=_STROKE,
+        )
 
 
 def outline_cell(ax: Axes, row: int, col: int, *, colour: str, linewidth: float = 1.8) -> None:
     """A coloured frame around one cell (the object a map is about)."""
-    _patch(ax, Rectangle((col - 0.5, row - 0.5), 1, 1, fill=False, edgecolor=colour, linewidth=linewidth))
+    _patch(
+        ax,
+        Rectangle((col - 0.5, row - 0.5), 1, 1, fill=False, edgecolor=colour, linewidth=linewidth),
+    )
 
 
 def head_arrow(
-    ax: Axes, start: tuple[float, float], end: tuple[float, float], *, colour: str, label: str, fontsize: float
+    ax: Axes,
+    start: tuple[float, float],
+    end: tuple[float, float],
+    *,
+    colour: str,
+    label: str,
+    fontsize: float,
 ) -> None:
     """An arrow from one attended cell to the other, with the head number at its middle.
 
@@ -120,16 +158,47 @@ def head_arrow(
     """
     (x0, y0), (x1, y1) = start, end
     if (x0, y0) == (x1, y1):
-        _patch(ax, Rectangle((x0 - 0.38, y0 - 0.38), 0.76, 0.76, fill=False, edgecolor=colour, linewidth=1.5))
-        _cell_text(ax, x0 + 0.38, y0 - 0.38, label, color=colour, fontsize=fontsize, fontweight="bold",
-                   path_effects=_STROKE)  # fmt: skip
+        _patch(
+            ax,
+            Rectangle(
+                (x0 - 0.38, y0 - 0.38), 0.76, 0.76, fill=False, edgecolor=colour, linewidth=1.5
+            ),
+        )
+        _cell_text(
+            ax,
+            x0 + 0.38,
+            y0 - 0.38,
+            label,
+            color=colour,
+            fontsize=fontsize,
+            fontweight="bold",
+            path_effects=_STROKE,
+        )
         return
-    _patch(ax, 
-        FancyArrowPatch((x0, y0), (x1, y1), arrowstyle="-|>", mutation_scale=8, color=colour, linewidth=1.4,
-                        shrinkA=2, shrinkB=2, connectionstyle="arc3,rad=0.15")  # fmt: skip
+    _patch(
+        ax,
+        FancyArrowPatch(
+            (x0, y0),
+            (x1, y1),
+            arrowstyle="-|>",
+            mutation_scale=8,
+            color=colour,
+            linewidth=1.4,
+            shrinkA=2,
+            shrinkB=2,
+            connectionstyle="arc3,rad=0.15",
+        ),
     )
-    _cell_text(ax, (x0 + x1) / 2, (y0 + y1) / 2, label, color=colour, fontsize=fontsize, fontweight="bold",
-               path_effects=_STROKE)  # fmt: skip
+    _cell_text(
+        ax,
+        (x0 + x1) / 2,
+        (y0 + y1) / 2,
+        label,
+        color=colour,
+        fontsize=fontsize,
+        fontweight="bold",
+        path_effects=_STROKE,
+    )
 
 
 def draw_route(ax: Axes, path: np.ndarray, *, colour: str = "#1f77b4") -> LineCollection:
@@ -140,8 +209,14 @@ def draw_route(ax: Axes, path: np.ndarray, *, colour: str = "#1f77b4") -> LineCo
     xy = path[:, ::-1].astype(float)  # (S+1, 2) as (x=col, y=row)
     segments = np.stack([xy[keep], xy[keep + 1]], axis=1)  # (M, 2, 2)
     styles = ["solid" if moves[i] == 1 else (0, (1, 1.5)) for i in keep]
-    lines = LineCollection(segments, colors=colour, linewidths=2.0, alpha=0.75, linestyles=styles or "solid",
-                           capstyle="round")  # fmt: skip
+    lines = LineCollection(
+        segments,
+        colors=colour,
+        linewidths=2.0,
+        alpha=0.75,
+        linestyles=styles or "solid",
+        capstyle="round",
+    )
     ax.add_collection(lines)
     return lines
 
@@ -150,6 +225,4 @@ def _with_missing(cmap: str | Colormap) -> Colormap:
     import matplotlib
 
     base = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
-    out = base.copy()
-    out.set_bad(MISSING_COLOUR)
-    return out
+    return base.with_extremes(bad=MISSING_COLOUR)

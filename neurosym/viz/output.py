@@ -49,7 +49,9 @@ def figure_bytes(fig: Figure, fmt: str, dpi: float) -> bytes:
         with matplotlib.rc_context({"svg.hashsalt": _SVG_SALT, "svg.fonttype": "path"}):
             fig.savefig(buf, format="svg", dpi=dpi, metadata={"Date": None, "Creator": None})
     else:
-        raise ConfigError(f"cannot render a figure as {fmt!r}: use one of {', '.join(IMAGE_FORMATS)}")
+        raise ConfigError(
+            f"cannot render a figure as {fmt!r}: use one of {', '.join(IMAGE_FORMATS)}"
+        )
     return buf.getvalue()
 
 
@@ -68,7 +70,9 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
-        raise ConfigError(f"cannot write {os.fspath(path)!r}: folder {os.fspath(folder)!r} does not exist")
+        raise ConfigError(
+            f"cannot write {os.fspath(path)!r}: folder {os.fspath(folder)!r} does not exist"
+        )
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as fh:

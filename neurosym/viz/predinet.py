@@ -32,7 +32,9 @@ from neurosym.viz.trace import EpisodeTrace
 DEFAULT_THRESHOLD = "quantile:0.9"
 """the threshold spec ``neurosym extract`` uses by default"""
 
-NOT_RECORDED = "grey cells: weight not recorded (the recording keeps only each head's strongest cell)"
+NOT_RECORDED = (
+    "grey cells: weight not recorded (the recording keeps only each head's strongest cell)"
+)
 
 R_WIDTH_INCHES = 8.0
 """width of the R-vector heat map"""
@@ -72,7 +74,11 @@ def predinet_trace_figure(trace: EpisodeTrace, *, step: int = 0, head: int | Non
     """:func:`predinet_figure` for a trace already built."""
     trace.require("predinet", "a PrediNet attention plot")
     trace.check_state(step)
-    assert trace.attention1 is not None and trace.attention2 is not None and trace.r_vectors is not None
+    assert (
+        trace.attention1 is not None
+        and trace.attention2 is not None
+        and trace.r_vectors is not None
+    )
     heads = trace.heads if head is None else (trace.heads[trace.head_index(head)],)
     h, w = trace.shape
     names = trace.grids[step]
@@ -86,7 +92,9 @@ def predinet_trace_figure(trace: EpisodeTrace, *, step: int = 0, head: int | Non
             weights = maps[step, i]  # (N,)
             cell = int(np.nanargmax(weights)) if np.isfinite(weights).any() else -1
             if cell < 0:
-                rows[arg - 1].append(Panel(weights.reshape(h, w), f"head {hd} · E{arg}: not recorded"))
+                rows[arg - 1].append(
+                    Panel(weights.reshape(h, w), f"head {hd} · E{arg}: not recorded")
+                )
                 attended.append("?")
                 continue
             r, c = divmod(cell, w)
@@ -161,12 +169,24 @@ def r_vectors_trace_figure(trace: EpisodeTrace, *, head: int | None = None) -> F
     for k, hd in enumerate(heads):
         i = trace.head_index(hd)
         ax_d, ax_p = axes[2 * k], axes[2 * k + 1]
-        d_image = ax_d.imshow(r[:, i, :j].T, aspect="auto", cmap="RdBu_r", norm=d_norm, interpolation="nearest",
-                              extent=(extent[0], extent[1], j - 0.5, -0.5))  # fmt: skip
+        d_image = ax_d.imshow(
+            r[:, i, :j].T,
+            aspect="auto",
+            cmap="RdBu_r",
+            norm=d_norm,
+            interpolation="nearest",
+            extent=(extent[0], extent[1], j - 0.5, -0.5),
+        )
         ax_d.set_yticks(range(j), [f"r({x})" for x in range(j)], fontsize=6)
         ax_d.set_ylabel(f"head {hd}", fontsize=8, color=head_colour(i), fontweight="bold")
-        p_image = ax_p.imshow(r[:, i, j:].T, aspect="auto", cmap="cividis", norm=p_norm, interpolation="nearest",
-                              extent=(extent[0], extent[1], 3.5, -0.5))  # fmt: skip
+        p_image = ax_p.imshow(
+            r[:, i, j:].T,
+            aspect="auto",
+            cmap="cividis",
+            norm=p_norm,
+            interpolation="nearest",
+            extent=(extent[0], extent[1], 3.5, -0.5),
+        )
         ax_p.set_yticks(range(4), ["E1 row", "E1 col", "E2 row", "E2 col"], fontsize=6)
         for ax in (ax_d, ax_p):
             ax.tick_params(axis="x", labelsize=7, length=2)
@@ -197,8 +217,17 @@ def _mark_events(axes: Sequence[Any], trace: EpisodeTrace) -> None:
         x = float(t) + 0.5
         for ax in axes:
             ax.axvline(x, color="black", linewidth=0.6, linestyle="--", alpha=0.6)
-        label = axes[0].annotate(text, (x, 1), xycoords=("data", "axes fraction"), xytext=(1, 1),
-                                 textcoords="offset points", fontsize=6, rotation=30, ha="left", va="bottom")  # fmt: skip
+        label = axes[0].annotate(
+            text,
+            (x, 1),
+            xycoords=("data", "axes fraction"),
+            xytext=(1, 1),
+            textcoords="offset points",
+            fontsize=6,
+            rotation=30,
+            ha="left",
+            va="bottom",
+        )
         label.set_in_layout(False)
 
 
@@ -206,7 +235,9 @@ def _mark_events(axes: Sequence[Any], trace: EpisodeTrace) -> None:
 # distributions of relation values
 
 
-def relation_values(source: Any, env: Any = None, *, episodes: int = 1, seed: int = 0) -> tuple[pd.DataFrame, str]:
+def relation_values(
+    source: Any, env: Any = None, *, episodes: int = 1, seed: int = 0
+) -> tuple[pd.DataFrame, str]:
     """The relation table (episode, t, head, j, value) and a phrase saying where it came from.
 
     A Recording gives its ``relations`` table; an Agent plays ``episodes``
@@ -219,14 +250,20 @@ def relation_values(source: Any, env: Any = None, *, episodes: int = 1, seed: in
         table = source.relations.loc[:, ["episode", "t", "head", "j", "value"]]
         name = str(source.meta.get("checkpoint", "")) or "recording"
         n = int(source.episodes["episode"].nunique())
-        return table, f"{_base(name)} on {source.meta.get('env', '?')}, {n} recorded episode{'s' * (n != 1)}"
+        return (
+            table,
+            f"{_base(name)} on {source.meta.get('env', '?')}, {n} recorded episode{'s' * (n != 1)}",
+        )
     if episodes < 1:
         raise ConfigError(f"--episodes must be at least 1, got {episodes}")
     traces = [trace_from_agent(source, env, seed=seed + e) for e in range(episodes)]
     traces = [replace(t, episode=e) for e, t in enumerate(traces)]  # number the episodes 0..n-1
     seeds = f"seed {seed}" if episodes == 1 else f"seeds {seed}..{seed + episodes - 1}"
     env_name = traces[0].env
-    return _trace_relations(traces), f"{_base(str(source.path))} on {env_name}, {episodes} greedy episode{'s' * (episodes != 1)} ({seeds})"
+    return (
+        _trace_relations(traces),
+        f"{_base(str(source.path))} on {env_name}, {episodes} greedy episode{'s' * (episodes != 1)} ({seeds})",
+    )
 
 
 def _base(path: str) -> str:
@@ -239,10 +276,20 @@ def _trace_relations(traces: Sequence[EpisodeTrace]) -> pd.DataFrame:
         assert tr.r_vectors is not None
         d = tr.r_vectors[:, :, : tr.relations]  # (S, heads, J)
         s, h, j = d.shape
-        t_idx, h_idx, j_idx = np.meshgrid(np.arange(s), np.asarray(tr.heads), np.arange(j), indexing="ij")
-        frames.append(pd.DataFrame({
-            "episode": tr.episode, "t": t_idx.ravel(), "head": h_idx.ravel(), "j": j_idx.ravel(), "value": d.ravel(),
-        }))  # fmt: skip
+        t_idx, h_idx, j_idx = np.meshgrid(
+            np.arange(s), np.asarray(tr.heads), np.arange(j), indexing="ij"
+        )
+        frames.append(
+            pd.DataFrame(
+                {
+                    "episode": tr.episode,
+                    "t": t_idx.ravel(),
+                    "head": h_idx.ravel(),
+                    "j": j_idx.ravel(),
+                    "value": d.ravel(),
+                }
+            )
+        )
     table = pd.concat(frames, ignore_index=True)
     return table.loc[np.isfinite(table["value"].to_numpy())]
 
@@ -270,7 +317,10 @@ def relations_figure(
     heads = sorted(int(h) for h in table["head"].unique())
     n_cols = min(HIST_COLUMNS, len(js))
     n_rows = -(-len(js) // n_cols)
-    fig = Figure(figsize=(HIST_PANEL_INCHES[0] * n_cols + 0.4, HIST_PANEL_INCHES[1] * n_rows + 1.0), layout="constrained")
+    fig = Figure(
+        figsize=(HIST_PANEL_INCHES[0] * n_cols + 0.4, HIST_PANEL_INCHES[1] * n_rows + 1.0),
+        layout="constrained",
+    )
     axes = fig.subplots(n_rows, n_cols, squeeze=False)
     values = table["value"].to_numpy()
     j_col = table["j"].to_numpy()
@@ -285,8 +335,14 @@ def relations_figure(
         edges = np.histogram_bin_edges(v, bins=_BINS)
         ax.hist(v, bins=edges, color="#d0d0d0", label="all heads")
         for i, hd in enumerate(heads):
-            ax.hist(v[h_col[mine] == hd], bins=edges, histtype="step", color=head_colour(i), linewidth=1.0,
-                    label=f"head {hd}")  # fmt: skip
+            ax.hist(
+                v[h_col[mine] == hd],
+                bins=edges,
+                histtype="step",
+                color=head_colour(i),
+                linewidth=1.0,
+                label=f"head {hd}",
+            )
         thr = float(per_j.get(j, np.nan))
         kept = int(np.sum(np.abs(v) > thr)) if np.isfinite(thr) else 0
         if np.isfinite(thr):
@@ -297,5 +353,8 @@ def relations_figure(
         ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7)
     axes[0, 0].set_ylabel("steps x heads", fontsize=7)
     axes[0, 0].legend(fontsize=6, frameon=False, loc="upper left")
-    fig.suptitle(f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}", fontsize=10)
+    fig.suptitle(
+        f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}",
+        fontsize=10,
+    )
     return fig

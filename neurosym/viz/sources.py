@@ -40,7 +40,9 @@ def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
     if episode is None:
         episode = known[0]
     if episode not in known:
-        raise ConfigError(f"--episode {episode} is not in the recording: it has episodes {_list(known)}")
+        raise ConfigError(
+            f"--episode {episode} is not in the recording: it has episodes {_list(known)}"
+        )
     meta = dict(rec.meta)
     row = episodes.loc[episodes["episode"] == episode].iloc[0]
     steps_tab = _episode_rows(rec.steps, episode).sort_values("t")
@@ -89,7 +91,9 @@ def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
         focus = _recorded_focus(attention, grids, heads, shape, n_steps)
         del n_cells
         return EpisodeTrace(**common, mhdpa=lazy, mhdpa_focus=focus)
-    raise ConfigError(f"the recording names an unknown module {module!r}: expected predinet or mhdpa")
+    raise ConfigError(
+        f"the recording names an unknown module {module!r}: expected predinet or mhdpa"
+    )
 
 
 def _episode_rows(table: pd.DataFrame | None, episode: int) -> pd.DataFrame:
@@ -100,8 +104,10 @@ def _episode_rows(table: pd.DataFrame | None, episode: int) -> pd.DataFrame:
 
 def _list(values: list[int]) -> str:
     if len(values) > 8:
-        return f"{values[0]}..{values[-1]}" if values == list(range(values[0], values[-1] + 1)) else (
-            ", ".join(map(str, values[:8])) + ", ..."
+        return (
+            f"{values[0]}..{values[-1]}"
+            if values == list(range(values[0], values[-1] + 1))
+            else (", ".join(map(str, values[:8])) + ", ...")
         )
     return ", ".join(map(str, values))
 
@@ -163,7 +169,9 @@ def _grids_from_positions(
     return grids
 
 
-def _layout_agrees(base: np.ndarray, t: np.ndarray, r: np.ndarray, c: np.ndarray, kind: np.ndarray) -> bool:
+def _layout_agrees(
+    base: np.ndarray, t: np.ndarray, r: np.ndarray, c: np.ndarray, kind: np.ndarray
+) -> bool:
     first = (t == 0) & (kind != "agent")
     return bool(np.all(base[r[first], c[first]] == kind[first]))
 
@@ -199,12 +207,18 @@ def _sparse_argument_maps(
     if not attends.empty:
         tab = attends.loc[attends["t"] < n_steps]
         arg = tab["arg"].to_numpy(dtype=np.int64) - 1  # arg 1 / 2 -> 0 / 1
-        maps[arg, tab["t"].to_numpy(dtype=np.int64), _head_positions(heads, tab["head"]),
-             _cells(tab["row"], tab["col"], shape[1])] = tab["weight"].to_numpy(dtype=float)  # fmt: skip
+        maps[
+            arg,
+            tab["t"].to_numpy(dtype=np.int64),
+            _head_positions(heads, tab["head"]),
+            _cells(tab["row"], tab["col"], shape[1]),
+        ] = tab["weight"].to_numpy(dtype=float)
     return maps[0], maps[1]
 
 
-def _r_vector_array(r_vectors: pd.DataFrame, n_steps: int, heads: tuple[int, ...], relations: int) -> np.ndarray:
+def _r_vector_array(
+    r_vectors: pd.DataFrame, n_steps: int, heads: tuple[int, ...], relations: int
+) -> np.ndarray:
     """(S, heads, J + 4) R vectors; NaN where a component is missing."""
     out = np.full((n_steps, len(heads), relations + POSITION_COMPONENTS), np.nan)
     if r_vectors.empty:
@@ -213,9 +227,9 @@ def _r_vector_array(r_vectors: pd.DataFrame, n_steps: int, heads: tuple[int, ...
     j = tab["j"].to_numpy(dtype=np.int64)
     j = j - j.min() if len(j) else j  # components are numbered from 0 or 1: keep their order
     keep = j < out.shape[2]
-    out[tab["t"].to_numpy(dtype=np.int64)[keep], _head_positions(heads, tab["head"])[keep], j[keep]] = (
-        tab["value"].to_numpy(dtype=float)[keep]
-    )
+    out[
+        tab["t"].to_numpy(dtype=np.int64)[keep], _head_positions(heads, tab["head"])[keep], j[keep]
+    ] = tab["value"].to_numpy(dtype=float)[keep]
     return out
 
 
@@ -226,7 +240,9 @@ class _RecordedAttention(Mapping[int, np.ndarray]):
     and a plot needs one or two states.
     """
 
-    def __init__(self, table: pd.DataFrame, n_steps: int, heads: tuple[int, ...], shape: tuple[int, int]) -> None:
+    def __init__(
+        self, table: pd.DataFrame, n_steps: int, heads: tuple[int, ...], shape: tuple[int, int]
+    ) -> None:
         self._by_t = {int(t): rows for t, rows in table.groupby("t")} if not table.empty else {}
         self._n_steps = n_steps
         self._heads = heads
@@ -240,8 +256,11 @@ class _RecordedAttention(Mapping[int, np.ndarray]):
         rows = self._by_t.get(int(t))
         if rows is not None:
             w = self._shape[1]
-            out[_head_positions(self._heads, rows["head"]), _cells(rows["query_row"], rows["query_col"], w),
-                _cells(rows["key_row"], rows["key_col"], w)] = rows["weight"].to_numpy(dtype=float)  # fmt: skip
+            out[
+                _head_positions(self._heads, rows["head"]),
+                _cells(rows["query_row"], rows["query_col"], w),
+                _cells(rows["key_row"], rows["key_col"], w),
+            ] = rows["weight"].to_numpy(dtype=float)
         return out
 
     def __iter__(self) -> Iterator[int]:
@@ -252,7 +271,11 @@ class _RecordedAttention(Mapping[int, np.ndarray]):
 
 
 def _recorded_focus(
-    attention: pd.DataFrame, grids: np.ndarray, heads: tuple[int, ...], shape: tuple[int, int], n_steps: int
+    attention: pd.DataFrame,
+    grids: np.ndarray,
+    heads: tuple[int, ...],
+    shape: tuple[int, int],
+    n_steps: int,
 ) -> np.ndarray:
     """(S, heads) key cell with the largest recorded weight for the agent's cell as query; -1 if none."""
     focus = np.full((n_steps, len(heads)), -1, dtype=np.int64)
@@ -373,7 +396,9 @@ def trace_from_agent(
                 focus[t] = att[:, flat_grids[t].argmax(), :].argmax(axis=1)
             if keep_attention is None or t in keep_attention:
                 kept[t] = att
-        return EpisodeTrace(**common, heads=tuple(range(heads)), relations=0, mhdpa=kept, mhdpa_focus=focus)
+        return EpisodeTrace(
+            **common, heads=tuple(range(heads)), relations=0, mhdpa=kept, mhdpa_focus=focus
+        )
     raise ConfigError(f"{Path(str(agent.path)).name} has an unknown module {module!r}")
 
 
@@ -451,7 +476,9 @@ def load_trace(
     if hasattr(source, "episodes") and hasattr(source, "positions"):
         return trace_from_recording(source, episode)
     if hasattr(source, "act") and hasattr(source, "config"):
-        return trace_from_agent(source, env, seed=seed, max_steps=max_steps, keep_attention=keep_attention)
+        return trace_from_agent(
+            source, env, seed=seed, max_steps=max_steps, keep_attention=keep_attention
+        )
     raise ConfigError(
         f"cannot plot a {type(source).__name__}: pass a Recording, an Agent (load_agent) or an EpisodeTrace"
     )

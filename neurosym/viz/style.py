@@ -15,7 +15,16 @@ from collections.abc import Iterable
 
 from matplotlib import colors as mcolors
 
-HEAD_COLOURS = ("#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4", "#42d4f4", "#f032e6", "#9a6324")
+HEAD_COLOURS = (
+    "#e6194b",
+    "#3cb44b",
+    "#4363d8",
+    "#f58231",
+    "#911eb4",
+    "#42d4f4",
+    "#f032e6",
+    "#9a6324",
+)
 """one colour per head (arrows, histogram lines); repeats past eight heads"""
 
 ENTITY_COLOURS: dict[str, str] = {
@@ -49,10 +58,25 @@ ENTITY_LABELS: dict[str, str] = {
 
 _COLOURED = re.compile(r"^(key|lock|held)\((.+)\)$")
 _FALLBACK_PALETTE = (
-    "#e6194b", "#3cb44b", "#ffe119", "#4363d8", "#f58231", "#911eb4",
-    "#42d4f4", "#f032e6", "#bfef45", "#fabed4", "#469990", "#dcbeff",
-    "#9a6324", "#fffac8", "#800000", "#aaffc3", "#808000", "#ffd8b1",
-)  # fmt: skip
+    "#e6194b",
+    "#3cb44b",
+    "#ffe119",
+    "#4363d8",
+    "#f58231",
+    "#911eb4",
+    "#42d4f4",
+    "#f032e6",
+    "#bfef45",
+    "#fabed4",
+    "#469990",
+    "#dcbeff",
+    "#9a6324",
+    "#fffac8",
+    "#800000",
+    "#aaffc3",
+    "#808000",
+    "#ffd8b1",
+)
 
 
 def head_colour(head_index: int) -> str:

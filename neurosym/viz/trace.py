@@ -96,7 +96,9 @@ class EpisodeTrace:
     def head_index(self, head: int) -> int:
         """Position of head number ``head`` in the arrays, or a one-line error."""
         if head not in self.heads:
-            raise ConfigError(f"--head {head} is out of range: this agent has heads {_span(self.heads)}")
+            raise ConfigError(
+                f"--head {head} is out of range: this agent has heads {_span(self.heads)}"
+            )
         return self.heads.index(head)
 
     def check_state(self, t: int, *, acted: bool = True) -> None:
@@ -105,13 +107,17 @@ class EpisodeTrace:
         if last < 0:
             raise ConfigError("the episode has no steps to show")
         if not 0 <= t <= last:
-            raise ConfigError(f"--step {t} is out of range: episode {self.episode} has steps 0..{last}")
+            raise ConfigError(
+                f"--step {t} is out of range: episode {self.episode} has steps 0..{last}"
+            )
 
     def require(self, module: str, what: str) -> None:
         """Refuse a plot that needs the other relational module."""
         require_module(self.module, module, what, self.checkpoint)
 
-    def locate(self, t: int, name: str | None = None, cell: tuple[int, int] | None = None) -> tuple[int, int, str]:
+    def locate(
+        self, t: int, name: str | None = None, cell: tuple[int, int] | None = None
+    ) -> tuple[int, int, str]:
         """(row, col, entity) of the object a picture is about, by name or by cell, at state t.
 
         A name held by several cells (walls, pits) needs a cell to pick one.
@@ -129,9 +135,15 @@ class EpisodeTrace:
             return int(hits[0][0]), int(hits[0][1]), name
         if len(hits) == 0:
             present = ", ".join(sorted(set(grid.ravel().tolist()) - {"empty"}))
-            raise ConfigError(f"--object {name}: no {name} on the grid at step {t} (there are: {present})")
-        where = " ".join(f"{r},{c}" for r, c in hits[:4].tolist()) + (" ..." if len(hits) > 4 else "")
-        raise ConfigError(f"--object {name}: {len(hits)} cells hold {name} at step {t}; pick one with --cell ({where})")
+            raise ConfigError(
+                f"--object {name}: no {name} on the grid at step {t} (there are: {present})"
+            )
+        where = " ".join(f"{r},{c}" for r, c in hits[:4].tolist()) + (
+            " ..." if len(hits) > 4 else ""
+        )
+        raise ConfigError(
+            f"--object {name}: {len(hits)} cells hold {name} at step {t}; pick one with --cell ({where})"
+        )
 
     def event_text(self, t: int) -> str:
         """Events of the transition out of state t, comma separated."""
@@ -149,7 +161,9 @@ def require_module(found: str, wanted: str, what: str, checkpoint: str) -> None:
         return
     name = Path(checkpoint).name if checkpoint else "this agent"
     found_text = _MODULE_TEXT.get(found, f"a {found!r}")
-    raise ConfigError(f"{what} needs {_MODULE_TEXT[wanted]} agent, but {name} is {found_text} agent")
+    raise ConfigError(
+        f"{what} needs {_MODULE_TEXT[wanted]} agent, but {name} is {found_text} agent"
+    )
 
 
 def _span(values: tuple[int, ...]) -> str:
