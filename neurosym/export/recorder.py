@@ -7,9 +7,10 @@ relation values); the tables are built from them with array operations once,
 at the end.
 
 Seeding: episode k is played from ``reset(seed=seed + k)``, whichever
-sub-environment plays it (the recorder resets finished sub-environments with
-``reset_mask``), so ``make(env).reset(seed=episodes.seed[k])`` followed by the
-recorded actions replays episode k exactly. With ``greedy=False`` actions are
+sub-environment plays it (episodes run in waves of one reset of the whole
+batch), so ``make(env).reset(seed=episodes.seed[k])`` followed by the recorded
+actions replays episode k exactly, and greedy recordings do not depend on the
+batch size. With ``greedy=False`` actions are
 sampled from a torch generator seeded with ``seed``; the result then depends
 on the batch size too (the draws are shared out over the batch).
 """
@@ -75,13 +76,13 @@ class _Trace:
 
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
-        row, col = info["agent"]
-        self.pos.append((episode, t, "agent", "agent", int(row), int(col)))
-        self.pos.extend((episode, t, oid, otype, r, c) for oid, otype, r, c in info["objects"])
+        objects = info["objects"]
+        if not any(obj[0] == "agent" for obj in objects[:1]):  # RGW lists the agent first, Box-World not
+            row, col = info["agent"]
+            self.pos.append((episode, t, "agent", "agent", int(row), int(col)))
+        self.pos.extend((episode, t, oid, otype, int(r), int(c)) for oid, otype, r, c in objects)
         self.holding.extend((episode, t, item) for item in info["holding"])
 
-    def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
-        self.events.extend((episode, t, ev) for ev in info["events"])
 
 
 def _resolve_env(agent: Any, env: Any) -> str:
@@ -131,7 +132,8 @@ def record(
     if top_keys < 1:
         raise ConfigError(f"top_keys must be at least 1, got {top_keys}")
     name = _resolve_env(agent, env)
-    n = min(batch or DEFAULT_BATCH, episodes)
+    waves = -(-episodes // (batch or DEFAULT_BATCH))
+    n = -(-episodes // waves)  # equal waves: 100 episodes at batch 64 run as 2 x 50
     venv = make_batched(name, n, seed=seed, **dict(getattr(agent, "env_kwargs", {}) or {}))
     try:
         with _progress_bar(progress, episodes) as advance:
@@ -205,65 +207,60 @@ class _Recorder:
     # -------------------------------------------------------------- stepping
 
     def run(self) -> Recording:
+        """Play the episodes in waves of ``n``: reset every sub-env with its episode's seed, step to the end.
+
+        A sub-env whose episode ended keeps stepping (the env autoresets it)
+        until the wave's longest episode ends; its later steps are not recorded.
+        Waves need nothing beyond ``reset(seed=[...])``; the price is idle steps
+        when episode lengths differ within a wave.
+        """
+        for start in range(0, self.episodes, self.n):
+            self._wave(start, min(self.n, self.episodes - start))
+        return self._tables()
+
+    def _wave(self, start: int, count: int) -> None:
         from neurosym.envs import ACTION_NAMES
 
         action_names = np.asarray(ACTION_NAMES, dtype=object)
         n, venv = self.n, self.venv
         episode = np.full(n, -1, dtype=np.int64)  # episode each sub-env plays, -1 idle
+        episode[:count] = start + np.arange(count)
         t = np.zeros(n, dtype=np.int64)
         ret = np.zeros(n, dtype=np.float64)
-        first = np.arange(n)
-        episode[first] = first
-        next_episode = n
-        obs, info = venv.reset(seed=[self.seed + int(k) for k in first])
-        for i in first:
-            self.trace.state(int(episode[i]), 0, venv.decode_info(info, int(i)))
+        seeds = [self.seed + start + i for i in range(n)]
+        obs, info = venv.reset(seed=seeds)
+        for i in range(count):
+            self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
         while (live := np.flatnonzero(episode >= 0)).size:
             grid = venv.entity_grid().reshape(n, -1)  # (n, N) entity codes of the current states
             actions, intro = self.agent.act(obs, greedy=self.greedy, introspect=True, generator=self.generator)
             actions = np.asarray(actions)
-            self._model_outputs(episode[live], t[live], grid[live], intro, live)
+            self._model_outputs(episode[live], t[live], grid, intro, live)
             obs, reward, terminated, truncated, info = venv.step(actions.astype(np.int64))
             self.step_cols.add(
                 episode=episode[live], t=t[live], action=action_names[actions[live]], reward=reward[live]
             )
             ret[live] += reward[live]
-            done = np.zeros(n, dtype=bool)
+            ended = 0
             for i in live.tolist():
                 d = venv.decode_info(info, i)
-                e, s = int(episode[i]), int(t[i])
-                self.trace.transition(e, s, d)
-                self.trace.state(e, s + 1, d)
+                e, s = int(episode[i]), int(t[i]) + 1
+                self.trace.events.extend((e, s - 1, ev) for ev in d["events"])
+                self.trace.state(e, s, d)
                 if terminated[i] or truncated[i]:
-                    done[i] = True
                     outcome = d["outcome"] or ("timeout" if truncated[i] else "terminal")
-                    self.ep_rows.append((e, s + 1, float(ret[i]), str(outcome), self.seed + e))
-                elif s + 1 >= self.max_steps:
-                    raise ConfigError(
-                        f"episode {e} ran {self.max_steps} steps without ending; the env has no time limit"
-                    )
+                    self.ep_rows.append((e, s, float(ret[i]), str(outcome), self.seed + e))
+                    episode[i] = -1
+                    ended += 1
+                elif s >= self.max_steps:
+                    raise ConfigError(f"episode {e} ran {s} steps without ending; the env has no time limit")
             t[live] += 1
-            if not done.any():
-                continue
-            ended = np.flatnonzero(done)
-            self.advance(len(ended))
-            restart = ended[: max(0, self.episodes - next_episode)]
-            episode[ended] = -1
-            if restart.size:
-                episode[restart] = next_episode + np.arange(restart.size)
-                next_episode += restart.size
-                t[restart] = 0
-                ret[restart] = 0.0
-                mask = np.zeros(n, dtype=bool)
-                mask[restart] = True
-                seeds = [self.seed + int(e) if e >= 0 else self.seed for e in episode]
-                obs, info = venv.reset(seed=seeds, options={"reset_mask": mask})
-                for i in restart.tolist():
-                    self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
-        return self._tables()
+            if ended:
+                self.advance(ended)
 
     def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any, live: np.ndarray) -> None:
         """Keep the live rows' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
+        grid = grid[live]
         if self.module == "predinet":
             a1 = np.asarray(intro.attention1)[live]  # (m, H, N)
             a2 = np.asarray(intro.attention2)[live]

@@ -1,0 +1,147 @@
+"""``neurosym extract``: record episodes, extract the R-vector facts, write the KB, print answers.
+
+    neurosym extract --checkpoint ckpt.pt --env rgw2 [--episodes 20] [--seed 0]
+        [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
+        [--format pl,parquet] [--qlf]
+
+Writes into ``--out`` (default ``kb_out/<env>``):
+
+* ``kb.pl`` (format ``pl``) -- the knowledge base; ``kb.qlf`` beside it with ``--qlf``;
+* ``facts/<predicate>.parquet`` (format ``parquet``) -- the same fact tables;
+* ``recording/`` -- the Recording itself, for ``neurosym plot --recording``.
+
+Everything is computed in memory first and then moved into place, each file
+or folder by one rename, so a failed run writes nothing and a reader never
+sees half a KB. A checkpoint that cannot be read, or that was trained on
+another env, is refused before anything is recorded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from neurosym.errors import ConfigError
+
+FORMATS = ("pl", "parquet")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the extract options."""
+    parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
+    parser.add_argument(
+        "--env", required=True, metavar="NAME", help="environment the checkpoint was trained on, e.g. rgw2"
+    )
+    parser.add_argument("--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)")
+    parser.add_argument("--seed", type=int, default=0, metavar="S", help="episode k is played from seed S + k (default: 0)")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--greedy", dest="greedy", action="store_true", default=True, help="most likely action (default)")
+    mode.add_argument("--sample", dest="greedy", action="store_false", help="sample actions from the policy")
+    parser.add_argument(
+        "--threshold",
+        default="quantile:0.9",
+        metavar="SPEC",
+        help="per-relation threshold for holds/5: quantile:Q, abs:X or z:K (default: quantile:0.9)",
+    )
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: kb_out/<env>)")
+    parser.add_argument(
+        "--format", default="pl", metavar="LIST", help="comma-separated outputs: pl, parquet (default: pl)"
+    )
+    parser.add_argument("--qlf", action="store_true", help="also compile the KB to kb.qlf (fast loading)")
+    parser.add_argument("--batch", type=int, default=None, metavar="B", help="environments stepped together (default: 64)")
+    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+
+def parse_formats(text: str) -> tuple[str, ...]:
+    """``"pl,parquet"`` -> ("pl", "parquet"); one-line ConfigError for anything else."""
+    parts = tuple(dict.fromkeys(p.strip().lower() for p in text.split(",") if p.strip()))
+    bad = [p for p in parts if p not in FORMATS]
+    if bad or not parts:
+        raise ConfigError(f"bad --format {text!r}: expected a comma-separated list of {', '.join(FORMATS)}")
+    return parts
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate, record, extract, write, then print the summary and the rule answers."""
+    from neurosym.envs import canonical_name
+    from neurosym.export.thresholds import parse_threshold
+
+    formats = parse_formats(args.format)
+    threshold = parse_threshold(args.threshold)
+    if args.episodes < 1:
+        raise ConfigError(f"--episodes must be at least 1, got {args.episodes}")
+    if args.seed < 0:
+        raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
+    env = canonical_name(args.env)
+    out = Path(args.out) if args.out else Path("kb_out") / env
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out} exists and is not a folder")
+
+    from neurosym.agent.checkpoint import load_agent
+    from neurosym.export.facts import extract_facts
+    from neurosym.export.recorder import record
+
+    agent = load_agent(args.checkpoint, env=env)
+    show = not args.quiet
+    rec = record(agent, env, episodes=args.episodes, seed=args.seed, greedy=args.greedy, batch=args.batch, progress=show and _tty())
+    facts = extract_facts(rec, threshold=threshold)
+    written = write_outputs(out, rec, facts, formats, qlf=args.qlf)
+    if show:
+        from neurosym.export.report import print_report
+
+        print_report(rec, facts, written, kb=written.get("kb.pl"))
+    return 0
+
+
+def _tty() -> bool:
+    import sys
+
+    return sys.stderr.isatty()
+
+
+def write_outputs(out: Path, rec: Any, facts: Any, formats: tuple[str, ...], qlf: bool = False) -> dict[str, Path]:
+    """Write into a staging folder inside ``out``, then move each product into place by rename.
+
+    Only neurosym's own names (kb.pl, kb.qlf, facts/, recording/) are replaced in
+    ``out``; anything else there is left alone. Returns name -> final path.
+    """
+    created = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".extract-", dir=out))
+    ok = False
+    try:
+        if "pl" in formats:
+            facts.to_prolog(stage / "kb.pl", qlf=qlf)
+        if "parquet" in formats:
+            facts.to_parquet(stage / "facts")
+        rec.save(stage / "recording")
+        names = sorted(p.name for p in stage.iterdir() if not p.name.startswith("."))
+        written: dict[str, Path] = {}
+        for name in names:
+            _move_into_place(stage / name, out / name)
+            written[name] = out / name
+        ok = True
+        return written
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+        if created and not ok:
+            shutil.rmtree(out, ignore_errors=True)
+
+
+def _move_into_place(src: Path, dst: Path) -> None:
+    """Rename ``src`` onto ``dst``: a file in one os.replace, a folder by swapping it with the old one."""
+    if src.is_dir():
+        old = None
+        if dst.exists():
+            old = dst.with_name(f".{dst.name}.old-{os.getpid()}")
+            shutil.rmtree(old, ignore_errors=True)
+            os.replace(dst, old)
+        os.replace(src, dst)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(src, dst)
