@@ -1,0 +1,164 @@
+"""Environment names: short names, gymnasium ids, registration and the two factories.
+
+Every environment is registered with gymnasium under a versioned id with a
+string entry point, so nothing is imported until an environment is made (a
+missing Box-World module only fails when a Box-World env is made). Each id
+also carries a ``vector_entry_point``: the batched class that
+:func:`make_batched` (and ``gymnasium.make_vec``) builds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from neurosym.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class EnvEntry:
+    """One registered environment."""
+
+    short: str
+    id: str
+    family: str
+    entry_point: str
+    vector_entry_point: str
+    description: str
+    kwargs: dict[str, Any] = field(default_factory=dict)
+
+
+_RGW = "neurosym.envs.rgw:RGWEnv"
+_RGW_VEC = "neurosym.envs.rgw_vector:RGWVectorEnv"
+_BW = "neurosym.envs.boxworld:BoxWorldEnv"
+_BW_VEC = "neurosym.envs.boxworld:BoxWorldVectorEnv"
+
+ENTRIES: tuple[EnvEntry, ...] = (
+    EnvEntry(
+        "rgw1",
+        "neurosym/RGW1-v0",
+        "rgw",
+        _RGW,
+        _RGW_VEC,
+        "Relational-Grid-World Configuration-1: sword, enemy, teleport, terminal; optimal return 11",
+        {"map": "rgw1"},
+    ),
+    EnvEntry(
+        "rgw2",
+        "neurosym/RGW2-v0",
+        "rgw",
+        _RGW,
+        _RGW_VEC,
+        "Relational-Grid-World Configuration-2 (the original map): adds mountains and pits; optimal return 10.7",
+        {"map": "rgw2"},
+    ),
+    EnvEntry(
+        "rgw-random",
+        "neurosym/RGWRandom-v0",
+        "rgw",
+        "neurosym.envs.rgw_random:RGWRandomEnv",
+        "neurosym.envs.rgw_vector:RGWRandomVectorEnv",
+        "Relational-Grid-World on procedural levels: a new solvable level each episode, enemy on route in half",
+    ),
+    EnvEntry(
+        "bw1",
+        "neurosym/BW1-v0",
+        "boxworld",
+        _BW,
+        _BW_VEC,
+        "Box-World Configuration-1: solution length 1, no distractor",
+        {"solution_length": 1, "num_distractors": 0, "distractor_length": 1},
+    ),
+    EnvEntry(
+        "bw2",
+        "neurosym/BW2-v0",
+        "boxworld",
+        _BW,
+        _BW_VEC,
+        "Box-World Configuration-2: solution length 1, one distractor of length 1",
+        {"solution_length": 1, "num_distractors": 1, "distractor_length": 1},
+    ),
+    EnvEntry(
+        "bw3",
+        "neurosym/BW3-v0",
+        "boxworld",
+        _BW,
+        _BW_VEC,
+        "Box-World Configuration-3: solution length 2, no distractor",
+        {"solution_length": 2, "num_distractors": 0, "distractor_length": 1},
+    ),
+    EnvEntry(
+        "boxworld",
+        "neurosym/BoxWorld-v0",
+        "boxworld",
+        _BW,
+        _BW_VEC,
+        "Box-World with free parameters: solution_length, num_distractors, distractor_length, max_steps",
+    ),
+)
+
+ENVS: dict[str, str] = {e.short: e.id for e in ENTRIES}
+"""short name -> registered gymnasium id"""
+
+_BY_NAME: dict[str, EnvEntry] = {**{e.short: e for e in ENTRIES}, **{e.id: e for e in ENTRIES}}
+
+
+def register_envs() -> None:
+    """Register every id with gymnasium (idempotent; done on import of neurosym.envs)."""
+    import gymnasium
+
+    for e in ENTRIES:
+        if e.id not in gymnasium.registry:
+            gymnasium.register(
+                id=e.id,
+                entry_point=e.entry_point,
+                vector_entry_point=e.vector_entry_point,
+                kwargs=dict(e.kwargs),
+                nondeterministic=False,
+            )
+
+
+def entry(name_or_id: str) -> EnvEntry:
+    """The EnvEntry of a short name or id, or ConfigError listing the known names."""
+    found = _BY_NAME.get(name_or_id)
+    if found is None:
+        raise ConfigError(
+            f"unknown environment {name_or_id!r}; expected one of {', '.join(ENVS)} "
+            f"or an id such as {ENVS['rgw2']}"
+        )
+    return found
+
+
+def canonical_name(name_or_id: str) -> str:
+    """The short name (``rgw2``) of a short name or registered id (``neurosym/RGW2-v0``)."""
+    return entry(name_or_id).short
+
+
+def env_family(name_or_id: str) -> str:
+    """``"rgw"`` or ``"boxworld"``."""
+    return entry(name_or_id).family
+
+
+def make(name: str, **kwargs: Any) -> Any:
+    """A gymnasium env by short name or id; kwargs override the registered ones."""
+    import gymnasium
+
+    e = entry(name)
+    register_envs()
+    return gymnasium.make(e.id, **kwargs)
+
+
+def make_batched(name: str, n: int, seed: int | None = None, **kwargs: Any) -> Any:
+    """A batched env of n copies (gymnasium VectorEnv, next-step autoreset).
+
+    ``seed`` seeds the first ``reset()`` that gets none (sub-env i: seed + i).
+    """
+    import gymnasium
+
+    e = entry(name)
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise ConfigError(f"number of environments must be a positive integer, got {n!r}")
+    register_envs()
+    return gymnasium.make_vec(
+        e.id, num_envs=n, vectorization_mode="vector_entry_point", seed=seed, **kwargs
+    )
