@@ -17,9 +17,10 @@ $(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
 	@# torch first, pinned, so that the package's range never pulls the CUDA wheels.
 	@$(PY) -m pip show torch >/dev/null 2>&1 || $(PY) -m pip install -q "$(TORCH_SPEC)"
 	@bash scripts/setup_swipl.sh $(VENV) > $(SWIPL_PATH_FILE).tmp && mv $(SWIPL_PATH_FILE).tmp $(SWIPL_PATH_FILE)
-	@# janus-swi compiles against the swipl found on PATH: put ours first.
+	@# janus-swi compiles against the swipl found on PATH: put ours first, and never
+	@# reuse a cached wheel (it would link the libswipl of another checkout).
 	@$(PY) -c "import janus_swi" 2>/dev/null || \
-	  PATH="$$(dirname "$$(cat $(SWIPL_PATH_FILE))"):$$PATH" $(PY) -m pip install -q --no-binary janus-swi "janus-swi>=1.5.3"
+	  PATH="$$(dirname "$$(cat $(SWIPL_PATH_FILE))"):$$PATH" $(PY) -m pip install -q --no-cache-dir --no-binary janus-swi "janus-swi>=1.5.3"
 	@$(PY) -m pip install -q -e ".[dev]"
 	@touch $@
 	@echo "neurosym: set up in $(VENV) (swipl: $$(cat $(SWIPL_PATH_FILE)))"
