@@ -1,0 +1,189 @@
+"""The Prolog half of the janus bridge, loaded once per process.
+
+It is kept as text here (not a .pl file beside it) so that it ships with the
+package without any package-data settings. What it does, and why in Prolog:
+
+* ``new_kb/1`` makes a temporary module whose default is ``system`` (not
+  ``user``), so a KB sees library predicates but nothing someone else put in
+  ``user``; ``close_kb/2`` unloads its files and destroys the module.
+* ``load/5`` loads one file into a KB module under a per-module source id,
+  because SWI-Prolog refuses (or silently reconsults) one non-module file in
+  two modules. Errors and warnings printed during the load are captured with
+  ``message_hook/3`` and returned instead of being printed.
+* ``solve/7`` parses the goal text in the KB module, binds the inputs by
+  variable name (values never pass through goal text), runs it under
+  ``limit/2`` and returns every answer in one call, each value encoded so
+  janus converts it unambiguously: atoms and strings -> str, numbers, lists
+  -> list, compounds -> ``Functor-Args`` (a Python tuple), unbound -> None.
+"""
+
+from __future__ import annotations
+
+MODULE = "neurosym_bridge"
+
+SOURCE = r"""
+:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/7, count/6]).
+:- use_module(library(solution_sequences), [limit/2]).
+:- use_module(library(apply), [maplist/3, exclude/3, partition/4]).
+:- use_module(library(lists), [member/2]).
+
+:- thread_local collecting_/0, collected_/2.
+
+% Embedded in Python there is nobody to answer the debugger: an error that
+% slips through must become an exception, never an interactive prompt.
+:- set_prolog_flag(debug_on_error, false).
+:- multifile user:message_hook/3.
+:- dynamic user:message_hook/3.
+
+user:message_hook(_Term, Kind, Lines) :-
+    collecting_,
+    ( Kind == error ; Kind == warning ),
+    !,
+    lines_text_(Lines, Text0),
+    (   source_location(File, Line),
+        \+ sub_string(Text0, 0, _, _, File)
+    ->  format(string(Text), "~w:~w: ~w", [File, Line, Text0])
+    ;   Text = Text0
+    ),
+    assertz(collected_(Kind, Text)).
+
+lines_text_(Lines, Text) :-
+    with_output_to(string(Text0), print_message_lines(current_output, '', Lines)),
+    split_string(Text0, "\n", " \t", Parts0),
+    exclude(==(""), Parts0, Parts),
+    atomic_list_concat(Parts, ' ', Atom),
+    atom_string(Atom, Text).
+
+error_text_(E0, Text) :-
+    (   E0 = error(existence_error(procedure, PI), _)
+    ->  E = error(existence_error(procedure, PI), _)  % its context names findall_loop/4
+    ;   E = E0
+    ),
+    (   catch(translate_(E, Text), _, fail)
+    ->  true
+    ;   format(string(Text), "~q", [E])
+    ).
+
+translate_(E, Text) :-
+    '$messages':translate_message(E, Lines, []),
+    lines_text_(Lines, Text).
+
+%!  new_kb(+Module) is det.
+new_kb(M) :-
+    set_module(M:class(temporary)),
+    set_module(M:base(system)),
+    set_prolog_flag(M:unknown, error).
+
+%!  close_kb(+Module, +Files) is det.
+%   Files: the source ids load/5 used. Not every file loaded with context M:
+%   libraries autoloaded from M are shared with everyone else.
+close_kb(M, Files) :-
+    forall(member(File, Files), catch(unload_file(File), _, true)),
+    retractall(system:'$load_context_module'(_, M, _)),
+    '$destroy_module'(M).
+
+%!  load(+Module, +Id, +File, +Format, -Messages) is det.
+%   Messages: list of Kind-Text, Kind error or warning.
+load(M, Id, File, Format, Messages) :-
+    retractall(collected_(_, _)),
+    setup_call_cleanup(
+        assertz(collecting_),
+        catch(load_(M, Id, File, Format), E, print_message(error, E)),
+        retractall(collecting_)),
+    findall(Kind-Text, retract(collected_(Kind, Text)), Messages).
+
+load_(M, Id, File, source) :-
+    setup_call_cleanup(
+        open(File, read, S, [encoding(utf8)]),
+        load_files(M:Id, [stream(S), silent(true)]),
+        close(S)).
+load_(M, Id, File, qlf) :-
+    setup_call_cleanup(
+        open(File, read, S, [type(binary)]),
+        load_files(M:Id, [stream(S), format(qlf), silent(true)]),
+        close(S)).
+
+%!  solve(+M, +Text, +Inputs, +Limit, -Names, -Rows, -Status) is det.
+%   Status: ok, missing-Names or error-Text (pairs: janus makes them tuples).
+solve(M, Text, Inputs, Limit, Names, Rows, Status) :-
+    catch(solve_(M, Text, Inputs, Limit, Names, Rows, Status), E,
+          ( error_text_(E, Msg), Names = [], Rows = [], Status = error-Msg )).
+
+solve_(M, Text, Inputs, Limit, Names, Rows, Status) :-
+    prepare_(M, Text, Inputs, Goal, Names, Vars, Missing),
+    (   Missing \== []
+    ->  Rows = [], Status = missing-Missing
+    ;   Template =.. [v|Vars],
+        (   Limit == all
+        ->  findall(Template, M:Goal, Raw)
+        ;   findall(Template, limit(Limit, M:Goal), Raw)
+        ),
+        maplist(encode_row_, Raw, Rows),
+        Status = ok
+    ).
+
+%!  count(+M, +Text, +Inputs, +Limit, -N, -Status) is det.
+count(M, Text, Inputs, Limit, N, Status) :-
+    catch(( prepare_(M, Text, Inputs, Goal, _, _, Missing),
+            (   Missing \== []
+            ->  N = 0, Status = missing-Missing
+            ;   Limit == all
+            ->  aggregate_all(count, M:Goal, N), Status = ok
+            ;   aggregate_all(count, limit(Limit, M:Goal), N), Status = ok
+            )
+          ), E,
+          ( error_text_(E, Msg), N = 0, Status = error-Msg )).
+
+prepare_(M, Text, Inputs, Goal, Names, Vars, Missing) :-
+    term_string(Goal, Text, [variable_names(Bindings), module(M)]),
+    (   Goal == end_of_file
+    ->  throw(error(syntax_error(empty_goal), _))
+    ;   true
+    ),
+    bind_inputs_(Inputs, Bindings, Missing),
+    outputs_(Bindings, Inputs, Names, Vars).
+
+% The named variables that are not inputs, in order; no findall: it would copy them.
+outputs_([], _, [], []).
+outputs_([Name=Var|T], Inputs, Names, Vars) :-
+    (   ( sub_atom(Name, 0, _, _, '_') ; memberchk(Name-_, Inputs) )
+    ->  outputs_(T, Inputs, Names, Vars)
+    ;   Names = [Name|Names1], Vars = [Var|Vars1],
+        outputs_(T, Inputs, Names1, Vars1)
+    ).
+
+bind_inputs_([], _, []).
+bind_inputs_([Name-Value0|T], Bindings, Missing) :-
+    (   memberchk(Name=Var, Bindings)
+    ->  decode_(Value0, Value),
+        Var = Value,
+        Missing = Missing1
+    ;   Missing = [Name|Missing1]
+    ),
+    bind_inputs_(T, Bindings, Missing1).
+
+% Python -> Prolog: janus made atoms, numbers and lists already; a Term
+% arrives as the tuple ('$neurosym_term', Functor, Args).
+decode_(X, X) :- var(X), !.
+decode_(-('$neurosym_term', F, As0), T) :- !,
+    maplist(decode_, As0, As),
+    compound_name_arguments(T, F, As).
+decode_(L0, L) :- is_list(L0), !, maplist(decode_, L0, L).
+decode_(X, X).
+
+encode_row_(Template, Row) :-
+    Template =.. [v|Values],
+    maplist(encode_, Values, Row).
+
+% Prolog -> Python, see the module comment.
+encode_(V, @(none)) :- var(V), !.
+encode_(X, X) :- atom(X), !.
+encode_(X, X) :- number(X), !.
+encode_(X, X) :- string(X), !.
+encode_(L, E) :- is_list(L), !, maplist(encode_, L, E).
+encode_(D, S) :- is_dict(D), !, format(string(S), "~q", [D]).
+encode_(T, F-As) :- compound(T), !,
+    compound_name_arguments(T, F, As0),
+    maplist(encode_, As0, As).
+encode_(X, S) :- format(string(S), "~q", [X]).
+"""

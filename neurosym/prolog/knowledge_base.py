@@ -1,0 +1,334 @@
+"""KnowledgeBase: fact files and rule files queried from Python through janus-swi.
+
+Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
+one process even when they load the same rule file. Files are plain Prolog
+(no module header); they are loaded under a per-module source id because
+SWI-Prolog will not load one non-module file into two modules.
+
+Values cross the boundary as data, never as goal text:
+
+* inputs (``kb.query("object(Id, T)", Id="agent")``): ``str`` -> atom,
+  ``int``/``float`` -> number, ``bool`` -> ``true``/``false``,
+  :class:`~neurosym.terms.Term` -> compound, list/tuple -> list;
+* outputs: atoms and strings -> ``str``, numbers -> ``int``/``float``,
+  lists -> ``list``, compound terms -> :class:`~neurosym.terms.Term` (whose
+  ``str()`` is the canonical text that recordings store, e.g.
+  ``picked(sword)``; lists inside a Term are tuples), unbound variables -> None.
+
+Output variables are the goal's named variables that are not inputs; names
+starting with ``_`` are left out. Any Prolog error (syntax, unknown
+procedure, type) raises :class:`~neurosym.errors.PrologError` with Prolog's
+message on one line. Large fact files load from ``.qlf`` with ``qlf=True``
+(compiled on first use, recompiled when the source is newer).
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+import threading
+import warnings
+import weakref
+from collections.abc import Iterable, Sequence
+from os import PathLike
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from neurosym.errors import ConfigError, NeurosymError, PrologError
+from neurosym.prolog import bridge
+from neurosym.prolog.locate import import_janus
+from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
+from neurosym.terms import Term
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+PathArg = str | PathLike[str]
+_VARIABLE = re.compile(r"[A-Z_][A-Za-z0-9_]*")
+_SCALARS = frozenset({str, int, float, type(None)})
+_ids = itertools.count(1)
+_bridge_lock = threading.Lock()
+_bridge_loaded = False
+
+
+class PrologWarning(UserWarning):
+    """A warning SWI-Prolog printed while loading a file (singleton variables, discontiguous clauses)."""
+
+
+class KnowledgeBaseFileNotFoundError(NeurosymError, FileNotFoundError):
+    """A fact or rule file that does not exist."""
+
+
+def _janus() -> Any:
+    """janus with the bridge module loaded (once per process)."""
+    global _bridge_loaded
+    janus = import_janus()
+    if not _bridge_loaded:
+        with _bridge_lock:
+            if not _bridge_loaded:
+                janus.consult(f"/neurosym/{bridge.MODULE}.pl", data=bridge.SOURCE)
+                _bridge_loaded = True
+    return janus
+
+
+def _call_once(goal: str, inputs: dict[str, Any]) -> dict[str, Any]:
+    janus = _janus()
+    try:
+        return janus.query_once(goal, inputs)
+    except janus.PrologError as exc:  # the bridge catches user errors; this is a bug or a crash
+        raise PrologError(_one_line(str(exc))) from exc
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def _to_prolog(value: Any, name: str) -> Any:
+    """Python input value -> what janus turns into the intended Prolog term."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return value
+    if isinstance(value, Term):
+        if not value.args:
+            return value.functor
+        return ("$neurosym_term", value.functor, [_to_prolog(a, name) for a in value.args])
+    if isinstance(value, list | tuple):
+        return [_to_prolog(v, name) for v in value]
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    if kind in ("b", "i", "u", "f", "U"):  # numpy scalars
+        return _to_prolog(value.item(), name)
+    if value is None:
+        raise ConfigError(f"input {name} is None; leave it out to keep {name} a free variable")
+    raise ConfigError(f"input {name}: cannot pass a {type(value).__name__} to Prolog")
+
+
+def _from_prolog(value: Any) -> Any:
+    """What the bridge encoded -> Python value (see the module docstring)."""
+    if type(value) in _SCALARS:
+        return value
+    if isinstance(value, tuple):
+        functor, args = value
+        return Term(functor, tuple(_from_prolog(a) for a in args))
+    if isinstance(value, list):
+        return [_from_prolog(v) for v in value]
+    return value
+
+
+def _as_paths(paths: PathArg | Iterable[PathArg] | None) -> list[Path]:
+    if paths is None:
+        return []
+    if isinstance(paths, str | PathLike):
+        return [Path(paths)]
+    return [Path(p) for p in paths]
+
+
+class KnowledgeBase:
+    """Facts and rules in a Prolog module of their own; query them with Python values.
+
+    >>> with KnowledgeBase("kb/rgw2.pl", rules=["rules/rgw.pl"]) as kb:
+    ...     kb.query("event(E, T, picked(Item))", E=0)
+    [{'T': 4, 'Item': 'sword'}]
+    """
+
+    def __init__(
+        self,
+        facts: PathArg | Sequence[PathArg] | None,
+        rules: PathArg | Sequence[PathArg] = (),
+        *,
+        qlf: bool = False,
+    ) -> None:
+        self.module = f"neurosym_kb_{next(_ids)}"
+        self.files: list[Path] = []
+        self._closed = False
+        _call_once(f"{bridge.MODULE}:new_kb(M)", {"M": self.module})
+        self._source_ids: list[str] = []  # what to unload on close
+        self._finalizer = weakref.finalize(self, _close_module, self.module, self._source_ids)
+        self._finalizer.atexit = False
+        try:
+            for path in _as_paths(facts):
+                self.load(path, qlf=qlf)
+            for path in _as_paths(rules):
+                self.load(path)
+        except BaseException:
+            self.close()
+            raise
+
+    # -- loading -----------------------------------------------------------
+
+    def load(self, path: PathArg, *, qlf: bool = False) -> None:
+        """Load one more Prolog file (facts or rules) into this KB.
+
+        A ``.qlf`` path is loaded as a quick-load file; with ``qlf=True`` a
+        ``.pl`` source is compiled to ``.qlf`` first (when missing or stale).
+        Syntax and other load errors raise :class:`PrologError` naming the
+        file and line; the file's clauses are then unloaded again.
+        """
+        self._check_open()
+        path = Path(path)
+        if not path.is_file():
+            raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {path}")
+        path = path.resolve()
+        if path.suffix == ".qlf" or qlf:
+            if path.suffix != ".qlf" and not is_fresh(path):
+                qcompile(path)
+            load_file, fmt = qlf_path(path), "qlf"
+            # A per-module directory: SWI-Prolog relocates the .qlf's recorded
+            # source path into it, so each KB owns its own copy of the clauses.
+            source_id = f"{path.parent}/.{self.module}/{load_file.name}"
+            clause_source = f"{path.parent}/.{self.module}/{path.stem}.pl"
+            aliases = {clause_source: str(path.with_suffix(".pl"))}
+        else:
+            load_file, fmt = path, "source"
+            source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
+            aliases = {}
+        aliases[source_id] = str(path)
+        self._source_ids.extend(aliases)
+        answer = _call_once(
+            f"{bridge.MODULE}:load(M, Id, File, Format, Messages)",
+            {"M": self.module, "Id": source_id, "File": str(load_file), "Format": fmt},
+        )
+        errors, notes = [], []
+        for kind, text in answer["Messages"]:
+            for alias, real in aliases.items():
+                text = text.replace(alias, real)
+            text = self._clean(text)
+            (errors if kind == "error" else notes).append(text)
+        if errors:
+            _call_once(
+                "forall(member(Id, Ids), catch(unload_file(Id), _, true))", {"Ids": list(aliases)}
+            )
+            more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
+            first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
+            raise PrologError(f"cannot load {first}{more}")
+        for note in notes:
+            warnings.warn(note, PrologWarning, stacklevel=2)
+        self.files.append(path)
+
+    # -- querying ----------------------------------------------------------
+
+    def _solve(
+        self, goal: str, limit: int | None, inputs: dict[str, Any]
+    ) -> tuple[list[str], list[list[Any]]]:
+        self._check_open()
+        answer = _call_once(
+            f"{bridge.MODULE}:solve(M, Goal, Inputs, Limit, Names, Rows, Status)",
+            {
+                "M": self.module,
+                "Goal": self._goal(goal),
+                "Inputs": self._inputs(inputs),
+                "Limit": self._limit(limit),
+            },
+        )
+        self._check_status(answer["Status"], goal)
+        rows = answer["Rows"]
+        for row in rows:
+            for i, value in enumerate(row):
+                if type(value) not in _SCALARS:
+                    row[i] = _from_prolog(value)
+        return answer["Names"], rows
+
+    def query(
+        self, goal: str, /, *, limit: int | None = None, **inputs: Any
+    ) -> list[dict[str, Any]]:
+        """Every answer of ``goal`` (at most ``limit``) as a dict: output variable -> value.
+
+        Keyword arguments named like the goal's variables bind them:
+        ``kb.query("holds(E, T, R, A, B)", A="agent")``.
+        """
+        names, rows = self._solve(goal, limit, inputs)
+        return [dict(zip(names, row, strict=True)) for row in rows]
+
+    def query_df(self, goal: str, /, *, limit: int | None = None, **inputs: Any) -> pd.DataFrame:
+        """Like :meth:`query`, as a DataFrame with one column per output variable (even when empty)."""
+        import pandas as pd
+
+        names, rows = self._solve(goal, limit, inputs)
+        return pd.DataFrame(rows, columns=names)
+
+    def once(self, goal: str, /, **inputs: Any) -> dict[str, Any] | None:
+        """The first answer of ``goal``, or None when it has none."""
+        answers = self.query(goal, limit=1, **inputs)
+        return answers[0] if answers else None
+
+    def count(self, goal: str, /, **inputs: Any) -> int:
+        """How many answers ``goal`` has (counted in Prolog; nothing is converted)."""
+        self._check_open()
+        answer = _call_once(
+            f"{bridge.MODULE}:count(M, Goal, Inputs, all, N, Status)",
+            {"M": self.module, "Goal": self._goal(goal), "Inputs": self._inputs(inputs)},
+        )
+        self._check_status(answer["Status"], goal)
+        return int(answer["N"])
+
+    # -- lifetime ----------------------------------------------------------
+
+    def close(self) -> None:
+        """Unload the files and drop the module; the KB cannot be queried afterwards."""
+        if not self._closed:
+            self._closed = True
+            self._finalizer.detach()
+            _close_module(self.module, self._source_ids)
+
+    def __enter__(self) -> KnowledgeBase:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        state = "closed" if self._closed else ", ".join(str(p) for p in self.files)
+        return f"KnowledgeBase({self.module}: {state})"
+
+    # -- helpers -----------------------------------------------------------
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise NeurosymError(f"knowledge base {self.module} is closed")
+
+    def _clean(self, text: str) -> str:
+        return _one_line(text.replace(f"{self.module}:", ""))
+
+    def _check_status(self, status: Any, goal: str) -> None:
+        if status == "ok":
+            return
+        kind, detail = status
+        if kind == "missing":
+            raise ConfigError(f"input {', '.join(detail)} is not a variable of the goal {goal!r}")
+        raise PrologError(self._clean(detail))
+
+    @staticmethod
+    def _goal(goal: str) -> str:
+        if not isinstance(goal, str) or not goal.strip():
+            raise ConfigError(
+                f"the goal must be Prolog text such as 'object(Id, Type)', not {goal!r}"
+            )
+        return goal
+
+    @staticmethod
+    def _inputs(inputs: dict[str, Any]) -> list[tuple[str, Any]]:
+        out = []
+        for name, value in inputs.items():
+            if not _VARIABLE.fullmatch(name):
+                raise ConfigError(
+                    f"input {name!r} is not a Prolog variable name (start it with a capital)"
+                )
+            out.append((name, _to_prolog(value, name)))
+        return out
+
+    @staticmethod
+    def _limit(limit: int | None) -> int | str:
+        if limit is None:
+            return "all"
+        if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+            raise ConfigError(f"limit must be a positive integer, not {limit!r}")
+        return limit
+
+
+def _close_module(module: str, source_ids: list[str]) -> None:
+    try:
+        _call_once(f"{bridge.MODULE}:close_kb(M, Files)", {"M": module, "Files": source_ids})
+    except Exception:  # noqa: BLE001 - closing must never mask the real error
+        pass

@@ -1,0 +1,118 @@
+"""The one place that finds SWI-Prolog and hands janus-swi its home.
+
+janus-swi needs SWI-Prolog >= 9.1.12. When an older system Prolog is around,
+janus can pick up the wrong home and die with "incompatible VM-signature", so
+neurosym decides which Prolog to use, in this order:
+
+1. ``NEUROSYM_SWIPL``: the path of a ``swipl`` binary (must be >= 9.1.12);
+2. ``<sys.prefix>/swipl/bin/swipl``: the one ``make setup`` builds into the venv;
+3. ``swipl`` on ``PATH``, when it is >= 9.1.12.
+
+:func:`import_janus` sets ``SWI_HOME_DIR`` to that Prolog's home before the
+first ``import janus_swi``; every neurosym module gets janus from there.
+:func:`swipl_executable` is for subprocess uses (qcompile, plunit runs).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+from neurosym.errors import NeurosymError
+
+MIN_VERSION = 90112  # 9.1.12 as current_prolog_flag(version) numbers it
+ENV_VAR = "NEUROSYM_SWIPL"
+
+
+@dataclass(frozen=True)
+class SwiProlog:
+    """A located SWI-Prolog: its binary, home (PLBASE) and numeric version."""
+
+    executable: Path
+    home: Path
+    version: int
+
+    @property
+    def version_text(self) -> str:
+        return f"{self.version // 10000}.{self.version // 100 % 100}.{self.version % 100}"
+
+
+def _probe(executable: Path) -> SwiProlog | None:
+    """Ask ``swipl --dump-runtime-variables`` for its home and version; None if it cannot run."""
+    try:
+        out = subprocess.run(
+            [str(executable), "--dump-runtime-variables"],
+            capture_output=True, text=True, timeout=30, check=True,
+        ).stdout  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return None
+    values = {}
+    for line in out.splitlines():  # lines look like: PLBASE="/usr/lib/swipl";
+        name, sep, value = line.partition("=")
+        if sep:
+            values[name.strip()] = value.strip().rstrip(";").strip('"')
+    try:
+        return SwiProlog(executable, Path(values["PLBASE"]), int(values["PLVERSION"]))
+    except (KeyError, ValueError):
+        return None
+
+
+@functools.cache
+def find_swipl() -> SwiProlog:
+    """Locate the SWI-Prolog neurosym uses (see the module docstring for the order)."""
+    explicit = os.environ.get(ENV_VAR)
+    if explicit:
+        found = _probe(Path(explicit))
+        if found is None:
+            raise NeurosymError(
+                f"{ENV_VAR}={explicit} is not a runnable swipl; point it at a SWI-Prolog >= 9.1.12 binary"
+            )
+        if found.version < MIN_VERSION:
+            raise NeurosymError(
+                f"{ENV_VAR}={explicit} is SWI-Prolog {found.version_text}; janus-swi needs >= 9.1.12"
+            )
+        return found
+    venv_swipl = Path(sys.prefix) / "swipl" / "bin" / "swipl"
+    if venv_swipl.is_file():
+        found = _probe(venv_swipl)
+        if found is not None and found.version >= MIN_VERSION:
+            return found
+    on_path = shutil.which("swipl")
+    if on_path:
+        found = _probe(Path(on_path))
+        if found is not None and found.version >= MIN_VERSION:
+            return found
+        version = found.version_text if found else "unknown"
+        raise NeurosymError(
+            f"swipl on PATH ({on_path}) is version {version}; neurosym needs SWI-Prolog >= 9.1.12: "
+            f"run `make setup` (builds one into the venv) or set {ENV_VAR}"
+        )
+    raise NeurosymError(
+        f"no SWI-Prolog found: run `make setup` (builds one into the venv) or set {ENV_VAR} to a swipl >= 9.1.12"
+    )
+
+
+def swipl_executable() -> Path:
+    """Path of the ``swipl`` binary to run in subprocesses."""
+    return find_swipl().executable
+
+
+def import_janus() -> ModuleType:
+    """Import janus-swi with ``SWI_HOME_DIR`` pointing at the located Prolog's home."""
+    module = sys.modules.get("janus_swi")
+    if module is not None:
+        return module
+    os.environ["SWI_HOME_DIR"] = str(find_swipl().home)
+    try:
+        import janus_swi
+    except ImportError as exc:
+        raise NeurosymError(
+            f"janus-swi is not installed ({exc}); run `make setup`, which builds it against {find_swipl().executable}"
+        ) from exc
+    return janus_swi
