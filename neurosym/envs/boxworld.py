@@ -177,17 +177,29 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
             if levels.cells.shape[1] > self._state.slots:
                 self._state = BoxWorldState(1, levels.cells.shape[1], self.config.max_steps)
         else:
-            raise ConfigError(f"options['level'] must be a neurosym.envs.boxworld.Level, got {type(level).__name__}")
+            raise ConfigError(
+                f"options['level'] must be a neurosym.envs.boxworld.Level, got {type(level).__name__}"
+            )
         self._state.load(np.zeros(1, np.int64), levels)
         return self._state.observation()[0], decode_info(self._state.info(), 0)
 
     def step(self, action: int) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        if self._key is None:
+            raise RuntimeError("call reset() before step()")
         if not (isinstance(action, int | np.integer) and 0 <= action < 4):
-            raise ValueError(f"unknown action {action!r}; actions are 0 up, 1 right, 2 down, 3 left")
+            raise ValueError(
+                f"unknown action {action!r}; actions are 0 up, 1 right, 2 down, 3 left"
+            )
         self._action[0] = action
         reward, terminated, truncated = self._state.step(self._action)
         info = decode_info(self._state.info(), 0)
-        return self._state.observation()[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), info
+        return (
+            self._state.observation()[0],
+            float(reward[0]),
+            bool(terminated[0]),
+            bool(truncated[0]),
+            info,
+        )
 
     def entity_grid(self) -> np.ndarray:
         """(14, 14) entity codes of the current state; names in ``entity_names``."""
@@ -262,7 +274,10 @@ class BoxWorldVectorEnv(VectorEnv):
         """Reset all sub-environments, or those in ``options["reset_mask"]`` (bool, (n,))."""
         n = self.num_envs
         mask = (options or {}).get("reset_mask")
-        rows = np.arange(n) if mask is None else np.flatnonzero(np.asarray(mask, bool).reshape(n))
+        if mask is None or self._keys is None:  # the first reset starts every sub-environment
+            rows = np.arange(n)
+        else:
+            rows = np.flatnonzero(np.asarray(mask, bool).reshape(n))
         if seed is not None:
             if isinstance(seed, int | np.integer):
                 super().reset(seed=int(seed))
@@ -276,7 +291,11 @@ class BoxWorldVectorEnv(VectorEnv):
             self._keys[rows] = keys[rows]
             self._episodes[rows] = 0
         elif self._keys is None:
-            self._keys = seed_keys(self._seed, n) if self._seed is not None else random_keys(self.np_random, n)
+            self._keys = (
+                seed_keys(self._seed, n)
+                if self._seed is not None
+                else random_keys(self.np_random, n)
+            )
             self._episodes[:] = 0
         else:
             self._episodes[rows] += np.uint64(1)
@@ -303,7 +322,9 @@ class BoxWorldVectorEnv(VectorEnv):
         restart = np.flatnonzero(self._autoreset)
         if restart.size:
             self._episodes[restart] += np.uint64(1)
-            self._state.load(restart, generate_levels(self.config, self._keys[restart], self._episodes[restart]))
+            self._state.load(
+                restart, generate_levels(self.config, self._keys[restart], self._episodes[restart])
+            )
             reward[restart] = 0.0
             terminated[restart] = False
             truncated[restart] = False

@@ -84,7 +84,9 @@ PALETTE.setflags(write=False)
 KEY_TEXT: tuple[str, ...] = ENTITY_NAMES[KEY:LOCK]
 LOCK_TEXT: tuple[str, ...] = ENTITY_NAMES[LOCK:HELD]
 GOT_KEY_TEXT: tuple[str, ...] = tuple(str(Term("got", (Term("key", (c,)),))) for c in COLOUR_NAMES)
-OPENED_TEXT: tuple[str, ...] = tuple(str(Term("opened", (Term("lock", (c,)),))) for c in COLOUR_NAMES)
+OPENED_TEXT: tuple[str, ...] = tuple(
+    str(Term("opened", (Term("lock", (c,)),))) for c in COLOUR_NAMES
+)
 GOT_GEM_TEXT = str(Term("got", ("gem",)))
 HIT_DISTRACTOR_TEXT = str(Term("hit", ("distractor",)))
 

@@ -77,11 +77,17 @@ class BoxWorldConfig:
             if not isinstance(value, int | np.integer) or isinstance(value, bool):
                 raise ConfigError(f"Box-World {name} must be an integer, got {value!r}")
         if self.solution_length < 1:
-            raise ConfigError(f"Box-World solution_length must be at least 1, got {self.solution_length}")
+            raise ConfigError(
+                f"Box-World solution_length must be at least 1, got {self.solution_length}"
+            )
         if self.num_distractors < 0:
-            raise ConfigError(f"Box-World num_distractors must be 0 or more, got {self.num_distractors}")
+            raise ConfigError(
+                f"Box-World num_distractors must be 0 or more, got {self.num_distractors}"
+            )
         if self.distractor_length < 1:
-            raise ConfigError(f"Box-World distractor_length must be at least 1, got {self.distractor_length}")
+            raise ConfigError(
+                f"Box-World distractor_length must be at least 1, got {self.distractor_length}"
+            )
         if self.max_steps < 1:
             raise ConfigError(f"Box-World max_steps must be at least 1, got {self.max_steps}")
         free = NUM_COLOURS - self.solution_length
@@ -152,7 +158,9 @@ def _mix(x: np.ndarray) -> np.ndarray:
     return x ^ (x >> np.uint64(31))
 
 
-def uniforms(keys: np.ndarray, episodes: np.ndarray, attempts: np.ndarray, count: int) -> np.ndarray:
+def uniforms(
+    keys: np.ndarray, episodes: np.ndarray, attempts: np.ndarray, count: int
+) -> np.ndarray:
     """(m, count) floats in [0, 1): draw j of level (key, episode, attempt), for any m at once."""
     with np.errstate(over="ignore"):
         base = _mix(_mix(keys.astype(np.uint64)) ^ (episodes.astype(np.uint64) * _GOLDEN))
@@ -167,7 +175,10 @@ def seed_keys(seed: int, count: int) -> np.ndarray:
     if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     return np.array(
-        [np.random.SeedSequence(int(seed) + i).generate_state(1, np.uint64)[0] for i in range(count)],
+        [
+            np.random.SeedSequence(int(seed) + i).generate_state(1, np.uint64)[0]
+            for i in range(count)
+        ],
         dtype=np.uint64,
     )
 
@@ -200,9 +211,7 @@ _INTERIOR[1:-1, 1:-1] = True
 _INTERIOR_CELLS = np.flatnonzero(_INTERIOR).astype(np.int16)  # (144,)
 
 
-def _structure(
-    config: BoxWorldConfig, u: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _structure(config: BoxWorldConfig, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Colours of every object: lock (-1 for the loose key) and content (NUM_COLOURS = gem)."""
     m = len(u)
     n, nd, ln = config.solution_length, config.num_distractors, config.distractor_length
@@ -259,7 +268,8 @@ def _try_generate(
     has_lock = locks >= 0
     slot_cells = np.concatenate([content_cell, content_cell + 1], axis=1)  # (m, 2 nobj)
     slot_codes = np.concatenate(
-        [np.where(contents == NUM_COLOURS, GEM, KEY + contents), LOCK + np.maximum(locks, 0)], axis=1
+        [np.where(contents == NUM_COLOURS, GEM, KEY + contents), LOCK + np.maximum(locks, 0)],
+        axis=1,
     )
     slot_distractor = np.concatenate(
         [np.zeros((m, nobj), bool), np.broadcast_to(distractor, (m, nobj))], axis=1
@@ -351,7 +361,9 @@ class Level:
                 )
             cell = row * GRID + col
             if cell in cells:
-                raise ConfigError(f"Box-World level: {what} at ({row}, {col}) shares its cell with another object")
+                raise ConfigError(
+                    f"Box-World level: {what} at ({row}, {col}) shares its cell with another object"
+                )
             cells.append(cell)
             codes.append(code)
             distractor.append(is_distractor)
@@ -366,7 +378,9 @@ class Level:
             place(*self.gem, GEM, "gem")
         row, col = self.agent
         if not (1 <= row <= SIZE and 1 <= col <= SIZE):
-            raise ConfigError(f"Box-World level: agent at ({row}, {col}) is outside the interior rows/cols 1..{SIZE}")
+            raise ConfigError(
+                f"Box-World level: agent at ({row}, {col}) is outside the interior rows/cols 1..{SIZE}"
+            )
         if row * GRID + col in cells:
             raise ConfigError(f"Box-World level: agent at ({row}, {col}) stands on an object")
         order = np.argsort(cells, kind="stable")
@@ -392,4 +406,3 @@ def base_grid() -> np.ndarray:
     grid = np.full((GRID, GRID), WALL, np.uint8)
     grid[1:-1, 1:-1] = EMPTY
     return grid.ravel()
-

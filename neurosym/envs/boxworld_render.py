@@ -42,8 +42,8 @@ def tile_atlas(tile: int = DEFAULT_TILE) -> np.ndarray:
     disc = yy**2 + xx**2 <= 0.36**2
     diamond = np.abs(yy) + np.abs(xx) <= 0.38
     diamond_edge = diamond & ~(np.abs(yy) + np.abs(xx) <= 0.38 - 1.5 / tile)
-    keyhole = (yy + 0.08) ** 2 + xx**2 <= 0.12**2
-    keyhole |= (np.abs(xx) <= 0.05) & (yy >= -0.08) & (yy <= 0.22)
+    keyhole = (yy + 0.1) ** 2 + xx**2 <= 0.14**2
+    keyhole |= (np.abs(xx) <= 0.07) & (yy >= -0.1) & (yy <= 0.25)
     edge = np.zeros((tile, tile), bool)
     edge[-1, :] = edge[:, -1] = True  # a faint grid line between cells
 
@@ -90,7 +90,14 @@ def ansi_text(grid: np.ndarray) -> str:
     the held key shows in the top-left corner."""
     lines = ["".join(row) for row in _CHARS[grid]]
     codes = np.unique(grid)
-    colours = sorted({int(c - base) for base in (KEY, LOCK, HELD) for c in codes if base <= c < base + NUM_COLOURS})
+    colours = sorted(
+        {
+            int(c - base)
+            for base in (KEY, LOCK, HELD)
+            for c in codes
+            if base <= c < base + NUM_COLOURS
+        }
+    )
     legend = ", ".join(f"{_LETTERS[c]}/{_LETTERS[c].upper()} {COLOUR_NAMES[c]}" for c in colours)
     if legend:
         lines.append(f"keys/locks: {legend}")

@@ -67,12 +67,15 @@ class BoxWorldState:
         self.n, self.slots, self.max_steps = n, slots, max_steps
         rows = np.arange(n)
         self.grid = np.tile(_BASE_GRID, (n, 1))  # (n, CELLS) uint8 entity codes
-        self.obs = np.ascontiguousarray(PALETTE[self.grid].transpose(0, 2, 1))  # (n, 3, CELLS) uint8
+        # (n, 3, CELLS) uint8 RGB, kept up to date cell by cell
+        self.obs = np.ascontiguousarray(PALETTE[self.grid].transpose(0, 2, 1))
         self.distractor = np.zeros((n, CELLS), bool)  # lock cells of distractor boxes
-        self.slot_of_cell = np.full((n, CELLS), slots, np.int64)  # object slot per cell; `slots` = none
+        # object slot of each cell; `slots` where there is none
+        self.slot_of_cell = np.full((n, CELLS), slots, np.int64)
         self.object_cell = np.full((n, slots), -1, np.int16)  # -1 pads
         self.object_code = np.zeros((n, slots), np.uint8)
-        self.object_alive = np.zeros((n, slots + 1), bool)  # last column absorbs writes for "no object"
+        # the last column absorbs the writes of environments that consumed nothing
+        self.object_alive = np.zeros((n, slots + 1), bool)
         # Flat views and row offsets for step(): env i, cell c is grid_flat[i * CELLS + c],
         # obs_flat[i * 3 * CELLS + channel * CELLS + c], alive_flat[i * (slots + 1) + slot].
         self._grid_flat = self.grid.reshape(-1)
@@ -143,7 +146,8 @@ class BoxWorldState:
         content = grid[at - 1].astype(np.int16)
         held = self.held.astype(np.int16)
 
-        in_box = (right >= LOCK) & (right < HELD)  # a key or gem with a lock to its right is locked in
+        # a key or gem with a lock to its right is locked in its box
+        in_box = (right >= LOCK) & (right < HELD)
         loose_key = (entity >= KEY) & (entity < LOCK) & ~in_box
         loose_gem = (entity == GEM) & ~in_box
         opens = (entity >= LOCK) & (entity < HELD) & (entity - LOCK == held)
@@ -257,7 +261,11 @@ def decode_info(info: dict[str, np.ndarray], i: int) -> dict:
         for s in np.flatnonzero(alive)
     )
     events: list[str] = []
-    key, lock, got = int(info["event_key"][i]), int(info["event_lock"][i]), int(info["event_got"][i])
+    key, lock, got = (
+        int(info["event_key"][i]),
+        int(info["event_lock"][i]),
+        int(info["event_got"][i]),
+    )
     outcome = int(info["outcome"][i])
     if key >= 0:
         events.append(GOT_KEY_TEXT[key])

@@ -67,7 +67,9 @@ def _bits(mask: np.ndarray) -> int:
 def _flood(start: int, passable: int) -> int:
     region = 1 << start
     while True:
-        grown = (region | (region << 1) | (region >> 1) | (region << GRID) | (region >> GRID)) & passable
+        grown = (
+            region | (region << 1) | (region >> 1) | (region << GRID) | (region >> GRID)
+        ) & passable
         grown |= region
         if grown == region:
             return region
@@ -79,9 +81,15 @@ def _ring(region: int) -> int:
 
 
 def search(
-    grid: np.ndarray, distractor: np.ndarray, agent: int, *, stop_at_distractor: bool = True
+    grid: np.ndarray,
+    distractor: np.ndarray,
+    agent: int,
+    *,
+    held: int = -1,
+    stop_at_distractor: bool = True,
 ) -> SearchResult:
-    """Search a level given as codes (CELLS,), distractor flags (CELLS,) and the agent's cell."""
+    """Search from a state given as codes (CELLS,), distractor flags (CELLS,), the agent's
+    cell and the held key's colour (-1 for none)."""
     grid = np.asarray(grid).copy()
     grid[agent] = EMPTY
     objects = [int(c) for c in np.flatnonzero((grid >= GEM) & (grid < HELD))]
@@ -98,7 +106,9 @@ def search(
             if consumed >> c & 1 or not ring >> c & 1:
                 continue
             code = codes[c]
-            right_is_lock = (c + 1) in codes and not consumed >> (c + 1) & 1 and LOCK <= codes[c + 1] < HELD
+            right_is_lock = (
+                (c + 1) in codes and not consumed >> (c + 1) & 1 and LOCK <= codes[c + 1] < HELD
+            )
             if KEY <= code < LOCK and not right_is_lock:
                 out.append((c, code - KEY, consumed | 1 << c, 0, False))
             elif code == GEM and not right_is_lock:
@@ -107,7 +117,11 @@ def search(
                 inner = codes.get(c - 1)
                 if inner is not None and consumed >> (c - 1) & 1:
                     inner = None
-                new_held = -1 if inner is None else (-2 if inner == GEM else (inner - KEY if KEY <= inner < LOCK else -1))
+                new_held = (
+                    -1
+                    if inner is None
+                    else (-2 if inner == GEM else (inner - KEY if KEY <= inner < LOCK else -1))
+                )
                 gone = consumed | 1 << c | (1 << (c - 1) if inner is not None else 0)
                 out.append((c, new_held, gone, 1, bool(distractor[c])))
         return out
@@ -115,12 +129,16 @@ def search(
     result = SearchResult(solvable=False, min_boxes=None)
     start_ring = _ring(_flood(agent, empty_bits)) & all_bits
     boxed = {c for c in objects if codes[c] < LOCK and LOCK <= codes.get(c + 1, -1) < HELD}
-    result.untouchable_from_start = {c for c in objects if c not in boxed and not start_ring >> c & 1}
+    result.untouchable_from_start = {
+        c for c in objects if c not in boxed and not start_ring >> c & 1
+    }
 
     # 0-1 BFS: opening a box costs 1, picking a key 0. State: (cell, held, consumed, tainted).
-    start = (agent, -1, 0, False)
+    start = (agent, held, 0, False)
     best: dict[tuple[int, int, int, bool], int] = {start: 0}
-    parent: dict[tuple[int, int, int, bool], tuple[tuple[int, int, int, bool], int] | None] = {start: None}
+    parent: dict[tuple[int, int, int, bool], tuple[tuple[int, int, int, bool], int] | None] = {
+        start: None
+    }
     queue: deque[tuple[int, int, int, bool]] = deque([start])
     goal: tuple[int, int, int, bool] | None = None
     while queue:
@@ -193,3 +211,35 @@ def walk(grid: np.ndarray, agent: int, route: list[int]) -> list[int]:
         grid[target] = EMPTY
         here = target
     return actions
+
+
+def nearest_interaction(grid: np.ndarray, agent: int, held: int) -> int | None:
+    """First action towards the nearest object the agent can use now (a loose key or gem, or
+    a lock its key opens, distractors included), or None when there is none.
+
+    A scripted explorer: the tests drive environments with it so that keys, boxes,
+    distractors and gems all happen, which random actions rarely reach."""
+    grid = np.asarray(grid)
+
+    def usable(cell: int) -> bool:
+        code = int(grid[cell])
+        boxed = LOCK <= int(grid[cell + 1]) < HELD
+        if KEY <= code < LOCK or code == GEM:
+            return not boxed
+        return LOCK <= code < HELD and code - LOCK == held
+
+    first = {agent: -1}
+    queue = deque([agent])
+    while queue:
+        cell = queue.popleft()
+        for a, d in enumerate(_STEPS):
+            nxt = cell + d
+            if nxt in first:
+                continue
+            start_action = a if cell == agent else first[cell]
+            if usable(nxt):
+                return start_action
+            if grid[nxt] == EMPTY:
+                first[nxt] = start_action
+                queue.append(nxt)
+    return None
