@@ -40,7 +40,7 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "rgw",
         _RGW,
         _RGW_VEC,
-        "Relational-Grid-World Configuration-1: sword, enemy, teleport, terminal; optimal return 11",
+        "RGW Configuration-1: sword, enemy, teleport, terminal (optimal return 11)",
         {"map": "rgw1"},
     ),
     EnvEntry(
@@ -49,7 +49,7 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "rgw",
         _RGW,
         _RGW_VEC,
-        "Relational-Grid-World Configuration-2 (the original map): adds mountains and pits; optimal return 10.7",
+        "RGW Configuration-2, the original map: adds mountains and pits (optimal 10.7)",
         {"map": "rgw2"},
     ),
     EnvEntry(
@@ -58,7 +58,7 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "rgw",
         "neurosym.envs.rgw_random:RGWRandomEnv",
         "neurosym.envs.rgw_vector:RGWRandomVectorEnv",
-        "Relational-Grid-World on procedural levels: a new solvable level each episode, enemy on route in half",
+        "RGW on procedural levels: a new solvable level every episode",
     ),
     EnvEntry(
         "bw1",
@@ -93,7 +93,7 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "boxworld",
         _BW,
         _BW_VEC,
-        "Box-World with free parameters: solution_length, num_distractors, distractor_length, max_steps",
+        "Box-World, free parameters: solution_length, num_distractors, distractor_length",
     ),
 )
 

@@ -210,6 +210,24 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             "outcome": rules.OUTCOME_NAMES[outcome],
         }
 
+    def set_state(self, agent: tuple[int, int], holding: bool = False) -> dict[str, Any]:
+        """Put the agent on a cell of the current level's initial map; returns the new info.
+
+        For analysis and tests (transition tables, value maps): ``holding``
+        also takes the sword off the map, as if picked up. The step count
+        starts again from 0.
+        """
+        if self.episode_index < 0:
+            raise gym.error.ResetNeeded("call reset() before set_state()")
+        r, c = (int(v) for v in agent)
+        if not (0 <= r < self.height and 0 <= c < self.width):
+            raise ValueError(f"agent {agent} is outside the {self.height}x{self.width} grid")
+        pos = r * self.width + c
+        if self._batch.level_cells[self._batch.slot[0], pos] == rules.WALL:
+            raise ValueError(f"agent {agent} would stand in a wall")
+        self._batch.place(0, pos, bool(holding))
+        return self._info(0, 0)
+
     # -- symbolic views and rendering ----------------------------------------
 
     def entity_grid(self) -> np.ndarray:

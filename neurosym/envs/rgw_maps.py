@@ -54,7 +54,7 @@ SHIPPED = ("rgw1", "rgw2")
 MAX_REMOVABLE = 64
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class GridMap:
     """A parsed, validated map: cell codes row-major and the agent's start cell."""
 

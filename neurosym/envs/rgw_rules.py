@@ -366,6 +366,36 @@ class RGWBatch:
         self.removed[rows] = 0
         self.t[rows] = 0
 
+    def place(self, row: int, pos: int, holding: bool) -> None:
+        """Start env ``row`` over with its agent on cell ``pos`` (for analysis and tests).
+
+        The map is the level's initial one; ``holding`` also takes the level's
+        swords off the map, as if the agent had picked them up.
+        """
+        N = self.cells_per_level
+        slot = int(self.slot[row])
+        cells = self.level_cells[slot].copy()
+        removed = np.uint64(0)
+        swords = cells == SWORD
+        if holding and swords.any():
+            removed = np.bitwise_or.reduce(self._level_bits[slot][swords])
+            cells[swords] = EMPTY
+        self.reset_rows(np.array([row]))
+        self.grid.reshape(self.n, N)[row] = cells
+        self.pos[row] = pos
+        self._key[row] = slot * (N * 4) + pos * 4
+        self._opos[row] = self._orow[row] + pos
+        self.under[row] = cells[pos]
+        self.holding[row] = bool(holding)
+        self.removed[row] = removed
+        start = np.array([pos])
+        if self.obs_mode == "onehot":
+            planes = onehot_planes(cells[None], start)
+            planes[:, HOLD_PLANE] = bool(holding)
+        else:
+            planes = grey_planes(cells[None], start)
+        self.obs.reshape(self.n, -1)[row] = planes.reshape(-1)
+
     # -- the step -----------------------------------------------------------
 
     def step(self, actions: np.ndarray) -> StepResult:

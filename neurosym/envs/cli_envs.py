@@ -1,0 +1,61 @@
+"""``neurosym envs``: list the environments (short name, gymnasium id, one line each).
+
+``--json`` prints one JSON object per line instead of a table; ``--show NAME``
+prints the first state of one environment as text.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from neurosym.envs.registration import ENTRIES, canonical_name
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="One JSON object per line.")
+    parser.add_argument(
+        "--show",
+        metavar="NAME",
+        help="Print the first state of one environment as text (seed 0).",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.show:
+        return _show(args.show)
+    if args.json:
+        for e in ENTRIES:
+            row = {"name": e.short, "id": e.id, "family": e.family, "description": e.description}
+            print(json.dumps(row))
+        return 0
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="neurosym environments", title_justify="left")
+    for column in ("name", "id", "family", "description"):
+        table.add_column(column, overflow="fold")
+    for e in ENTRIES:
+        table.add_row(e.short, e.id, e.family, e.description)
+    console = Console()
+    if not console.is_terminal:  # piped: never wrap, whatever width rich guesses
+        rows = [(e.short, e.id, e.family, e.description) for e in ENTRIES]
+        natural = sum(max(len(r[i]) for r in rows) + 3 for i in range(4)) + 1
+        console = Console(width=max(natural, console.width))
+    console.print(table)
+    return 0
+
+
+def _show(name: str) -> int:
+    from neurosym.envs.registration import make
+
+    env = make(canonical_name(name), render_mode="ansi")
+    env.reset(seed=0)
+    text = env.render()
+    if not sys.stdout.isatty():
+        import re
+
+        text = re.sub(r"\x1b\[[0-9;]*m", "", text)
+    print(text, end="" if text.endswith("\n") else "\n")
+    return 0

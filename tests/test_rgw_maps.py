@@ -1,0 +1,106 @@
+"""Relational-Grid-World maps: the shipped layouts, user maps, and refusal of bad maps."""
+
+from __future__ import annotations
+
+import pytest
+
+from neurosym.envs.rgw import RGWEnv
+from neurosym.envs.rgw_maps import load_map, parse_map
+from neurosym.errors import MapError
+
+# reference/rgw-original.md, "Layout" (Configuration-2).
+RGW2_OBJECTS = {
+    "agent": [(0, 0)],
+    "terminal": [(9, 0)],
+    "sword": [(0, 6)],
+    "enemy": [(9, 1)],
+    "wall": [(6, c) for c in range(8)] + [(4, 3), (5, 3), (8, 0), (8, 1)],
+    "pit": [(7, 8), (8, 9)],
+    "mountain": [(0, 5), (0, 7), (0, 8), (0, 9), (1, 6), (1, 7), (1, 8), (1, 9)]
+    + [(2, 7), (2, 8), (2, 9), (3, 8), (4, 9)],
+    "teleport": [(3, 9), (8, 8)],
+}
+
+
+def objects_by_type(name: str) -> dict[str, list[tuple[int, int]]]:
+    env = RGWEnv(name)
+    _, info = env.reset(seed=0)
+    out: dict[str, list[tuple[int, int]]] = {}
+    for _, kind, r, c in info["objects"]:
+        out.setdefault(kind, []).append((r, c))
+    return {k: sorted(v) for k, v in out.items()}
+
+
+def test_rgw2_is_the_original_layout() -> None:
+    assert objects_by_type("rgw2") == {k: sorted(v) for k, v in RGW2_OBJECTS.items()}
+
+
+def test_rgw1_is_rgw2_without_mountains_and_pits() -> None:
+    want = {k: sorted(v) for k, v in RGW2_OBJECTS.items() if k not in ("mountain", "pit")}
+    assert objects_by_type("rgw1") == want
+
+
+def test_object_ids_are_unique_atoms() -> None:
+    env = RGWEnv("rgw2")
+    _, info = env.reset(seed=0)
+    ids = [o[0] for o in info["objects"]]
+    assert (
+        len(ids)
+        == len(set(ids))
+        == 1 + sum(len(v) for k, v in RGW2_OBJECTS.items() if k != "agent")
+    )
+    assert {
+        "agent",
+        "sword",
+        "enemy",
+        "terminal",
+        "teleport_1",
+        "teleport_2",
+        "wall_1",
+        "pit_2",
+    } <= set(ids)
+
+
+def test_map_text_round_trip() -> None:
+    m = load_map("rgw2")
+    again = parse_map(m.text())
+    assert (again.height, again.width, again.start) == (m.height, m.width, m.start)
+    assert (again.cells == m.cells).all()
+    assert m.text().splitlines()[3] == "........MQ"
+
+
+def test_user_map_from_string_and_file(tmp_path) -> None:
+    text = "# a corridor\nA.ST\n"
+    env = RGWEnv(text)
+    _, info = env.reset(seed=0)
+    assert env.observation_space.shape == (9, 1, 4)
+    rewards = [env.step(1)[1] for _ in range(3)]
+    assert rewards == [0.0, 0.0, 10.0]
+    path = tmp_path / "corridor.txt"
+    path.write_text(text)
+    env2 = RGWEnv(str(path))
+    assert env2.reset(seed=0)[1] == info
+    assert RGWEnv(path).source.name == "corridor.txt"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("A.X\n..T\n", r"unknown symbol 'X' at row 0, column 2"),
+        ("A..\n..\n..T\n", r"row 1 has 2 cells, expected 3"),
+        ("...\n..T\n", r"no agent start 'A'"),
+        ("A..\n...\n", r"no terminal 'T'"),
+        ("A.O\n..T\n", r"one teleport end at row 0, column 2"),
+        ("AOO\nO.T\n", r"third teleport end at row 1, column 0"),
+        ("A.A\n..T\n", r"second agent start 'A' at row 0, column 2"),
+        ("# only a comment\n", r"no rows"),
+    ],
+)
+def test_bad_maps_name_row_and_column(text: str, message: str) -> None:
+    with pytest.raises(MapError, match=message):
+        parse_map(text)
+
+
+def test_unknown_map_name_is_refused() -> None:
+    with pytest.raises(MapError, match="not a shipped map"):
+        load_map("rgw9")
