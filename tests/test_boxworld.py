@@ -290,6 +290,7 @@ def test_gymnasium_check_env(config, render_mode):
         ({"solution_length": 20, "num_distractors": 1}, "leaves 0 of the 20 colours"),
         ({"solution_length": 10, "num_distractors": 5}, "would hold 16 objects"),
         ({"render_mode": "human"}, "unknown render_mode 'human'"),
+        ({"tile_size": 2}, "tile_size must be an integer of at least 4 pixels, got 2"),
     ],
 )
 def test_bad_parameters_are_refused_with_one_line(kwargs, message):

@@ -8,7 +8,6 @@ come from :mod:`neurosym.envs.boxworld_gen`.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from enum import IntEnum
 from typing import Any
 
 import gymnasium as gym
@@ -17,12 +16,14 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from neurosym.envs.actions import ACTION_NAMES, Action
 from neurosym.envs.boxworld_entities import ENTITY_NAMES
 from neurosym.envs.boxworld_gen import (
     GRID,
     Box,
     BoxWorldConfig,
     Level,
+    NextLevels,
     generate_levels,
     random_keys,
     seed_keys,
@@ -43,17 +44,6 @@ __all__ = [
 ]
 
 
-class Action(IntEnum):
-    """The four moves; the atoms in facts are ``ACTION_NAMES``."""
-
-    UP = 0
-    RIGHT = 1
-    DOWN = 2
-    LEFT = 3
-
-
-ACTION_NAMES: tuple[str, ...] = ("up", "right", "down", "left")
-
 BOXWORLD_CONFIGS: dict[str, dict[str, int]] = {
     # thesis section 4.2, Figures 10-12; episodes end after 300 steps
     "bw1": {"solution_length": 1, "num_distractors": 0, "distractor_length": 1, "max_steps": 300},
@@ -70,11 +60,13 @@ def _observation_space() -> spaces.Box:
     return spaces.Box(0, 255, (3, GRID, GRID), np.uint8)
 
 
-def _check_render_mode(render_mode: str | None) -> None:
+def _check_render_mode(render_mode: str | None, tile_size: int) -> None:
     if render_mode is not None and render_mode not in _METADATA["render_modes"]:
         raise ConfigError(
             f"unknown render_mode {render_mode!r}; Box-World renders {', '.join(_METADATA['render_modes'])}"
         )
+    if not isinstance(tile_size, int | np.integer) or isinstance(tile_size, bool) or tile_size < 4:
+        raise ConfigError(f"tile_size must be an integer of at least 4 pixels, got {tile_size!r}")
 
 
 class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
@@ -94,7 +86,8 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
     Levels are drawn anew every episode (:mod:`neurosym.envs.boxworld_gen`).
 
     ## Action Space
-    ``Discrete(4)``: 0 up, 1 right, 2 down, 3 left (:class:`Action`).
+    ``Discrete(4)``: 0 up, 1 right, 2 down, 3 left
+    (:class:`neurosym.envs.actions.Action`).
 
     ## Observation
     ``uint8`` RGB ``(3, 14, 14)``, channels first (``obs_scale`` 1/255): wall
@@ -149,7 +142,7 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
         tile_size: int = DEFAULT_TILE,
     ) -> None:
         self.config = BoxWorldConfig(solution_length, num_distractors, distractor_length, max_steps)
-        _check_render_mode(render_mode)
+        _check_render_mode(render_mode, tile_size)
         self.render_mode = render_mode
         self.tile_size = tile_size
         self.observation_space = _observation_space()
@@ -219,8 +212,9 @@ class BoxWorldVectorEnv(VectorEnv):
     Same rules, observation and configurations as :class:`BoxWorldEnv`, with
     gymnasium's next-step autoreset: the step after one that ends sub-env
     ``i``'s episode ignores its action and returns the first observation of a
-    new level (reward 0, not terminated, not truncated). Levels of the envs
-    that reset on one step are generated together, vectorised.
+    new level (reward 0, not terminated, not truncated). Every sub-env's next
+    level is drawn ahead; used ones are drawn again together, vectorised, once
+    an eighth of the sub-envs used theirs (:class:`~neurosym.envs.boxworld_gen.NextLevels`).
 
     ``info`` holds arrays (agent, held, object_code/cell/alive, event_key,
     event_lock, event_got, outcome); :meth:`decode_info` gives the single
@@ -252,7 +246,7 @@ class BoxWorldVectorEnv(VectorEnv):
             raise ConfigError(f"num_envs must be a positive integer, got {num_envs!r}")
         self.num_envs = int(num_envs)
         self.config = BoxWorldConfig(solution_length, num_distractors, distractor_length, max_steps)
-        _check_render_mode(render_mode)
+        _check_render_mode(render_mode, tile_size)
         self.render_mode = render_mode
         self.tile_size = tile_size
         self.single_observation_space = _observation_space()
@@ -265,6 +259,8 @@ class BoxWorldVectorEnv(VectorEnv):
         self._seed = seed
         self._keys: np.ndarray | None = None  # (n,) uint64 level streams
         self._episodes = np.zeros(self.num_envs, np.uint64)
+        # next levels drawn ahead, refilled once an eighth of the envs used theirs
+        self._next = NextLevels(self.config, self.num_envs, self.num_envs // 8)
         self._autoreset = np.zeros(self.num_envs, bool)
         self._last_info: dict[str, Any] | None = None
 
@@ -299,7 +295,7 @@ class BoxWorldVectorEnv(VectorEnv):
             self._episodes[:] = 0
         else:
             self._episodes[rows] += np.uint64(1)
-        self._state.load(rows, generate_levels(self.config, self._keys[rows], self._episodes[rows]))
+        self._state.load(rows, self._next.take(rows, self._keys, self._episodes))
         self._autoreset[rows] = False
         info = self._state.info()
         self._last_info = info
@@ -322,9 +318,7 @@ class BoxWorldVectorEnv(VectorEnv):
         restart = np.flatnonzero(self._autoreset)
         if restart.size:
             self._episodes[restart] += np.uint64(1)
-            self._state.load(
-                restart, generate_levels(self.config, self._keys[restart], self._episodes[restart])
-            )
+            self._state.load(restart, self._next.take(restart, self._keys, self._episodes))
             reward[restart] = 0.0
             terminated[restart] = False
             truncated[restart] = False

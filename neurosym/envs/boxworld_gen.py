@@ -144,6 +144,19 @@ class LevelArrays:
             np.concatenate([self.distractor, np.zeros((m, extra), bool)], axis=1),
         )
 
+    def take(self, rows: np.ndarray) -> LevelArrays:
+        """Levels ``rows`` (copies)."""
+        return LevelArrays(
+            self.agent[rows], self.cells[rows], self.codes[rows], self.distractor[rows]
+        )
+
+    def put(self, rows: np.ndarray, levels: LevelArrays) -> None:
+        """Overwrite levels ``rows`` with ``levels``."""
+        self.agent[rows] = levels.agent
+        self.cells[rows] = levels.cells
+        self.codes[rows] = levels.codes
+        self.distractor[rows] = levels.distractor
+
 
 # ---------------------------------------------------------------- random numbers
 
@@ -192,8 +205,28 @@ def _pick(valid: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Index of a uniformly chosen True per row of ``valid`` (m, P), and whether there was one."""
     count = valid.sum(axis=1)
     k = np.floor(u * count).astype(np.int64)
-    chosen = np.argmax(np.cumsum(valid, axis=1) > k[:, None], axis=1)
+    chosen = np.argmax(np.cumsum(valid, axis=1, dtype=np.int16) > k[:, None], axis=1)
     return chosen, count > 0
+
+
+def _choose(
+    valid: np.ndarray, candidates: np.ndarray, u_exact: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A uniformly chosen valid index per row of ``valid`` (m, P), and whether there was one.
+
+    The first valid one of a few uniform ``candidates`` (m, C) is uniform among the valid
+    indices; rows where no candidate is valid fall back to an exact draw with ``u_exact``,
+    which keeps the choice exactly uniform while the common case never scans all P."""
+    m, p = valid.shape
+    rows = np.arange(m)
+    hit = valid.reshape(-1)[(rows * p)[:, None] + candidates]  # (m, C)
+    first = np.argmax(hit, axis=1)
+    chosen = candidates[rows, first]
+    found = hit[rows, first]
+    miss = np.flatnonzero(~found)
+    if miss.size:
+        chosen[miss], found[miss] = _pick(valid[miss], u_exact[miss])
+    return chosen, found
 
 
 # ---------------------------------------------------------------- placement tables
@@ -245,53 +278,57 @@ def _structure(config: BoxWorldConfig, u: np.ndarray) -> tuple[np.ndarray, np.nd
     return locks, contents, distractor
 
 
+_CANDIDATES = 8  # uniform candidate positions drawn per object before the exact fallback
+
+
 def _try_generate(
     config: BoxWorldConfig, keys: np.ndarray, episodes: np.ndarray, attempts: np.ndarray
 ) -> tuple[LevelArrays, np.ndarray]:
     """One attempt at m levels; returns them and which ones could be placed."""
     m = len(keys)
-    nobj = config.num_objects
+    rows = np.arange(m)
+    nobj, places = config.num_objects, len(_PLACE_CELL)
     nd, ln = config.num_distractors, config.distractor_length
+    # draws: colours | branch roots | branch keys | per object (exact, candidates) | agent (same)
     first_pos = NUM_COLOURS + nd + nd * ln
-    u = uniforms(keys, episodes, attempts, first_pos + nobj + 1)
+    per = 1 + _CANDIDATES
+    u = uniforms(keys, episodes, attempts, first_pos + per * (nobj + 1))
     locks, contents, distractor = _structure(config, u)
+    draws = u[:, first_pos:].reshape(m, nobj + 1, per)
+    exact = draws[:, :, 0]  # (m, nobj + 1)
+    candidates = (draws[:, :, 1:] * places).astype(np.int64)  # (m, nobj + 1, C) placement indices
 
-    blocked = np.zeros((m, _BLOCK.shape[0]), bool)
+    blocked = np.zeros((m, places), bool)
     ok = np.ones(m, bool)
-    content_cell = np.empty((m, nobj), np.int16)
+    content_cell = np.empty((m, nobj), np.int64)
     for j in range(nobj):
-        pos, found = _pick(~blocked, u[:, first_pos + j])
+        pos, found = _choose(~blocked, candidates[:, j], exact[:, j])
         ok &= found
         content_cell[:, j] = _PLACE_CELL[pos]
         blocked |= _BLOCK[pos]
 
-    has_lock = locks >= 0
-    slot_cells = np.concatenate([content_cell, content_cell + 1], axis=1)  # (m, 2 nobj)
+    # Object cells: every content, then every lock (the loose key, object 0, has none).
+    slot_cells = np.concatenate([content_cell, content_cell[:, 1:] + 1], axis=1)  # (m, S)
     slot_codes = np.concatenate(
-        [np.where(contents == NUM_COLOURS, GEM, KEY + contents), LOCK + np.maximum(locks, 0)],
-        axis=1,
+        [np.where(contents == NUM_COLOURS, GEM, KEY + contents), LOCK + locks[:, 1:]], axis=1
     )
-    slot_distractor = np.concatenate(
-        [np.zeros((m, nobj), bool), np.broadcast_to(distractor, (m, nobj))], axis=1
-    )
-    keep = np.concatenate([np.ones((m, nobj), bool), has_lock], axis=1)
-    # The loose key has no lock: every level drops the same column, so reshape is safe.
-    slot_cells = slot_cells[keep].reshape(m, config.num_slots)
-    slot_codes = slot_codes[keep].reshape(m, config.num_slots)
-    slot_distractor = slot_distractor[keep].reshape(m, config.num_slots)
+    slot_distractor = np.zeros((m, config.num_slots), bool)
+    slot_distractor[:, nobj:] = distractor[1:]
 
     occupied = np.zeros((m, CELLS), bool)
-    np.put_along_axis(occupied, slot_cells.astype(np.int64), True, axis=1)
+    occupied.reshape(-1)[(rows * CELLS)[:, None] + slot_cells] = True
     free = ~occupied[:, _INTERIOR_CELLS]
-    agent_pos, found = _pick(free, u[:, first_pos + nobj])
+    agent_candidates = (draws[:, nobj, 1:] * len(_INTERIOR_CELLS)).astype(np.int64)
+    agent_pos, found = _choose(free, agent_candidates, exact[:, nobj])
     ok &= found
 
     order = np.argsort(slot_cells, axis=1, kind="stable")
+    flat = (rows * config.num_slots)[:, None] + order  # row-major object order
     levels = LevelArrays(
         agent=_INTERIOR_CELLS[agent_pos].astype(np.int16),
-        cells=np.take_along_axis(slot_cells, order, axis=1).astype(np.int16),
-        codes=np.take_along_axis(slot_codes, order, axis=1).astype(np.uint8),
-        distractor=np.take_along_axis(slot_distractor, order, axis=1),
+        cells=slot_cells.reshape(-1)[flat].astype(np.int16),
+        codes=slot_codes.reshape(-1)[flat].astype(np.uint8),
+        distractor=slot_distractor.reshape(-1)[flat],
     )
     return levels, ok
 
@@ -318,6 +355,43 @@ def generate_levels(config: BoxWorldConfig, keys: np.ndarray, episodes: np.ndarr
             getattr(levels, field)[redo] = getattr(again, field)
         ok[redo] = ok_again
     return levels
+
+
+class NextLevels:
+    """The next level of each of n level streams, drawn ahead and refilled in batches.
+
+    A call to :func:`generate_levels` costs a fixed ~0.2 ms plus a few microseconds per
+    level, and autoresets come a few environments at a time: drawing each level when it
+    is needed would pay the fixed cost on most steps. Here every stream's next level
+    waits ready; the ones used are drawn again together once ``batch`` of them are used.
+    Levels stay a pure function of (key, episode), so nothing about them changes."""
+
+    def __init__(self, config: BoxWorldConfig, n: int, batch: int) -> None:
+        self.config, self.batch = config, max(1, batch)
+        self._levels = LevelArrays(
+            np.zeros(n, np.int16),
+            np.full((n, config.num_slots), -1, np.int16),
+            np.zeros((n, config.num_slots), np.uint8),
+            np.zeros((n, config.num_slots), bool),
+        )
+        self._key = np.zeros(n, np.uint64)  # the (key, episode) each buffered level belongs to
+        self._episode = np.full(n, np.iinfo(np.uint64).max, np.uint64)
+
+    def take(self, rows: np.ndarray, keys: np.ndarray, episodes: np.ndarray) -> LevelArrays:
+        """Levels of streams ``rows`` for their episodes ``episodes[rows]``; then keep the
+        following ones ready. ``keys`` and ``episodes`` are the (n,) arrays of all streams."""
+        want_key, want_episode = keys[rows], episodes[rows]
+        levels = self._levels.take(rows)
+        miss = np.flatnonzero((self._key[rows] != want_key) | (self._episode[rows] != want_episode))
+        if miss.size:
+            levels.put(miss, generate_levels(self.config, want_key[miss], want_episode[miss]))
+        self._episode[rows] = np.iinfo(np.uint64).max  # used up
+        stale = np.flatnonzero(self._episode == np.iinfo(np.uint64).max)
+        if stale.size >= self.batch:
+            following = episodes[stale] + np.uint64(1)
+            self._levels.put(stale, generate_levels(self.config, keys[stale], following))
+            self._key[stale], self._episode[stale] = keys[stale], following
+        return levels
 
 
 # ---------------------------------------------------------------- hand-built levels

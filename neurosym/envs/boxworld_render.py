@@ -3,7 +3,7 @@
 The tiles keep the observation's colours (what the agent sees) and add a glyph
 where a colour alone would be ambiguous to a reader: a keyhole on locks, a
 disc for the agent, an outlined diamond for the gem. Drawing is one lookup of
-a per-code tile atlas, no loop over cells.
+a per-code tile atlas (laid out by :mod:`neurosym.envs.render`), no loop over cells.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from neurosym.envs.boxworld_entities import (
     PALETTE,
     WALL,
 )
+from neurosym.envs.render import ansi_grid, draw_tiles
 
 DEFAULT_TILE = 24
 """pixels per cell of ``rgb_array`` frames"""
@@ -63,9 +64,7 @@ def tile_atlas(tile: int = DEFAULT_TILE) -> np.ndarray:
 
 def rgb_frame(grid: np.ndarray, tile: int = DEFAULT_TILE) -> np.ndarray:
     """(H * tile, W * tile, 3) uint8 picture of an (H, W) grid of entity codes."""
-    h, w = grid.shape
-    tiles = tile_atlas(tile)[grid]  # (H, W, tile, tile, 3)
-    return tiles.transpose(0, 2, 1, 3, 4).reshape(h * tile, w * tile, 3)
+    return draw_tiles(grid, tile_atlas(tile), line=None)  # the atlas draws its own grid lines
 
 
 _LETTERS = "abcdefghijklmnopqrst"
@@ -82,13 +81,14 @@ def _char_table() -> np.ndarray:
 
 
 _CHARS = _char_table()
+_NO_COLOUR = [None] * NUM_CODES  # 20 colours do not fit the terminal's 16: letters name them
 
 
 def ansi_text(grid: np.ndarray) -> str:
     """Text picture of an (H, W) grid: ``#`` wall, ``.`` empty, ``@`` agent, ``*`` gem,
     a key in lower case and its lock in upper case (letter per colour, legend below);
     the held key shows in the top-left corner."""
-    lines = ["".join(row) for row in _CHARS[grid]]
+    lines = [ansi_grid(grid, _CHARS.tolist(), _NO_COLOUR)]
     codes = np.unique(grid)
     colours = sorted(
         {
