@@ -63,9 +63,11 @@ def float_text(value: float) -> str:
         raise FactError(f"{value!r} cannot be written as a Prolog fact; replace NaN/inf first")
     text = repr(float(value))
     mantissa, e, exponent = text.partition("e")
-    if e and "." not in mantissa:  # Python's '1e-05' -> Prolog's '1.0e-5'
-        return f"{mantissa}.0e{int(exponent)}"
-    return text
+    if not e:
+        return text
+    if "." not in mantissa:  # Python's '1e-05' -> '1.0e-5' (ISO Prolog wants the dot)
+        mantissa += ".0"
+    return f"{mantissa}e{int(exponent)}"
 
 
 TermArg: TypeAlias = "str | int | float | Term | tuple[TermArg, ...]"

@@ -32,7 +32,7 @@ import weakref
 from collections.abc import Iterable, Sequence
 from os import PathLike
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from neurosym.errors import ConfigError, NeurosymError, PrologError
 from neurosym.prolog import bridge
@@ -49,6 +49,13 @@ _SCALARS = frozenset({str, int, float, type(None)})
 _ids = itertools.count(1)
 _bridge_lock = threading.Lock()
 _bridge_loaded = False
+
+
+class Answers(NamedTuple):
+    """The answers of a goal: output variable names, and one row of values per answer."""
+
+    variables: list[str]
+    rows: list[list[Any]]
 
 
 class PrologWarning(UserWarning):
@@ -198,7 +205,7 @@ class KnowledgeBase:
             (errors if kind == "error" else notes).append(text)
         if errors:
             _call_once(
-                "forall(member(Id, Ids), catch(unload_file(Id), _, true))", {"Ids": list(aliases)}
+                "forall(member(_Id, Ids), catch(unload_file(_Id), _, true))", {"Ids": list(aliases)}
             )
             more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
             first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
@@ -209,9 +216,8 @@ class KnowledgeBase:
 
     # -- querying ----------------------------------------------------------
 
-    def _solve(
-        self, goal: str, limit: int | None, inputs: dict[str, Any]
-    ) -> tuple[list[str], list[list[Any]]]:
+    def solve(self, goal: str, /, *, limit: int | None = None, **inputs: Any) -> Answers:
+        """Every answer as rows of values, with the output variable names (the cheapest form)."""
         self._check_open()
         answer = _call_once(
             f"{bridge.MODULE}:solve(M, Goal, Inputs, Limit, Names, Rows, Status)",
@@ -228,7 +234,7 @@ class KnowledgeBase:
             for i, value in enumerate(row):
                 if type(value) not in _SCALARS:
                     row[i] = _from_prolog(value)
-        return answer["Names"], rows
+        return Answers(answer["Names"], rows)
 
     def query(
         self, goal: str, /, *, limit: int | None = None, **inputs: Any
@@ -238,14 +244,14 @@ class KnowledgeBase:
         Keyword arguments named like the goal's variables bind them:
         ``kb.query("holds(E, T, R, A, B)", A="agent")``.
         """
-        names, rows = self._solve(goal, limit, inputs)
+        names, rows = self.solve(goal, limit=limit, **inputs)
         return [dict(zip(names, row, strict=True)) for row in rows]
 
     def query_df(self, goal: str, /, *, limit: int | None = None, **inputs: Any) -> pd.DataFrame:
         """Like :meth:`query`, as a DataFrame with one column per output variable (even when empty)."""
         import pandas as pd
 
-        names, rows = self._solve(goal, limit, inputs)
+        names, rows = self.solve(goal, limit=limit, **inputs)
         return pd.DataFrame(rows, columns=names)
 
     def once(self, goal: str, /, **inputs: Any) -> dict[str, Any] | None:

@@ -1,0 +1,36 @@
+"""Shared pytest fixtures: where SWI-Prolog is, and running the real ``neurosym`` command."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def swipl() -> Path:
+    """The swipl binary neurosym uses (tests fail, not skip, when there is none)."""
+    from neurosym.prolog.locate import swipl_executable
+
+    return swipl_executable()
+
+
+@pytest.fixture(scope="session")
+def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
+    """Run ``python -m neurosym ARGS...`` in a subprocess, from the repository root."""
+
+    def run(*args: object, timeout: float = 300) -> subprocess.CompletedProcess[str]:
+        path = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH")) if p)
+        env = {**os.environ, "PYTHONPATH": path}
+        return subprocess.run(
+            [sys.executable, "-m", "neurosym", *map(str, args)],
+            capture_output=True, text=True, cwd=REPO, env=env, timeout=timeout,
+        )  # fmt: skip
+
+    return run
