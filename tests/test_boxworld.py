@@ -55,13 +55,13 @@ def pixel(obs: np.ndarray, row: int, col: int) -> tuple[int, ...]:
 def test_walking_into_a_loose_key_picks_it_up_and_draws_it_top_left():
     level = Level(agent=(5, 5), keys=((5, 6, "red"),))
     env, info0, [(obs, reward, terminated, truncated, info)] = play(level, [RIGHT])
-    assert info0["objects"] == (("key_red", "key(red)", 5, 6),)
+    assert info0["objects"] == (("agent", "agent", 5, 5), ("key_red", "key(red)", 5, 6))
     assert info0["holding"] == () and info0["events"] == () and info0["outcome"] is None
     assert (reward, terminated, truncated) == (0.0, False, False)
     assert info == {
         "agent": (5, 6),
         "holding": ("key(red)",),
-        "objects": (),
+        "objects": (("agent", "agent", 5, 6),),
         "events": ("got(key(red))",),
         "outcome": None,
     }
@@ -86,7 +86,7 @@ def test_a_lock_without_its_key_and_a_box_content_block_like_walls():
     obs, reward, terminated, truncated, info = steps[0]
     assert (reward, terminated, truncated) == (0.0, False, False)
     assert info["agent"] == (5, 8) and info["events"] == ()
-    assert info["objects"] == info0["objects"]
+    assert info["objects"] == info0["objects"] and info["objects"][0] == ("agent", "agent", 5, 8)
     # the content cannot be walked onto either, from above
     env.reset(options={"level": Level(agent=(4, 6), boxes=(box,))})
     _, reward, terminated, _, info = env.step(DOWN)
@@ -109,6 +109,7 @@ def test_opening_a_correct_box_hands_over_its_key():
     )
     env, info0, steps = play(level, [RIGHT, DOWN])
     assert [o[0] for o in info0["objects"]] == [
+        "agent",
         "key_red",
         "key_blue",
         "lock_red",
@@ -120,7 +121,7 @@ def test_opening_a_correct_box_hands_over_its_key():
     assert info["events"] == ("opened(lock(red))", "got(key(blue))")
     assert info["holding"] == ("key(blue)",)
     assert info["agent"] == (5, 5)  # on the lock's cell
-    assert [o[0] for o in info["objects"]] == ["gem", "lock_blue"]
+    assert [o[0] for o in info["objects"]] == ["agent", "gem", "lock_blue"]
     grid = names(env)
     assert grid[5, 4] == "empty" and grid[5, 5] == "agent" and grid[0, 0] == "held(blue)"
     assert pixel(obs, 5, 4) == BACKGROUND_RGB and pixel(obs, 0, 0) == RGB["blue"]
@@ -132,7 +133,8 @@ def test_the_gem_box_pays_eleven_and_ends_the_episode():
     obs, reward, terminated, truncated, info = steps[1]
     assert (reward, terminated, truncated) == (11.0, True, False)
     assert info["events"] == ("opened(lock(red))", "got(gem)")
-    assert info["outcome"] == "gem" and info["holding"] == () and info["objects"] == ()
+    assert info["outcome"] == "gem" and info["holding"] == ()
+    assert info["objects"] == (("agent", "agent", 5, 5),)
     assert pixel(obs, 0, 0) == WALL_RGB  # nothing held any more
 
 
@@ -144,13 +146,13 @@ def test_a_distractor_box_costs_one_and_ends_the_episode():
     )
     env, info0, steps = play(level, [RIGHT, DOWN])
     ids = [o[0] for o in info0["objects"]]
-    assert ids == ["key_red", "key_purple", "lock_red", "gem", "lock_red_2"]
+    assert ids == ["agent", "key_red", "key_purple", "lock_red", "gem", "lock_red_2"]
     _, reward, terminated, truncated, info = steps[1]
     assert (reward, terminated, truncated) == (-1.0, True, False)
     assert info["events"] == ("opened(lock(red))", "got(key(purple))", "hit(distractor)")
     assert info["outcome"] == "distractor"
     # the other red lock keeps its id for the rest of the episode
-    assert [o[0] for o in info["objects"]] == ["gem", "lock_red_2"]
+    assert [o[0] for o in info["objects"]] == ["agent", "gem", "lock_red_2"]
 
 
 def test_a_loose_gem_pays_ten():
@@ -198,7 +200,8 @@ def test_observation_colours_and_entity_names_of_a_generated_level():
     for oid, typ, row, col in info["objects"]:
         assert grid[row, col] == typ, oid
         colour = typ[typ.index("(") + 1 : -1] if "(" in typ else None
-        assert pixel(obs, row, col) == (RGB[colour] if colour else GEM_RGB)
+        expected = RGB[colour] if colour else {"gem": GEM_RGB, "agent": AGENT_RGB}[typ]
+        assert pixel(obs, row, col) == expected, oid
     # bw2: one loose key, the gem box and a distractor box sharing the gem box's lock colour
     types = sorted(t for _, t, _, _ in info["objects"])
     locks = [t for t in types if t.startswith("lock(")]

@@ -30,12 +30,18 @@ def held_colour(info: dict) -> int:
 
 
 @pytest.mark.parametrize(
-    ("config", "n", "steps"),
-    [("bw2", 6, 500), ("bw3", 5, 400), ("default", 3, 300)],
+    ("config", "n", "steps", "max_steps"),
+    [
+        ("bw2", 6, 500, 60),
+        ("bw3", 5, 400, 60),
+        ("default", 3, 300, 60),
+        # 24 envs: next levels are drawn ahead and refilled in batches of 3
+        ("bw1", 24, 60, 4),
+    ],
 )
-def test_lockstep_with_single_environments(config, n, steps):
+def test_lockstep_with_single_environments(config, n, steps, max_steps):
     kwargs = dict(BOXWORLD_CONFIGS.get(config, {}))
-    kwargs["max_steps"] = 60  # many truncations and autoresets
+    kwargs["max_steps"] = max_steps  # many truncations and autoresets
     seed = 100
     batched = BoxWorldVectorEnv(n, seed=seed, **kwargs)
     singles = [BoxWorldEnv(**kwargs) for _ in range(n)]
@@ -80,7 +86,9 @@ def test_lockstep_with_single_environments(config, n, steps):
             assert not (info["_final_info"] & ~done).any(), f"[{t}] final_info marks a running env"
         done = terminated | truncated
     # the run covered what it is meant to compare
-    assert seen["gem"] and seen["timeout"] and seen["opened"] and seen["autoreset"], seen
+    assert seen["timeout"] and seen["opened"] and seen["autoreset"] > n, seen
+    if max_steps > 10:
+        assert seen["gem"], seen
     if config == "bw2":
         assert seen["distractor"], seen
 

@@ -107,10 +107,10 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
 
     ## Info
     ``agent`` (row, col); ``holding`` ``("key(red)",)`` or ``()``; ``objects``
-    ``(id, type, row, col)`` of every key, lock and gem still on the map (ids
-    ``key_red``, ``lock_red``, ``lock_red_2`` when a colour repeats, numbered
-    row-major, fixed for the episode; the held key is in ``holding``, not
-    here); ``events``: ``got(key(C))`` on picking up a loose key;
+    ``(id, type, row, col)`` of the agent (id ``agent``, first) and every key,
+    lock and gem still on the map (ids ``key_red``, ``lock_red``, ``lock_red_2``
+    when a colour repeats, numbered row-major, fixed for the episode; the held
+    key is in ``holding``, not here); ``events``: ``got(key(C))`` on picking up a loose key;
     ``opened(lock(C))`` then ``got(key(C2))`` or ``got(gem)`` on opening a box;
     ``got(gem)`` on a loose gem; ``hit(distractor)`` after the events of a
     distractor box; ``outcome``: ``gem``, ``distractor``, ``timeout`` or None.

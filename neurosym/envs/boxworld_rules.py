@@ -256,7 +256,7 @@ def decode_info(info: dict[str, np.ndarray], i: int) -> dict:
     held = int(info["held"][i])
     codes, cells, alive = info["object_code"][i], info["object_cell"][i], info["object_alive"][i]
     ids = object_ids(codes, cells)
-    objects = tuple(
+    objects = (("agent", "agent", row, col),) + tuple(
         (ids[s], ENTITY_NAMES[int(codes[s])], int(cells[s]) // GRID, int(cells[s]) % GRID)
         for s in np.flatnonzero(alive)
     )
