@@ -183,14 +183,14 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             self._batch.set_levels(np.zeros(1, np.intp), cells, starts)
             self._objects = self.source.objects(self.level_seed, self.episode_index)
         self._batch.reset_rows()
-        return self._batch.obs[0].copy(), self._info(0, 0)
+        return self._batch.obs[0].copy(), self._info(0, False)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self.episode_index < 0:
             raise gym.error.ResetNeeded("call reset() before step()")
         a = parse_action(action)
         res = self._batch.step(np.array([a], dtype=np.intp))
-        info = self._info(int(res.events[0]), int(res.outcome[0]))
+        info = self._info(int(res.events[0]), bool(res.truncated[0]))
         return (
             self._batch.obs[0].copy(),
             float(res.reward[0]),
@@ -199,7 +199,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             info,
         )
 
-    def _info(self, events: int, outcome: int) -> dict[str, Any]:
+    def _info(self, events: int, truncated: bool) -> dict[str, Any]:
         b = self._batch
         pos = int(b.pos[0])
         return {
@@ -207,7 +207,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             "holding": ("sword",) if b.holding[0] else (),
             "objects": self._objects.with_agent(pos, int(b.removed[0])),
             "events": rules.EVENT_TUPLES[events],
-            "outcome": rules.OUTCOME_NAMES[outcome],
+            "outcome": rules.outcome_name(events, truncated),
         }
 
     def set_state(self, agent: tuple[int, int], holding: bool = False) -> dict[str, Any]:
@@ -226,7 +226,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         if self._batch.level_cells[self._batch.slot[0], pos] == rules.WALL:
             raise ValueError(f"agent {agent} would stand in a wall")
         self._batch.place(0, pos, bool(holding))
-        return self._info(0, 0)
+        return self._info(0, False)
 
     # -- symbolic views and rendering ----------------------------------------
 

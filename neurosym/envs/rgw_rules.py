@@ -23,6 +23,7 @@ counts as a mountain.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -119,7 +120,7 @@ class RuleTables:
     new_cell: np.ndarray  # uint8 code of the cell after the step
     new_holding: np.ndarray  # uint8
     removes: np.ndarray  # bool: the landing cell's object leaves the map
-    outcome: np.ndarray  # uint8 outcome code when terminated
+    special: np.ndarray  # bool: removes an object or picks up the sword (rare; handled apart)
 
 
 def rule_tables(classic: bool) -> RuleTables:
@@ -130,7 +131,6 @@ def rule_tables(classic: bool) -> RuleTables:
     terminated = np.zeros(size, dtype=bool)
     new_cell = np.zeros(size, dtype=np.uint8)
     new_holding = np.zeros(size, dtype=np.uint8)
-    outcome = np.zeros(size, dtype=np.uint8)
     for cell in range(NUM_CELL_CODES):
         for a in (0, 1):
             for b in (0, 1):
@@ -166,9 +166,24 @@ def rule_tables(classic: bool) -> RuleTables:
                             r, ev, term = 10.0, EV_TERMINAL, True
                 reward[i], events[i], terminated[i] = r, ev, term
                 new_cell[i], new_holding[i] = nc, hold
-                outcome[i] = 2 if ev & EV_PIT else 1 if ev & EV_TERMINAL else 0
     removes = (new_cell != np.repeat(np.arange(NUM_CELL_CODES), 4)) & (new_cell == EMPTY)
-    return RuleTables(reward, events, terminated, new_cell, new_holding, removes, outcome)
+    special = removes | ((events & EV_PICKED) != 0)
+    return RuleTables(reward, events, terminated, new_cell, new_holding, removes, special)
+
+
+def outcome_codes(events: np.ndarray, truncated: np.ndarray) -> np.ndarray:
+    """(n,) index into OUTCOME_NAMES from a step's event bits and truncation flags."""
+    codes = np.where(events & EV_TERMINAL, 1, np.where(events & EV_PIT, 2, 0))
+    return np.where(truncated, 3, codes).astype(np.uint8)
+
+
+def outcome_name(events: int, truncated: bool) -> str | None:
+    """The outcome of one step: terminal, pit, timeout, or None while the episode goes on."""
+    if events & EV_TERMINAL:
+        return "terminal"
+    if events & EV_PIT:
+        return "pit"
+    return "timeout" if truncated else None
 
 
 def teleport_partners(cells: np.ndarray) -> np.ndarray:
@@ -254,17 +269,13 @@ def removable_bits(cells: np.ndarray) -> np.ndarray:
     return np.where(mask, bits, np.uint64(0))
 
 
-class StepResult:
+class StepResult(NamedTuple):
     """Arrays of one batched step (fresh arrays, safe to hand out)."""
 
-    __slots__ = ("reward", "terminated", "truncated", "events", "outcome")
-
-    def __init__(self, reward, terminated, truncated, events, outcome) -> None:  # noqa: ANN001
-        self.reward: np.ndarray = reward
-        self.terminated: np.ndarray = terminated
-        self.truncated: np.ndarray = truncated
-        self.events: np.ndarray = events
-        self.outcome: np.ndarray = outcome
+    reward: np.ndarray  # (n,) float64
+    terminated: np.ndarray  # (n,) bool
+    truncated: np.ndarray  # (n,) bool
+    events: np.ndarray  # (n,) uint16 event bits
 
 
 class RGWBatch:
@@ -317,11 +328,16 @@ class RGWBatch:
         self.holding = np.zeros(n, dtype=np.uint8)
         self.removed = np.zeros(n, dtype=np.uint64)  # bits of removed swords/enemies
         self.t = np.zeros(n, dtype=np.int64)
-        # Observation update tables indexed by cell code.
-        if obs_mode == "onehot":
-            plane = ENTITY_OF_CELL.astype(np.intp)
-            self._plane_off = np.where(np.arange(NUM_CELL_CODES) == EMPTY, 0, plane * N)
-            self._plane_val = (np.arange(NUM_CELL_CODES) != EMPTY).astype(np.uint8)
+        # Observation update tables indexed by cell code: the plane offset of each
+        # code; an empty cell has no plane, so its writes go to the wall plane (always
+        # 0 where the agent can be) with value 0, which keeps every write of a step
+        # at a distinct index or a repeat of the same value.
+        code = np.arange(NUM_CELL_CODES)
+        plane = np.where(code == EMPTY, WALL, ENTITY_OF_CELL)
+        self._plane_off = plane.astype(np.intp) * N
+        self._plane_val = (code != EMPTY).astype(np.uint8)
+        self._write_at = np.empty((n, 2), dtype=np.intp)  # scratch for the paired writes
+        self._write_val = np.empty((n, 2), dtype=np.uint8)
 
     # -- levels ---------------------------------------------------------------
 
@@ -407,58 +423,73 @@ class RGWBatch:
             if a.dtype.kind not in "iu":
                 raise ValueError(f"actions must be integers 0..3, got dtype {a.dtype}")
             a = a.astype(np.intp)
-        if (a.view(np.uintp) > 3).any():
+        if a.view(np.uintp).max() > 3:
             raise ValueError(
                 f"actions must be 0 up, 1 right, 2 down or 3 left; got {a[(a < 0) | (a > 3)][:5]}"
             )
         T = self._tables
+        # Where each agent goes: one gather per static table.
         flat = self._key + a
-        new = self._dest_pos[flat]
-        self._key = self._dest_key[flat]
-        mc = self._mcode[flat]
+        new = self._dest_pos.take(flat)
+        self._key = self._dest_key.take(flat)
+        mc = self._mcode.take(flat)
         gidx = self._grow + new
-        cell = self.grid[gidx]
+        cell = self.grid.take(gidx)
+        # What happens there: one gather per rule table.
         if self.classic:
             held = self.holding * (self.pos != 0)  # the original's `state > nS_pos` test
             idx = cell * 4 + held * 2 + self.holding
         else:
             idx = cell * 4 + self.holding * 2 + (mc & MV_STAY)
-        reward = T.reward[idx]
-        terminated = T.terminated[idx]
-        events = T.events[idx] | MOVE_EVENTS[mc]
-        new_cell = T.new_cell[idx]
+        reward = T.reward.take(idx)
+        terminated = T.terminated.take(idx)
+        events = T.events.take(idx) | MOVE_EVENTS.take(mc)
+        new_cell = T.new_cell.take(idx)
         self.grid[gidx] = new_cell
-        holding = T.new_holding[idx]
-        removes = T.removes[idx]
-        if removes.any():
-            rows = np.flatnonzero(removes)
-            self.removed = self.removed.copy()
-            self.removed[rows] |= self._level_bits[self.slot[rows], new[rows]]
-        # Observation: restore the cell left behind, draw the agent on the new one.
+        holding = T.new_holding.take(idx)
+        special = T.special.take(idx)
+        if special.any():  # rare: a sword picked up or an object removed
+            self._special(np.flatnonzero(special), idx, new, holding)
+        # Observation: restore the cell left behind, then draw the agent on the new one.
         o_new = self._orow + new
         obs = self._obs_flat
         if self.channels == 1:
-            obs[self._opos] = GREY_OF_CELL[self.under]
+            obs[self._opos] = GREY_OF_CELL.take(self.under)
             obs[o_new] = GREY_AGENT
         else:
-            o_old = self._opos
-            obs[o_old] = 0
-            obs[o_old + self._plane_off[self.under]] = self._plane_val[self.under]
-            obs[o_new + self._plane_off[cell]] = 0
-            obs[o_new] = 1
-            picked = holding > self.holding
-            if picked.any():
-                self.obs[np.flatnonzero(picked), HOLD_PLANE] = 1
+            # Two writes per env and pass, side by side so each env's cache lines are
+            # loaded once per pass: (agent plane <- 0, left cell's plane <- 1), then
+            # (entered cell's plane <- 0, agent plane <- 1).
+            o_old, where, val = self._opos, self._write_at, self._write_val
+            where[:, 0] = o_old
+            np.add(o_old, self._plane_off.take(self.under), out=where[:, 1])
+            val[:, 0] = 0
+            val[:, 1] = self._plane_val.take(self.under)
+            obs[where] = val
+            np.add(o_new, self._plane_off.take(cell), out=where[:, 0])
+            where[:, 1] = o_new
+            val[:, 1] = 1
+            obs[where] = val
         self._opos = o_new
         self.under = new_cell
         self.holding = holding
         self.pos = new
         self.t += 1
         truncated = (self.t >= self.max_steps) > terminated
-        outcome = T.outcome[idx]
-        if truncated.any():
-            outcome[truncated] = 3
-        return StepResult(reward, terminated, truncated, events, outcome)
+        return StepResult(reward, terminated, truncated, events)
+
+    def _special(
+        self, rows: np.ndarray, idx: np.ndarray, new: np.ndarray, holding: np.ndarray
+    ) -> None:
+        """Bookkeeping of the rare steps: removed objects' bits, the holding plane."""
+        T = self._tables
+        gone = rows[T.removes.take(idx[rows])]
+        if len(gone):
+            self.removed = self.removed.copy()
+            self.removed[gone] |= self._level_bits[self.slot[gone], new[gone]]
+        if self.channels > 1:
+            picked = rows[holding[rows] > self.holding[rows]]
+            self.obs[picked, HOLD_PLANE] = 1
 
     # -- views ----------------------------------------------------------------
 

@@ -9,8 +9,8 @@ episode with reward 0.
 ``info`` is a dict of arrays, cheap to build every step:
 
 * ``pos``: (n,) row-major cell of the agent; ``holding``: (n,) 1 with the sword;
-* ``events``: (n,) bitmask over ``rgw_rules.EVENT_NAMES``; ``outcome``: (n,)
-  index into ``rgw_rules.OUTCOME_NAMES``;
+* ``events``: (n,) bitmask over ``rgw_rules.EVENT_NAMES``; ``truncated``: (n,)
+  (``rgw_rules.outcome_codes(events, truncated)`` gives the outcomes);
 * ``removed``: (n,) bitmask of swords and enemies gone from the map;
 * ``episode_id``: (n,) episodes begun by each sub-env since the seeded reset;
   ``seed``: (n,) level seeds (procedural levels only);
@@ -159,8 +159,7 @@ class RGWVectorEnv(VectorEnv):
             self._batch.set_levels(np.arange(n), cells, starts)
         self._batch.reset_rows(None)
         self._pending = None
-        zeros = np.zeros(n, dtype=np.uint16)
-        info = self._info(zeros, zeros.astype(np.uint8))
+        info = self._info(np.zeros(n, dtype=np.uint16), np.zeros(n, dtype=bool))
         self._last_info = info
         return self._observation(), info
 
@@ -183,8 +182,7 @@ class RGWVectorEnv(VectorEnv):
             res.terminated[rows] = False
             res.truncated[rows] = False
             res.events[rows] = 0
-            res.outcome[rows] = 0
-        info = self._info(res.events, res.outcome)
+        info = self._info(res.events, res.truncated)
         if rows is not None:
             mask = np.zeros(self.num_envs, dtype=bool)
             mask[rows] = True
@@ -198,13 +196,13 @@ class RGWVectorEnv(VectorEnv):
     def _observation(self) -> np.ndarray:
         return self._batch.obs.copy() if self.copy else self._batch.obs
 
-    def _info(self, events: np.ndarray, outcome: np.ndarray) -> dict[str, Any]:
+    def _info(self, events: np.ndarray, truncated: np.ndarray) -> dict[str, Any]:
         b = self._batch
         info = {
             "pos": b.pos,
             "holding": b.holding,
             "events": events,
-            "outcome": outcome,
+            "truncated": truncated,
             "removed": b.removed,
             "episode_id": self._episodes,
         }
@@ -224,7 +222,7 @@ class RGWVectorEnv(VectorEnv):
             "holding": ("sword",) if info["holding"][i] else (),
             "objects": objects.with_agent(pos, int(info["removed"][i])),
             "events": rules.EVENT_TUPLES[int(info["events"][i])],
-            "outcome": rules.OUTCOME_NAMES[int(info["outcome"][i])],
+            "outcome": rules.outcome_name(int(info["events"][i]), bool(info["truncated"][i])),
         }
 
     # -- symbolic views and rendering ----------------------------------------
