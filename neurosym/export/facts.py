@@ -159,38 +159,36 @@ class FactSet:
     # ----------------------------------------------------------------- writers
 
     def prolog_tables(self) -> dict[str, pd.DataFrame]:
-        """The tables as the Prolog writer takes them: term text as Term, r(J) for holds."""
-        from neurosym.terms import Term, parse_term
-
+        """The tables as the Prolog writer takes them: columns in argument order, r(J) text for holds."""
         out: dict[str, pd.DataFrame] = {}
         for name, df in self.tables.items():
             df = df.loc[:, list(PREDICATES[name])]
-            term_cols = TERM_COLUMNS.get(name, ())
-            if term_cols or name == "holds":
-                df = df.copy()
-            for col in term_cols:
-                codes, uniques = pd.factorize(df[col], sort=False)
-                terms = np.array([parse_term(str(u)) for u in uniques] + [None], dtype=object)
-                df[col] = terms[codes]
             if name == "holds":
                 codes, uniques = pd.factorize(df["j"], sort=False)
-                terms = np.array([Term("r", (int(u),)) for u in uniques] + [None], dtype=object)
-                df["j"] = terms[codes]
+                text = np.array([f"r({int(u)})" for u in uniques] + [""], dtype=object)
+                df = df.assign(j=text[codes])
             out[name] = df
         return out
 
     def to_prolog(self, path: str | os.PathLike[str], qlf: bool = False) -> Path:
-        """Write the KB as one plain Prolog file (atomically); with ``qlf`` also compile a .qlf.
+        """Write the KB as one plain Prolog file (atomically); with ``qlf`` also compile ``<stem>.qlf``.
 
         Every schema predicate is declared dynamic, so rules that ask for facts the
         KB has none of (attention/6 in a PrediNet KB) fail instead of raising, and
-        the file loads in plain ``swipl`` without warnings. Returns the path written.
+        the file loads in plain ``swipl`` without warnings. Returns the .pl path.
         """
         from neurosym.export.prolog_writer import write_prolog
 
-        dynamic = [f"{name}/{len(cols)}" for name, cols in PREDICATES.items()]
-        written = write_prolog(Path(path), self.prolog_tables(), header=self._header(), dynamic=dynamic, qlf=qlf)
-        return Path(written) if written is not None else Path(path)
+        term_columns = {**TERM_COLUMNS, "holds": ("j", "a", "b")}
+        written = write_prolog(
+            Path(path),
+            self.prolog_tables(),
+            header=self._header(),
+            dynamic=predicate_indicators(),
+            qlf=qlf,
+            term_columns=term_columns,
+        )
+        return Path(written)
 
     def to_parquet(self, directory: str | os.PathLike[str]) -> Path:
         """Write one Parquet file per predicate and ``meta.json``, each file atomically."""
