@@ -118,7 +118,9 @@ def test_failed_write_leaves_the_old_file_intact(tmp_path: Path) -> None:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["kb.pl"]
 
 
-def test_large_tables_are_written_in_blocks(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_large_tables_are_written_in_blocks(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import neurosym.export.prolog_writer as writer
 
     monkeypatch.setattr(writer, "CHUNK_ROWS", 3)
@@ -131,7 +133,9 @@ def test_large_tables_are_written_in_blocks(tmp_path: Path, monkeypatch: pytest.
 
 def test_plain_swipl_loads_the_file_without_warnings(tmp_path: Path, swipl: Path) -> None:
     tables = {
-        "event": pd.DataFrame({"e": [0, 1], "ev": [Term("picked", ("sword",)), Term("fell", ("pit",))]}),
+        "event": pd.DataFrame(
+            {"e": [0, 1], "ev": [Term("picked", ("sword",)), Term("fell", ("pit",))]}
+        ),
         "empty": pd.DataFrame({"a": [], "b": []}),
     }
     path = write_prolog(tmp_path / "kb.pl", tables, dynamic=["holds/5"])
@@ -156,15 +160,35 @@ def test_qlf_is_written_beside_the_source_and_loads(tmp_path: Path) -> None:
 # --- round trips through SWI-Prolog ------------------------------------------
 
 atoms = st.text(max_size=10) | st.sampled_from(
-    ["", "[]", "{}", "-", ";", "!", ",", "|", "a b", "It's", "\\", "'", "é", "is", "dynamic", "None", "true"]
+    [
+        "",
+        "[]",
+        "{}",
+        "-",
+        ";",
+        "!",
+        ",",
+        "|",
+        "a b",
+        "It's",
+        "\\",
+        "'",
+        "é",
+        "is",
+        "dynamic",
+        "None",
+        "true",
+    ]
 )
 ints = st.integers() | st.integers(min_value=-(2**200), max_value=2**200)
 floats = st.floats(allow_nan=False, allow_infinity=False)
 functors = atoms.filter(lambda a: a != "[|]")  # '[|]'(H, T) *is* a list cell in SWI-Prolog 7
 values = st.recursive(
     atoms | ints | floats,
-    lambda children: st.builds(Term, functors, st.lists(children, min_size=1, max_size=3).map(tuple))
-    | st.lists(children, max_size=3).map(tuple),
+    lambda children: (
+        st.builds(Term, functors, st.lists(children, min_size=1, max_size=3).map(tuple))
+        | st.lists(children, max_size=3).map(tuple)
+    ),
     max_leaves=10,
 )
 
@@ -204,7 +228,11 @@ def test_mixed_values_read_back_equal(cells: list[object]) -> None:
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    st.lists(st.tuples(atoms, st.integers(-(2**63), 2**63 - 1), floats, st.booleans()), min_size=1, max_size=20)
+    st.lists(
+        st.tuples(atoms, st.integers(-(2**63), 2**63 - 1), floats, st.booleans()),
+        min_size=1,
+        max_size=20,
+    )
 )
 def test_typed_columns_read_back_equal(rows: list[tuple[str, int, float, bool]]) -> None:
     names, numbers, reals, flags = zip(*rows, strict=True)

@@ -116,12 +116,18 @@ def test_parse_term_errors_name_the_position(text: str, message: str) -> None:
         parse_term(text)
 
 
-atoms = st.text(max_size=12) | st.sampled_from(["", "[]", "{}", "-", ";", "!", "a b", "It's", "\\", "é", "is"])
-numbers = st.integers(min_value=-(2**100), max_value=2**100) | st.floats(allow_nan=False, allow_infinity=False)
+atoms = st.text(max_size=12) | st.sampled_from(
+    ["", "[]", "{}", "-", ";", "!", "a b", "It's", "\\", "é", "is"]
+)
+numbers = st.integers(min_value=-(2**100), max_value=2**100) | st.floats(
+    allow_nan=False, allow_infinity=False
+)
 terms = st.recursive(
     atoms | numbers,
-    lambda children: st.builds(Term, atoms, st.lists(children, min_size=1, max_size=3).map(tuple))
-    | st.lists(children, max_size=3).map(tuple),
+    lambda children: (
+        st.builds(Term, atoms, st.lists(children, min_size=1, max_size=3).map(tuple))
+        | st.lists(children, max_size=3).map(tuple)
+    ),
     max_leaves=12,
 )
 

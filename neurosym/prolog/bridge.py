@@ -8,8 +8,11 @@ package without any package-data settings. What it does, and why in Prolog:
   ``user``; ``close_kb/2`` unloads its files and destroys the module.
 * ``load/5`` loads one file into a KB module under a per-module source id,
   because SWI-Prolog refuses (or silently reconsults) one non-module file in
-  two modules. Errors and warnings printed during the load are captured with
-  ``message_hook/3`` and returned instead of being printed.
+  two modules. Predicates already loaded are declared multifile first, so
+  several fact files add up instead of replacing each other. Errors and
+  warnings printed during the load are captured with ``message_hook/3`` and
+  returned instead of being printed. The ``dynamic``, ``discontiguous`` and
+  ``multifile`` directives a ``.qlf`` replays land in the KB's module.
 * ``solve/7`` parses the goal text in the KB module, binds the inputs by
   variable name (values never pass through goal text), runs it under
   ``limit/2`` and returns every answer in one call, each value encoded so
@@ -86,11 +89,19 @@ close_kb(M, Files) :-
 %   Messages: list of Kind-Text, Kind error or warning.
 load(M, Id, File, Format, Messages) :-
     retractall(collected_(_, _)),
+    multifile_loaded_(M),
     setup_call_cleanup(
         assertz(collecting_),
         catch(load_(M, Id, File, Format), E, print_message(error, E)),
         retractall(collecting_)),
     findall(Kind-Text, retract(collected_(Kind, Text)), Messages).
+
+% Several files of one KB add up: without this a second file with clauses
+% for relation/7 would silently replace those of the first.
+multifile_loaded_(M) :-
+    forall(( current_predicate(_, M:Head),
+             \+ predicate_property(M:Head, imported_from(_)) ),
+           ( functor(Head, Name, Arity), multifile(M:Name/Arity) )).
 
 load_(M, Id, File, source) :-
     setup_call_cleanup(
@@ -102,6 +113,22 @@ load_(M, Id, File, qlf) :-
         open(File, read, S, [type(binary)]),
         load_files(M:Id, [stream(S), format(qlf), silent(true)]),
         close(S)).
+
+% A .qlf replays a file's directives qualified with the module it was
+% compiled in. neurosym compiles into neurosym_qlf (see neurosym/prolog/qlf.py),
+% and these declarations there forward to the module being loaded.
+:- redefine_system_predicate(neurosym_qlf:dynamic(_)).
+:- redefine_system_predicate(neurosym_qlf:discontiguous(_)).
+:- redefine_system_predicate(neurosym_qlf:multifile(_)).
+neurosym_qlf:dynamic(Spec) :- load_module_(M), dynamic(M:Spec).
+neurosym_qlf:discontiguous(Spec) :- load_module_(M), discontiguous(M:Spec).
+neurosym_qlf:multifile(Spec) :- load_module_(M), multifile(M:Spec).
+
+load_module_(M) :-
+    (   prolog_load_context(module, M0)
+    ->  M = M0
+    ;   M = neurosym_qlf
+    ).
 
 %!  solve(+M, +Text, +Inputs, +Limit, -Names, -Rows, -Status) is det.
 %   Status: ok, missing-Names or error-Text (pairs: janus makes them tuples).

@@ -16,6 +16,8 @@ from neurosym.errors import PrologError
 from neurosym.prolog.locate import swipl_executable
 from neurosym.terms import atom_text
 
+QLF_MODULE = "neurosym_qlf"
+
 
 def qlf_path(source: Path | str) -> Path:
     """Where ``qcompile`` puts the quick-load file of ``source``: same stem, ``.qlf``."""
@@ -36,7 +38,10 @@ def qcompile(source: Path | str) -> Path:
     """
     source = Path(source).resolve()
     target = qlf_path(source)
-    goal = f"qcompile({atom_text(str(source))})"
+    # Compiled in module neurosym_qlf: the .qlf replays directives qualified with
+    # it, and neurosym's bridge forwards dynamic/discontiguous/multifile from
+    # there to the KB module that loads the file.
+    goal = f"qcompile({QLF_MODULE}:{atom_text(str(source))})"
     cmd = [str(swipl_executable()), "-f", "none", "--no-packs", "-q", "--on-error=status",
            "-g", goal, "-t", "halt"]  # fmt: skip
     proc = subprocess.run(cmd, capture_output=True, text=True)
