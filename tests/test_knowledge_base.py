@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -254,3 +256,89 @@ def test_qlf_compile_errors_name_the_file(tmp_path: Path) -> None:
     ):
         KnowledgeBase(bad, qlf=True)
     assert not (tmp_path / "bad.qlf").exists()
+
+
+def test_unreadable_qlf_is_recompiled_from_its_source(tmp_path: Path) -> None:
+    facts = _write(tmp_path / "kb.pl", "p(1).\n")
+    qlf = tmp_path / "kb.qlf"
+    qlf.write_bytes(b"not a qlf file")  # newer than the source, but unreadable
+    with KnowledgeBase(facts, qlf=True) as kb:
+        assert kb.query("p(X)") == [{"X": 1}]
+    assert qlf.read_bytes() != b"not a qlf file"
+    qlf.write_bytes(b"not a qlf file")
+    with pytest.raises(PrologError, match="kb.qlf"):  # named directly: nothing to recompile from
+        KnowledgeBase(qlf)
+
+
+# --- locating SWI-Prolog -------------------------------------------------------
+
+
+def _fake_swipl(directory: Path, version: int) -> Path:
+    directory.mkdir(parents=True, exist_ok=True)
+    exe = directory / "swipl"
+    exe.write_text(
+        f"#!/bin/sh\necho 'PLBASE=\"{directory}/home\";'\necho 'PLVERSION=\"{version}\";'\n"
+    )
+    exe.chmod(0o755)
+    return exe
+
+
+@pytest.fixture
+def fresh_locate(monkeypatch: pytest.MonkeyPatch):
+    from neurosym.prolog import locate
+
+    locate.find_swipl.cache_clear()
+    yield locate
+    monkeypatch.undo()
+    locate.find_swipl.cache_clear()
+
+
+def test_neurosym_swipl_is_checked(tmp_path: Path, monkeypatch, fresh_locate) -> None:
+    monkeypatch.setenv("NEUROSYM_SWIPL", str(_fake_swipl(tmp_path / "old", 90004)))
+    with pytest.raises(NeurosymError, match=r"is SWI-Prolog 9\.0\.4; janus-swi needs >= 9\.1\.12"):
+        fresh_locate.find_swipl()
+    fresh_locate.find_swipl.cache_clear()
+    monkeypatch.setenv("NEUROSYM_SWIPL", str(tmp_path / "nope"))
+    with pytest.raises(NeurosymError, match="is not a runnable swipl"):
+        fresh_locate.find_swipl()
+    fresh_locate.find_swipl.cache_clear()
+    new = _fake_swipl(tmp_path / "new", 90209)
+    monkeypatch.setenv("NEUROSYM_SWIPL", str(new))
+    found = fresh_locate.find_swipl()
+    assert (found.executable, found.home, found.version_text) == (
+        new,
+        tmp_path / "new" / "home",
+        "9.2.9",
+    )
+
+
+def test_old_swipl_on_path_is_not_used(tmp_path: Path, monkeypatch, fresh_locate) -> None:
+    monkeypatch.delenv("NEUROSYM_SWIPL", raising=False)
+    monkeypatch.setattr(sys, "prefix", str(tmp_path / "empty-venv"))
+    old = _fake_swipl(tmp_path / "bin", 90004)
+    monkeypatch.setenv("PATH", str(old.parent))
+    with pytest.raises(NeurosymError, match=r"swipl on PATH .* is version 9\.0\.4; .*make setup"):
+        fresh_locate.find_swipl()
+
+
+def test_janus_gets_the_venv_home_despite_an_old_swipl_on_path(tmp_path: Path, swipl: Path) -> None:
+    if swipl != Path(sys.prefix) / "swipl" / "bin" / "swipl":
+        pytest.skip("this setup uses a SWI-Prolog outside the venv")
+    old = _fake_swipl(tmp_path / "bin", 90004)
+    code = (
+        "import os, sys\n"
+        "from neurosym.prolog.knowledge_base import KnowledgeBase\n"
+        "from neurosym.prolog.locate import find_swipl\n"
+        "kb = KnowledgeBase(None)\n"
+        "assert kb.query('X is 6 * 7') == [{'X': 42}]\n"
+        "print(os.environ['SWI_HOME_DIR'] == str(find_swipl().home), find_swipl().executable)\n"
+    )
+    env = {**os.environ, "PATH": f"{old.parent}{os.pathsep}{os.environ['PATH']}"}
+    env.pop("NEUROSYM_SWIPL", None)
+    env.pop("SWI_HOME_DIR", None)
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1])
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["True", str(swipl)]

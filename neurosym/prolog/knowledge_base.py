@@ -169,30 +169,47 @@ class KnowledgeBase:
         """Load one more Prolog file (facts or rules) into this KB.
 
         A ``.qlf`` path is loaded as a quick-load file; with ``qlf=True`` a
-        ``.pl`` source is compiled to ``.qlf`` first (when missing or stale).
-        Syntax and other load errors raise :class:`PrologError` naming the
-        file and line; the file's clauses are then unloaded again.
+        ``.pl`` source is compiled to ``.qlf`` first (when missing, stale, or
+        written by another SWI-Prolog version). Syntax and other load errors
+        raise :class:`PrologError` naming the file and line; the file's
+        clauses are then unloaded again. Warnings become :class:`PrologWarning`.
         """
         self._check_open()
         path = Path(path)
         if not path.is_file():
             raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {path}")
         path = path.resolve()
-        if path.suffix == ".qlf" or qlf:
-            if path.suffix != ".qlf" and not is_fresh(path):
+        if path.suffix != ".qlf" and qlf:
+            compiled = not is_fresh(path)
+            if compiled:
                 qcompile(path)
-            load_file, fmt = qlf_path(path), "qlf"
+            errors, notes = self._load_file(path, "qlf")
+            if errors and not compiled:  # e.g. a .qlf from another SWI-Prolog version
+                qcompile(path)
+                errors, notes = self._load_file(path, "qlf")
+        else:
+            errors, notes = self._load_file(path, "qlf" if path.suffix == ".qlf" else "source")
+        if errors:
+            more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
+            first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
+            raise PrologError(f"cannot load {first}{more}")
+        for note in notes:
+            warnings.warn(note, PrologWarning, stacklevel=2)
+        self.files.append(path)
+
+    def _load_file(self, path: Path, fmt: str) -> tuple[list[str], list[str]]:
+        """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error."""
+        if fmt == "qlf":
+            load_file = qlf_path(path)
             # A per-module directory: SWI-Prolog relocates the .qlf's recorded
             # source path into it, so each KB owns its own copy of the clauses.
             source_id = f"{path.parent}/.{self.module}/{load_file.name}"
             clause_source = f"{path.parent}/.{self.module}/{path.stem}.pl"
-            aliases = {clause_source: str(path.with_suffix(".pl"))}
+            aliases = {clause_source: str(path.with_suffix(".pl")), source_id: str(path)}
         else:
-            load_file, fmt = path, "source"
+            load_file = path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
-            aliases = {}
-        aliases[source_id] = str(path)
-        self._source_ids.extend(aliases)
+            aliases = {source_id: str(path)}
         answer = _call_once(
             f"{bridge.MODULE}:load(M, Id, File, Format, Messages)",
             {"M": self.module, "Id": source_id, "File": str(load_file), "Format": fmt},
@@ -207,12 +224,9 @@ class KnowledgeBase:
             _call_once(
                 "forall(member(_Id, Ids), catch(unload_file(_Id), _, true))", {"Ids": list(aliases)}
             )
-            more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
-            first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
-            raise PrologError(f"cannot load {first}{more}")
-        for note in notes:
-            warnings.warn(note, PrologWarning, stacklevel=2)
-        self.files.append(path)
+        else:
+            self._source_ids.extend(aliases)
+        return errors, notes
 
     # -- querying ----------------------------------------------------------
 
