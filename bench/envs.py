@@ -33,7 +33,9 @@ from neurosym.envs import ENVS, env_family, make, make_batched  # noqa: E402
 
 def timed(step: Callable[[], int], seconds: float) -> tuple[int, float, float]:
     """Call step (which returns the env steps it took) until `seconds` of wall time passed."""
-    step()  # warm up
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < seconds / 2:  # warm up (procedural levels: fill buffers)
+        step()
     steps, t0, c0 = 0, time.perf_counter(), time.thread_time()
     while time.perf_counter() - t0 < seconds:
         steps += step()

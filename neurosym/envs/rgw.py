@@ -77,7 +77,8 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
     ## Rewards
     Default rules (the thesis text), paid on *entering* a cell: mountain -0.1;
     pit -1; terminal +10; enemy +1 when holding the sword (the enemy is
-    defeated and removed) and -1 otherwise (it stays); sword and teleport 0.
+    defeated and removed) and -1 otherwise (it stays, and the agent stands on
+    its cell); sword and teleport 0.
     Bumping into a wall or the border leaves the agent in place, pays nothing
     and triggers nothing (not even a teleport under the agent). Entering a
     teleport end puts the agent on the other end.
@@ -88,7 +89,8 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
     step; the original's ``state > nS_pos`` test makes an agent at cell (0, 0)
     count as not holding the sword; the ``Q`` teleport end at (3, 9) of rgw2
     also counts as a mountain (-0.1 on landing there); any step that ends on a
-    teleport end, bumps included, teleports.
+    teleport end, bumps included, teleports. The original has no step limit:
+    ``classic=True, max_steps=None`` is the original release exactly.
 
     ## Termination
     Terminated on reaching the terminal (outcome ``terminal``) or falling into

@@ -316,11 +316,18 @@ class LevelRing:
     """
 
     def __init__(
-        self, cfg: RandomLevelConfig, n: int, first_batch: int = 2048, depth: int = 16
+        self,
+        cfg: RandomLevelConfig,
+        n: int,
+        first_batch: int = 2048,
+        max_buffered: int = 16384,
+        depth: int = 16,
     ) -> None:
         self.cfg, self.n, self.depth = cfg, n, depth
-        # Levels kept ahead per env: small at first (a quick first reset), doubling per refill.
-        self.first_window = self.window = int(np.clip(first_batch // n, 1, depth))
+        # Levels kept ahead per env: few at first (a quick first reset), doubling per
+        # refill up to `cap`, so that at most about max_buffered levels wait in all.
+        self.cap = int(np.clip(max_buffered // n, 1, depth))
+        self.first_window = self.window = int(np.clip(first_batch // n, 1, self.cap))
         N = cfg.height * cfg.width
         self.cells = np.zeros((n, depth, N), dtype=np.uint8)
         self.starts = np.zeros((n, depth), dtype=np.intp)
@@ -359,7 +366,7 @@ class LevelRing:
         self.starts[need_env, need_slot] = starts
         self.key_ep[need_env, need_slot] = need_ep
         self.key_seed[need_env, need_slot] = self.seeds[need_env]
-        self.window = min(self.depth, self.window * 2)
+        self.window = min(self.cap, self.window * 2)
 
 
 class RandomLevels:

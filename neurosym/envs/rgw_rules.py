@@ -209,32 +209,45 @@ def compile_moves(
     cell is a teleport end (so bumping while standing on one teleports too).
     """
     S, N = cells.shape
-    target, border = _geometry(height, width)  # (N, 4) each
-    base = (np.arange(S, dtype=np.intp) * N)[:, None, None]  # flat offset of each level
+    target, border = _geometry(height, width)  # (4, N) each
+    base = (np.arange(S, dtype=np.intp) * N)[:, None]  # flat offset of each level
     flat_cells = cells.reshape(-1)
-    wall = (flat_cells[base + target] == WALL) & ~border  # (S, N, 4)
-    stay = wall | border
-    new = np.where(stay, np.arange(N)[None, :, None], target)  # (S, N, 4)
     is_tele = (flat_cells == TELEPORT) | (flat_cells == TELEPORT_MOUNTAIN)
-    tele = is_tele[base + new]
-    if not classic:
-        tele &= ~stay
-    partner = teleport_partners(cells).reshape(-1)
-    dest = np.where(tele, partner[base + new], new)
-    code = (stay * MV_STAY) | (wall * MV_WALL) | (border * MV_BORDER) | (tele * MV_TELEPORT)
-    return dest, code.astype(np.uint8)
+    partner = teleport_partners(cells).reshape(-1) if is_tele.any() else None
+    dest = np.empty((S, N, 4), dtype=np.intp)
+    code = np.empty((S, N, 4), dtype=np.uint8)
+    here = np.arange(N)
+    u8 = np.uint8
+    # One action at a time keeps the temporaries small (S * N), which is faster.
+    for a in range(4):
+        wall = (
+            flat_cells.take(base + target[a]) == WALL
+        )  # (S, N); a border target is the cell itself
+        stay = wall | border[a]
+        new = np.where(stay, here, target[a])  # (S, N)
+        flat = new + base
+        tele = is_tele.take(flat)
+        if not classic:
+            tele &= ~stay
+        if partner is not None:  # partner holds cells within each level
+            new = np.where(tele, partner.take(flat), new)
+        dest[:, :, a] = new
+        code[:, :, a] = (
+            stay.view(u8) | (wall.view(u8) << u8(1)) | (border[a].view(u8) << u8(2))
+        ) | (tele.view(u8) << u8(3))
+    return dest, code
 
 
 _GEOMETRY: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
 
 def _geometry(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
-    """(N, 4) clipped target cell of each action and (N, 4) whether it hits the border."""
+    """(4, N) clipped target cell of each action and (4, N) whether it hits the border."""
     key = (height, width)
     if key not in _GEOMETRY:
         r, c = np.divmod(np.arange(height * width), width)
-        tr = r[:, None] + ACTION_DELTAS[None, :, 0]
-        tc = c[:, None] + ACTION_DELTAS[None, :, 1]
+        tr = r[None, :] + ACTION_DELTAS[:, 0, None]
+        tc = c[None, :] + ACTION_DELTAS[:, 1, None]
         border = (tr < 0) | (tr >= height) | (tc < 0) | (tc >= width)
         target = np.clip(tr, 0, height - 1) * width + np.clip(tc, 0, width - 1)
         _GEOMETRY[key] = (target.astype(np.intp), border)
@@ -347,11 +360,14 @@ class RGWBatch:
         slots = np.asarray(slots, dtype=np.intp)
         cells = np.asarray(cells, dtype=np.uint8).reshape(len(slots), N)
         starts = np.asarray(starts, dtype=np.intp)
+        k, S = len(slots), self.num_slots
         dest, code = compile_moves(cells, self.height, self.width, self.classic)
-        rows = (slots[:, None] * (N * 4) + np.arange(N * 4)[None, :]).reshape(-1)
-        self._dest_pos[rows] = dest.reshape(-1)
-        self._dest_key[rows] = (slots[:, None, None] * (N * 4) + dest * 4).reshape(-1)
-        self._mcode[rows] = code.reshape(-1)
+        dest = dest.reshape(k, N * 4)
+        self._dest_pos.reshape(S, N * 4)[slots] = dest
+        dest *= 4
+        dest += slots[:, None] * (N * 4)
+        self._dest_key.reshape(S, N * 4)[slots] = dest
+        self._mcode.reshape(S, N * 4)[slots] = code.reshape(k, N * 4)
         self.level_cells[slots] = cells
         self.level_start[slots] = starts
         planes = (
