@@ -198,7 +198,7 @@ def seed_keys(seed: int, count: int) -> np.ndarray:
 
 def random_keys(rng: np.random.Generator, count: int) -> np.ndarray:
     """Level keys for unseeded environments, drawn from ``rng``."""
-    return rng.integers(0, np.iinfo(np.uint64).max, size=count, dtype=np.uint64, endpoint=True)
+    return rng.integers(0, _USED, size=count, dtype=np.uint64, endpoint=True)
 
 
 def _pick(valid: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -357,6 +357,9 @@ def generate_levels(config: BoxWorldConfig, keys: np.ndarray, episodes: np.ndarr
     return levels
 
 
+_USED = np.uint64(np.iinfo(np.uint64).max)  # episode tag of a buffered level already handed out
+
+
 class NextLevels:
     """The next level of each of n level streams, drawn ahead and refilled in batches.
 
@@ -375,7 +378,7 @@ class NextLevels:
             np.zeros((n, config.num_slots), bool),
         )
         self._key = np.zeros(n, np.uint64)  # the (key, episode) each buffered level belongs to
-        self._episode = np.full(n, np.iinfo(np.uint64).max, np.uint64)
+        self._episode = np.full(n, _USED, np.uint64)
 
     def take(self, rows: np.ndarray, keys: np.ndarray, episodes: np.ndarray) -> LevelArrays:
         """Levels of streams ``rows`` for their episodes ``episodes[rows]``; then keep the
@@ -385,8 +388,8 @@ class NextLevels:
         miss = np.flatnonzero((self._key[rows] != want_key) | (self._episode[rows] != want_episode))
         if miss.size:
             levels.put(miss, generate_levels(self.config, want_key[miss], want_episode[miss]))
-        self._episode[rows] = np.iinfo(np.uint64).max  # used up
-        stale = np.flatnonzero(self._episode == np.iinfo(np.uint64).max)
+        self._episode[rows] = _USED  # used up
+        stale = np.flatnonzero(self._episode == _USED)
         if stale.size >= self.batch:
             following = episodes[stale] + np.uint64(1)
             self._levels.put(stale, generate_levels(self.config, keys[stale], following))

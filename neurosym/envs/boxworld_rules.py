@@ -84,11 +84,9 @@ class BoxWorldState:
         self._slot_flat = self.slot_of_cell.reshape(-1)
         self._alive_flat = self.object_alive.reshape(-1)
         self._base = rows * CELLS
-        self._base4 = np.tile(self._base, 4)
-        self._obs_base4 = np.tile(rows * 3 * CELLS, 4)
+        self._base3 = np.tile(self._base, 3)
+        self._obs_base3 = np.tile(rows * 3 * CELLS, 3)
         self._alive_base = rows * (slots + 1)
-        self._alive_none = self._alive_base + slots
-        self._zeros = np.zeros(n, np.int64)
         self.agent = np.zeros(n, np.int64)  # flat cell of the agent
         self.held = np.full(n, -1, np.int8)  # colour index of the held key, -1 none
         self.steps = np.zeros(n, np.int32)
@@ -107,21 +105,23 @@ class BoxWorldState:
         m, s = levels.cells.shape
         assert m == len(rows) and s == self.slots, (m, len(rows), s, self.slots)
         real = levels.cells >= 0
-        r = np.repeat(rows, s).reshape(m, s)[real]
-        cells = levels.cells[real].astype(np.int64)
-        grid = np.tile(_BASE_GRID, (m, 1))
-        grid[np.repeat(np.arange(m), s).reshape(m, s)[real], cells] = levels.codes[real]
-        grid[np.arange(m), levels.agent.astype(np.int64)] = AGENT
+        # Padding writes go to cell 0 (border) with values that leave it as it is.
+        cells = np.where(real, levels.cells, 0).astype(np.int64)  # (m, S)
+        grid = np.tile(_BASE_GRID, (m, 1))  # (m, CELLS)
+        grid.reshape(-1)[(np.arange(m) * CELLS)[:, None] + cells] = np.where(
+            real, levels.codes, WALL
+        )
+        grid.reshape(-1)[np.arange(m) * CELLS + levels.agent] = AGENT
         self.grid[rows] = grid
         self.obs[rows] = PALETTE[grid].transpose(0, 2, 1)
+        at = (rows * CELLS)[:, None] + cells
         self.distractor[rows] = False
-        self.distractor[r, cells] = levels.distractor[real]
+        self._distractor_flat[at] = levels.distractor & real
         self.slot_of_cell[rows] = self.slots
-        self.slot_of_cell[r, cells] = np.nonzero(real)[1]
+        self._slot_flat[at] = np.where(real, np.arange(s), self.slots)
         self.object_cell[rows] = levels.cells
         self.object_code[rows] = levels.codes
-        self.object_alive[rows] = False
-        self.object_alive[rows, :s] = real
+        self.object_alive[rows] = np.concatenate([real, np.zeros((m, 1), bool)], axis=1)
         self.agent[rows] = levels.agent
         self.held[rows] = -1
         self.steps[rows] = 0
@@ -171,11 +171,13 @@ class BoxWorldState:
         outcome = np.where(distractor, OUTCOME_DISTRACTOR, outcome)
         self.outcome = np.where(got_gem, OUTCOME_GEM, outcome).astype(np.int8)
 
-        # Objects consumed: the picked key / gem, or the opened lock and its content.
-        slot_of_cell, alive, none = self._slot_flat, self._alive_flat, self._alive_none
-        consumed = loose_key | loose_gem | opens
-        alive[np.where(consumed, self._alive_base + slot_of_cell[at], none)] = False
-        alive[np.where(opens, self._alive_base + slot_of_cell[at - 1], none)] = False
+        # Objects consumed (rare): the picked key / gem, or the opened lock and its content.
+        taken = np.flatnonzero(loose_key | loose_gem | opens)
+        if taken.size:
+            alive, slot_of_cell = self._alive_flat, self._slot_flat
+            alive[self._alive_base[taken] + slot_of_cell[at[taken]]] = False
+            box = taken[opens[taken]]
+            alive[self._alive_base[box] + slot_of_cell[at[box] - 1]] = False
 
         # Redraw the cells that changed. Cell 0 (the held key) is written last, so it
         # also absorbs the writes of environments that emptied no box content.
@@ -184,14 +186,16 @@ class BoxWorldState:
         grid[base + emptied] = EMPTY
         grid[base + old] = EMPTY
         grid[base + new] = AGENT
-        grid[base] = np.where(self.held >= 0, HELD + self.held.astype(np.int16), WALL)
-        changed = np.concatenate([old, emptied, new, self._zeros])  # (4n,) cells to repaint
-        codes = grid[self._base4 + changed]
-        paint = self._obs_base4 + changed
+        held_code = np.where(self.held >= 0, HELD + self.held.astype(np.int16), WALL)
+        self.grid[:, 0] = held_code  # strided write
+        changed = np.concatenate([old, emptied, new])  # (3n,) cells to repaint
+        codes = grid[self._base3 + changed]
+        paint = self._obs_base3 + changed
         obs = self._obs_flat
         obs[paint] = _RED[codes]
         obs[paint + CELLS] = _GREEN[codes]
         obs[paint + 2 * CELLS] = _BLUE[codes]
+        self.obs[:, :, 0] = PALETTE[held_code]  # the held key's cell, a strided write
         self.agent = new
         return reward, terminated, truncated
 
