@@ -74,10 +74,9 @@ class BoxWorldState:
         self.slot_of_cell = np.full((n, CELLS), slots, np.int64)
         self.object_cell = np.full((n, slots), -1, np.int16)  # -1 pads
         self.object_code = np.zeros((n, slots), np.uint8)
-        # the last column absorbs the writes of environments that consumed nothing
-        self.object_alive = np.zeros((n, slots + 1), bool)
+        self.object_alive = np.zeros((n, slots), bool)  # still on the map
         # Flat views and row offsets for step(): env i, cell c is grid_flat[i * CELLS + c],
-        # obs_flat[i * 3 * CELLS + channel * CELLS + c], alive_flat[i * (slots + 1) + slot].
+        # obs_flat[i * 3 * CELLS + channel * CELLS + c], alive_flat[i * slots + slot].
         self._grid_flat = self.grid.reshape(-1)
         self._obs_flat = self.obs.reshape(-1)
         self._distractor_flat = self.distractor.reshape(-1)
@@ -86,7 +85,7 @@ class BoxWorldState:
         self._base = rows * CELLS
         self._base3 = np.tile(self._base, 3)
         self._obs_base3 = np.tile(rows * 3 * CELLS, 3)
-        self._alive_base = rows * (slots + 1)
+        self._alive_base = rows * slots
         self.agent = np.zeros(n, np.int64)  # flat cell of the agent
         self.held = np.full(n, -1, np.int8)  # colour index of the held key, -1 none
         self.steps = np.zeros(n, np.int32)
@@ -121,7 +120,7 @@ class BoxWorldState:
         self._slot_flat[at] = np.where(real, np.arange(s), self.slots)
         self.object_cell[rows] = levels.cells
         self.object_code[rows] = levels.codes
-        self.object_alive[rows] = np.concatenate([real, np.zeros((m, 1), bool)], axis=1)
+        self.object_alive[rows] = real
         self.agent[rows] = levels.agent
         self.held[rows] = -1
         self.steps[rows] = 0
@@ -217,7 +216,7 @@ class BoxWorldState:
             "held": self.held.copy(),
             "object_code": self.object_code.copy(),
             "object_cell": self.object_cell.copy(),
-            "object_alive": self.object_alive[:, : self.slots].copy(),
+            "object_alive": self.object_alive.copy(),
             "event_key": self.event_key.copy(),
             "event_lock": self.event_lock.copy(),
             "event_got": self.event_got.copy(),
