@@ -220,9 +220,8 @@ def compile_moves(
     u8 = np.uint8
     # One action at a time keeps the temporaries small (S * N), which is faster.
     for a in range(4):
-        wall = (
-            flat_cells.take(base + target[a]) == WALL
-        )  # (S, N); a border target is the cell itself
+        # (S, N); a border target is the cell itself, never a wall
+        wall = flat_cells.take(base + target[a]) == WALL
         stay = wall | border[a]
         new = np.where(stay, here, target[a])  # (S, N)
         flat = new + base
