@@ -39,7 +39,13 @@ def recording() -> Recording:
     rel = pd.DataFrame(RELATIONS, columns=["episode", "t", "head", "j", "a", "b", "value"])
     return Recording(
         episodes=pd.DataFrame(
-            {"episode": [0, 1], "steps": [3, 1], "return": [10.5, -1.0], "outcome": ["terminal", "pit"], "seed": [0, 1]}
+            {
+                "episode": [0, 1],
+                "steps": [3, 1],
+                "return": [10.5, -1.0],
+                "outcome": ["terminal", "pit"],
+                "seed": [0, 1],
+            }
         ),
         steps=pd.DataFrame(
             {
@@ -60,9 +66,18 @@ def recording() -> Recording:
             }
         ),
         holding=pd.DataFrame({"episode": [0], "t": [2], "item": ["sword"]}),
-        events=pd.DataFrame({"episode": [0, 1], "t": [1, 0], "event": ["picked(sword)", "fell(pit)"]}),
+        events=pd.DataFrame(
+            {"episode": [0, 1], "t": [1, 0], "event": ["picked(sword)", "fell(pit)"]}
+        ),
         relations=rel,
-        meta={"checkpoint": "ckpt.pt", "env": "rgw2", "module": "predinet", "heads": 2, "relations": 2, "seed": 0},
+        meta={
+            "checkpoint": "ckpt.pt",
+            "env": "rgw2",
+            "module": "predinet",
+            "heads": 2,
+            "relations": 2,
+            "seed": 0,
+        },
     )
 
 
@@ -137,7 +152,11 @@ def test_strongest_relations_between_types() -> None:
     facts = extract_facts(recording(), threshold="abs:0.3")
     top = facts.strongest_relations(3)
     # (0, sword, enemy) held at (0, 0) (strongest head 1.0) and (0, 1) (0.5)
-    assert rows(top) == [(0, "sword", "enemy", 2, 0.75), (1, "sword", "enemy", 2, 0.4375), (0, "sword", "agent", 1, 0.5)]
+    assert rows(top) == [
+        (0, "sword", "enemy", 2, 0.75),
+        (1, "sword", "enemy", 2, 0.4375),
+        (0, "sword", "agent", 1, 0.5),
+    ]
 
 
 def test_object_with_two_types_is_refused() -> None:

@@ -51,7 +51,9 @@ def first_t(events: pd.DataFrame, which: tuple[str, ...]) -> pd.Series:
 def test_kb_loads_in_plain_swipl_without_messages(rgw: tuple, swipl: Path) -> None:
     _, path, _ = rgw
     for files in ([path], [path, RULES / "rgw.pl", RULES / "relations.pl", RULES / "boxworld.pl"]):
-        proc = subprocess.run([swipl, "-q", "-g", "halt", *files], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(
+            [swipl, "-q", "-g", "halt", *files], capture_output=True, text=True, timeout=60
+        )
         assert proc.returncode == 0
         assert proc.stderr == "" and proc.stdout == ""
 
@@ -75,7 +77,9 @@ def test_sword_before_enemy_matches_pandas(rgw: tuple) -> None:
     assert values(kb, "sword_before_enemy(E)", "E") == expected
     teleport = first_t(ev, ("teleported",))
     both = teleport.index.intersection(enemy.index)
-    assert values(kb, "teleport_before_enemy(E)", "E") == sorted(int(e) for e in both if teleport[e] < enemy[e])
+    assert values(kb, "teleport_before_enemy(E)", "E") == sorted(
+        int(e) for e in both if teleport[e] < enemy[e]
+    )
 
 
 def test_enemy_beaten_with_sword_matches_pandas(rgw: tuple) -> None:
@@ -91,8 +95,12 @@ def test_visit_order_matches_pandas(rgw: tuple) -> None:
     facts, _, kb = rgw
     visit = {"picked(sword)": "sword", "teleported": "teleport", "defeated(enemy)": "enemy",
              "hurt_by(enemy)": "enemy", "reached(terminal)": "terminal", "fell(pit)": "pit"}  # fmt: skip
-    ev = facts["event"][facts["event"]["event"].isin(visit)].sort_values(["episode", "t"], kind="stable")
-    expected = {int(e): list(dict.fromkeys(g["event"].map(visit))) for e, g in ev.groupby("episode")}
+    ev = facts["event"][facts["event"]["event"].isin(visit)].sort_values(
+        ["episode", "t"], kind="stable"
+    )
+    expected = {
+        int(e): list(dict.fromkeys(g["event"].map(visit))) for e, g in ev.groupby("episode")
+    }
     got = {row["E"]: row["O"] for row in kb.query("visit_order(E, O)")}
     assert got == {e: expected.get(e, []) for e in facts["episode"]["episode"]}
     assert got[0] == ["sword", "teleport", "enemy", "terminal"]
@@ -112,7 +120,9 @@ def test_representational_rules_match_pandas(rgw: tuple) -> None:
     assert sorted(r.args[0] for r in values(kb, "sword_enemy_direct(L)", "L")) == direct
     linked = {(a, b) for _, a, b in pairs} | {(b, a) for _, a, b in pairs}
     types = {"agent"} | set(facts["object"]["type"])
-    via = {x for x in types - {"sword", "enemy"} if ("sword", x) in linked and (x, "enemy") in linked}
+    via = {
+        x for x in types - {"sword", "enemy"} if ("sword", x) in linked and (x, "enemy") in linked
+    }
     assert set(values(kb, "sword_enemy_via(X)", "X")) == via
     link = kb.once("sword_enemy_link(A)")["A"]
     if direct:
@@ -133,7 +143,10 @@ def test_relation_statistics_match_pandas(rgw: tuple) -> None:
     for j, row in stats.iterrows():
         assert got[j]["N"] == row["size"]
         assert got[j]["Mean"] == pytest.approx(row["mean"], rel=1e-9, abs=1e-15)
-        assert (got[j]["Min"], got[j]["Max"]) == (row["min"], row["max"])  # written in full precision
+        assert (got[j]["Min"], got[j]["Max"]) == (
+            row["min"],
+            row["max"],
+        )  # written in full precision
     first = rel[rel["j"] == 0]
     counts = first.groupby(["head", "a", "b"]).size().reset_index(name="n")
     for head, group in counts.groupby("head"):
@@ -146,7 +159,9 @@ def test_boxworld_rules_match_pandas(boxworld: tuple) -> None:
     facts, kb = boxworld
     at0 = facts["at"][facts["at"]["t"] == 0].merge(facts["object"], on="id")
     locks = at0[at0["type"].str.startswith("lock(")]
-    left = at0.assign(col=at0["col"] + 1)[["episode", "row", "col", "type"]].rename(columns={"type": "content"})
+    left = at0.assign(col=at0["col"] + 1)[["episode", "row", "col", "type"]].rename(
+        columns={"type": "content"}
+    )
     boxes = locks.merge(left, on=["episode", "row", "col"])
     expected = sorted(zip(boxes["episode"], boxes["type"], boxes["content"], strict=True))
     got = sorted((r["E"], str(r["L"]), str(r["X"])) for r in kb.query("box(E, L, X)"))
@@ -154,18 +169,28 @@ def test_boxworld_rules_match_pandas(boxworld: tuple) -> None:
 
     ev = facts["event"]
     got_items = ev[ev["event"].str.startswith("got(")].sort_values(["episode", "t"], kind="stable")
-    expected_order = {int(e): [s[4:-1] for s in g["event"]] for e, g in got_items.groupby("episode")}
+    expected_order = {
+        int(e): [s[4:-1] for s in g["event"]] for e, g in got_items.groupby("episode")
+    }
     orders = {r["E"]: [str(x) for x in r["Items"]] for r in kb.query("got_order(E, Items)")}
     assert orders == {int(e): expected_order.get(int(e), []) for e in facts["episode"]["episode"]}
 
     episodes = facts["episode"]
-    assert values(kb, "distractor_taken(E)", "E") == sorted(episodes[episodes["outcome"] == "distractor"]["episode"])
-    assert values(kb, "gem_chain(E, _)", "E") == sorted(episodes[episodes["outcome"] == "gem"]["episode"])
+    assert values(kb, "distractor_taken(E)", "E") == sorted(
+        episodes[episodes["outcome"] == "distractor"]["episode"]
+    )
+    assert values(kb, "gem_chain(E, _)", "E") == sorted(
+        episodes[episodes["outcome"] == "gem"]["episode"]
+    )
 
     opened = ev[ev["event"].str.startswith("opened(")].merge(facts["holding"], on=["episode", "t"])
-    expected_pairs = {(item, event[7:-1]) for item, event in zip(opened["item"], opened["event"], strict=True)}
+    expected_pairs = {
+        (item, event[7:-1]) for item, event in zip(opened["item"], opened["event"], strict=True)
+    }
     assert {(str(r["K"]), str(r["L"])) for r in kb.query("key_opens(K, L)")} == expected_pairs
-    assert all(k[4:-1] == lk[5:-1] for k, lk in expected_pairs)  # a key opens the lock of its colour
+    assert all(
+        k[4:-1] == lk[5:-1] for k, lk in expected_pairs
+    )  # a key opens the lock of its colour
 
 
 def test_boxworld_solution_chain_is_consistent_with_the_gem_episodes(boxworld: tuple) -> None:

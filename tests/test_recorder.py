@@ -38,13 +38,21 @@ def small_agent(env: str, module: str = "predinet") -> Agent:
         hidden_sizes=(16,),
     )
     return Agent(
-        model=ActorCritic(cfg).eval(), config=cfg, env_name=env, env_kwargs={"max_steps": MAX_STEPS}, path="random.pt"
+        model=ActorCritic(cfg).eval(),
+        config=cfg,
+        env_name=env,
+        env_kwargs={"max_steps": MAX_STEPS},
+        path="random.pt",
     )
 
 
 @cache
-def recorded(env: str, module: str = "predinet", greedy: bool = False, batch: int = 4, episodes: int = 6) -> Recording:
-    return record(small_agent(env, module), env, episodes=episodes, seed=11, greedy=greedy, batch=batch)
+def recorded(
+    env: str, module: str = "predinet", greedy: bool = False, batch: int = 4, episodes: int = 6
+) -> Recording:
+    return record(
+        small_agent(env, module), env, episodes=episodes, seed=11, greedy=greedy, batch=batch
+    )
 
 
 def state_positions(info: dict) -> list[tuple[str, str, int, int]]:
@@ -69,7 +77,9 @@ def test_trace_replays_in_a_fresh_single_env(env: str) -> None:
         e = int(ep.episode)
         single = make(env, max_steps=MAX_STEPS)
         obs, info = single.reset(seed=int(ep.seed))
-        assert table_rows(rec.positions, e, 0, ["object", "type", "row", "col"]) == state_positions(info), f"[{e}/0]"
+        assert table_rows(rec.positions, e, 0, ["object", "type", "row", "col"]) == state_positions(
+            info
+        ), f"[{e}/0]"
         steps = rec.steps[rec.steps["episode"] == e].sort_values("t")
         assert steps["t"].tolist() == list(range(int(ep.steps)))
         total = 0.0
@@ -77,11 +87,15 @@ def test_trace_replays_in_a_fresh_single_env(env: str) -> None:
             obs, r, terminated, truncated, info = single.step(action_index[action])
             total += r
             assert r == reward, f"[{e}/{t}] reward"
-            assert [ev for (ev,) in table_rows(rec.events, e, t, ["event"])] == list(info["events"]), f"[{e}/{t}]"
-            assert table_rows(rec.positions, e, t + 1, ["object", "type", "row", "col"]) == state_positions(info), (
-                f"[{e}/{t + 1}] positions"
-            )
-            assert [i for (i,) in table_rows(rec.holding, e, t + 1, ["item"])] == list(info["holding"]), f"[{e}/{t + 1}]"
+            assert [ev for (ev,) in table_rows(rec.events, e, t, ["event"])] == list(
+                info["events"]
+            ), f"[{e}/{t}]"
+            assert table_rows(
+                rec.positions, e, t + 1, ["object", "type", "row", "col"]
+            ) == state_positions(info), f"[{e}/{t + 1}] positions"
+            assert [i for (i,) in table_rows(rec.holding, e, t + 1, ["item"])] == list(
+                info["holding"]
+            ), f"[{e}/{t + 1}]"
             assert (terminated or truncated) == (t == ep.steps - 1), f"[{e}/{t}] episode end"
         assert info["outcome"] == ep.outcome
         assert total == pytest.approx(ep._2)  # the return column
@@ -105,15 +119,36 @@ def test_model_outputs_match_the_model_on_replayed_states() -> None:
         for h in range(agent.config.heads):
             for arg, att in ((1, intro.attention1), (2, intro.attention2)):
                 k = int(np.argmax(att[0, h]))
-                row = rec.attends[(rec.attends.episode == e) & (rec.attends.t == t) & (rec.attends["head"] == h) & (rec.attends.arg == arg)]
+                row = rec.attends[
+                    (rec.attends.episode == e)
+                    & (rec.attends.t == t)
+                    & (rec.attends["head"] == h)
+                    & (rec.attends.arg == arg)
+                ]
                 assert len(row) == 1
                 got = row.iloc[0]
-                assert (got.entity, got.row, got.col) == (names[grid[k]], k // W, k % W), f"[{t}] head {h} arg {arg}"
+                assert (got.entity, got.row, got.col) == (names[grid[k]], k // W, k % W), (
+                    f"[{t}] head {h} arg {arg}"
+                )
                 assert got.weight == pytest.approx(float(att[0, h, k]), rel=1e-5)
-            rel = rec.relations[(rec.relations.episode == e) & (rec.relations.t == t) & (rec.relations["head"] == h)]
-            np.testing.assert_allclose(rel.sort_values("j")["value"].to_numpy(), intro.relations[0, h], rtol=1e-5, atol=1e-7)
-            rv = rec.r_vectors[(rec.r_vectors.episode == e) & (rec.r_vectors.t == t) & (rec.r_vectors["head"] == h)]
-            np.testing.assert_allclose(rv.sort_values("j")["value"].to_numpy(), intro.r_vectors()[0, h], rtol=1e-5, atol=1e-7)
+            rel = rec.relations[
+                (rec.relations.episode == e) & (rec.relations.t == t) & (rec.relations["head"] == h)
+            ]
+            np.testing.assert_allclose(
+                rel.sort_values("j")["value"].to_numpy(),
+                intro.relations[0, h],
+                rtol=1e-5,
+                atol=1e-7,
+            )
+            rv = rec.r_vectors[
+                (rec.r_vectors.episode == e) & (rec.r_vectors.t == t) & (rec.r_vectors["head"] == h)
+            ]
+            np.testing.assert_allclose(
+                rv.sort_values("j")["value"].to_numpy(),
+                intro.r_vectors()[0, h],
+                rtol=1e-5,
+                atol=1e-7,
+            )
         obs, *_ = single.step(action_index[action])
 
 
@@ -127,7 +162,12 @@ def test_table_shapes_follow_the_time_convention() -> None:
     assert len(rec.r_vectors) == acted * H * (J + 4)
     last_t = rec.positions.groupby("episode")["t"].max()
     assert (last_t == rec.episodes.set_index("episode")["steps"]).all()  # states 0..S
-    assert rec.attends.groupby("episode")["t"].max().add(1).equals(rec.episodes.set_index("episode")["steps"])
+    assert (
+        rec.attends.groupby("episode")["t"]
+        .max()
+        .add(1)
+        .equals(rec.episodes.set_index("episode")["steps"])
+    )
     # the first J components of R^h are D^h
     rv = rec.r_vectors[rec.r_vectors.j < J].reset_index(drop=True)
     assert np.array_equal(rv["value"].to_numpy(), rec.relations["value"].to_numpy())

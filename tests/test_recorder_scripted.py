@@ -31,18 +31,38 @@ PLANS: dict[str, list[int]] = {
     # sword, teleport, pit
     "pit": SWORD_THEN_TELEPORT + [U],
     # teleport, hurt, back through the teleport for the sword, teleport, enemy beaten, terminal
-    "back_for_sword": TO_TELEPORT_WITHOUT_SWORD + [D] + [L] * 7 + [R] * 7 + [U] + [L] * 3 + [U] * 3
-    + [D] * 3 + [R] * 3 + [D] + [L] * 8,
+    "back_for_sword": TO_TELEPORT_WITHOUT_SWORD
+    + [D]
+    + [L] * 7
+    + [R] * 7
+    + [U]
+    + [L] * 3
+    + [U] * 3
+    + [D] * 3
+    + [R] * 3
+    + [D]
+    + [L] * 8,
     # bumps into the top border until the time limit
     "timeout": [],
 }
 EXPECTED = {  # plan -> (outcome, key events in order)
-    "optimal": ("terminal", ["picked(sword)", "teleported", "defeated(enemy)", "reached(terminal)"]),
+    "optimal": (
+        "terminal",
+        ["picked(sword)", "teleported", "defeated(enemy)", "reached(terminal)"],
+    ),
     "no_sword": ("terminal", ["teleported", "hurt_by(enemy)", "reached(terminal)"]),
     "pit": ("pit", ["picked(sword)", "teleported", "fell(pit)"]),
     "back_for_sword": (
         "terminal",
-        ["teleported", "hurt_by(enemy)", "teleported", "picked(sword)", "teleported", "defeated(enemy)", "reached(terminal)"],
+        [
+            "teleported",
+            "hurt_by(enemy)",
+            "teleported",
+            "picked(sword)",
+            "teleported",
+            "defeated(enemy)",
+            "reached(terminal)",
+        ],
     ),
     "timeout": ("timeout", []),
 }
@@ -65,11 +85,15 @@ class ScriptedAgent:
     env_kwargs = {"max_steps": MAX_STEPS}  # noqa: RUF012
     path = "scripted.pt"
 
-    def act(self, obs: np.ndarray, greedy: bool = True, introspect: bool = False, generator: Any = None) -> Any:
+    def act(
+        self, obs: np.ndarray, greedy: bool = True, introspect: bool = False, generator: Any = None
+    ) -> Any:
         _, intro = self.inner.act(obs, greedy=True, introspect=introspect)
         k = self.step
         self.step += 1
-        actions = np.array([p[k] if k < len(p) else U for p in self.plans[: len(obs)]], dtype=np.int64)
+        actions = np.array(
+            [p[k] if k < len(p) else U for p in self.plans[: len(obs)]], dtype=np.int64
+        )
         return actions, intro
 
 
@@ -82,7 +106,14 @@ def scripted_recording(module: str = "predinet") -> Recording:
     return record(agent, "rgw2", episodes=len(PLANS), seed=0, batch=len(PLANS))
 
 
-KEY_EVENTS = ("picked(sword)", "teleported", "defeated(enemy)", "hurt_by(enemy)", "reached(terminal)", "fell(pit)")
+KEY_EVENTS = (
+    "picked(sword)",
+    "teleported",
+    "defeated(enemy)",
+    "hurt_by(enemy)",
+    "reached(terminal)",
+    "fell(pit)",
+)
 
 
 def test_plans_give_the_expected_events_and_outcomes() -> None:
@@ -90,7 +121,9 @@ def test_plans_give_the_expected_events_and_outcomes() -> None:
     for e, (name, (outcome, events)) in enumerate(EXPECTED.items()):
         row = rec.episodes[rec.episodes.episode == e].iloc[0]
         assert row.outcome == outcome, name
-        got = rec.events[(rec.events.episode == e) & rec.events.event.isin(KEY_EVENTS)]["event"].tolist()
+        got = rec.events[(rec.events.episode == e) & rec.events.event.isin(KEY_EVENTS)][
+            "event"
+        ].tolist()
         assert got == events, name
     timeout = rec.episodes.iloc[-1]
     assert timeout.steps == MAX_STEPS
@@ -143,7 +176,9 @@ class ExplorerAgent:
     def config(self) -> Any:
         return self.inner.config
 
-    def act(self, obs: np.ndarray, greedy: bool = True, introspect: bool = False, generator: Any = None) -> Any:
+    def act(
+        self, obs: np.ndarray, greedy: bool = True, introspect: bool = False, generator: Any = None
+    ) -> Any:
         from neurosym.envs.boxworld_entities import AGENT, HELD
         from neurosym.envs.boxworld_solver import nearest_interaction
 
@@ -161,8 +196,9 @@ class ExplorerAgent:
 @cache
 def explorer_recording(env: str = "bw2", episodes: int = 8) -> Recording:
     """Episodes of the explorer on ``env`` from seed 0, all in one wave."""
-    import neurosym.envs as envs
     from test_recorder import small_agent
+
+    import neurosym.envs as envs
 
     agent = ExplorerAgent(small_agent(env), env)
     real = envs.make_batched

@@ -16,10 +16,21 @@ def small_recording() -> Recording:
     """Two episodes by hand, with a compound entity name and a float that needs full precision."""
     return Recording(
         episodes=pd.DataFrame(
-            {"episode": [0, 1], "steps": [2, 1], "return": [0.9, -1.0], "outcome": ["terminal", "pit"], "seed": [7, 8]}
+            {
+                "episode": [0, 1],
+                "steps": [2, 1],
+                "return": [0.9, -1.0],
+                "outcome": ["terminal", "pit"],
+                "seed": [7, 8],
+            }
         ),
         steps=pd.DataFrame(
-            {"episode": [0, 0, 1], "t": [0, 1, 0], "action": ["right", "down", "left"], "reward": [-0.1, 1.0, -1.0]}
+            {
+                "episode": [0, 0, 1],
+                "t": [0, 1, 0],
+                "action": ["right", "down", "left"],
+                "reward": [-0.1, 1.0, -1.0],
+            }
         ),
         positions=pd.DataFrame(
             {
@@ -32,9 +43,19 @@ def small_recording() -> Recording:
             }
         ),
         holding=pd.DataFrame({"episode": [0], "t": [2], "item": ["key(red)"]}),
-        events=pd.DataFrame({"episode": [0, 1], "t": [1, 0], "event": ["got(key(red))", "fell(pit)"]}),
+        events=pd.DataFrame(
+            {"episode": [0, 1], "t": [1, 0], "event": ["got(key(red))", "fell(pit)"]}
+        ),
         relations=pd.DataFrame(
-            {"episode": [0], "t": [0], "head": [1], "j": [3], "a": ["sword"], "b": ["lock(blue)"], "value": [0.1 + 0.2]}
+            {
+                "episode": [0],
+                "t": [0],
+                "head": [1],
+                "j": [3],
+                "a": ["sword"],
+                "b": ["lock(blue)"],
+                "value": [0.1 + 0.2],
+            }
         ),
         meta={"env": "rgw2", "module": "predinet", "heads": 4, "relations": 8, "seed": 7},
     )
@@ -50,7 +71,15 @@ def test_missing_tables_are_empty_with_schema_columns() -> None:
 
 
 def test_tables_are_brought_to_schema_order_and_dtypes() -> None:
-    steps = pd.DataFrame({"reward": [1], "action": ["up"], "t": [np.int32(0)], "episode": [np.int16(3)], "extra": [1]})
+    steps = pd.DataFrame(
+        {
+            "reward": [1],
+            "action": ["up"],
+            "t": [np.int32(0)],
+            "episode": [np.int16(3)],
+            "extra": [1],
+        }
+    )
     rec = Recording(steps=steps)
     assert list(rec.steps.columns) == ["episode", "t", "action", "reward"]
     assert rec.steps["reward"].dtype == np.float64
@@ -58,7 +87,10 @@ def test_tables_are_brought_to_schema_order_and_dtypes() -> None:
 
 
 def test_missing_column_is_a_one_line_error() -> None:
-    with pytest.raises(ConfigError, match=r"recording table 'events' lacks column\(s\) event; expected episode, t, event"):
+    with pytest.raises(
+        ConfigError,
+        match=r"recording table 'events' lacks column\(s\) event; expected episode, t, event",
+    ):
         Recording(events=pd.DataFrame({"episode": [0], "t": [0]}))
 
 

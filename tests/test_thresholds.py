@@ -86,7 +86,9 @@ def test_zero_values_never_kept() -> None:
 
 
 def test_empty_relations() -> None:
-    empty = pd.DataFrame({"j": pd.Series([], dtype="int64"), "value": pd.Series([], dtype="float64")})
+    empty = pd.DataFrame(
+        {"j": pd.Series([], dtype="int64"), "value": pd.Series([], dtype="float64")}
+    )
     thr = parse_threshold("quantile:0.9")
     assert thr.per_relation(empty).empty
     assert thr.keep(empty).shape == (0,)

@@ -34,13 +34,32 @@ def configure(parser: argparse.ArgumentParser) -> None:
     """Add the extract options."""
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
     parser.add_argument(
-        "--env", required=True, metavar="NAME", help="environment the checkpoint was trained on, e.g. rgw2"
+        "--env",
+        required=True,
+        metavar="NAME",
+        help="environment the checkpoint was trained on, e.g. rgw2",
     )
-    parser.add_argument("--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)")
-    parser.add_argument("--seed", type=int, default=0, metavar="S", help="episode k is played from seed S + k (default: 0)")
+    parser.add_argument(
+        "--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)"
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        metavar="S",
+        help="episode k is played from seed S + k (default: 0)",
+    )
     mode = parser.add_mutually_exclusive_group()
-    mode.add_argument("--greedy", dest="greedy", action="store_true", default=True, help="most likely action (default)")
-    mode.add_argument("--sample", dest="greedy", action="store_false", help="sample actions from the policy")
+    mode.add_argument(
+        "--greedy",
+        dest="greedy",
+        action="store_true",
+        default=True,
+        help="most likely action (default)",
+    )
+    mode.add_argument(
+        "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
+    )
     parser.add_argument(
         "--threshold",
         default="quantile:0.9",
@@ -49,10 +68,21 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--out", metavar="DIR", help="output folder (default: kb_out/<env>)")
     parser.add_argument(
-        "--format", default="pl", metavar="LIST", help="comma-separated outputs: pl, parquet (default: pl)"
+        "--format",
+        default="pl",
+        metavar="LIST",
+        help="comma-separated outputs: pl, parquet (default: pl)",
     )
-    parser.add_argument("--qlf", action="store_true", help="also compile the KB to kb.qlf (fast loading)")
-    parser.add_argument("--batch", type=int, default=None, metavar="B", help="environments stepped together (default: 64)")
+    parser.add_argument(
+        "--qlf", action="store_true", help="also compile the KB to kb.qlf (fast loading)"
+    )
+    parser.add_argument(
+        "--batch",
+        type=int,
+        default=None,
+        metavar="B",
+        help="environments stepped together (default: 64)",
+    )
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -61,13 +91,14 @@ def parse_formats(text: str) -> tuple[str, ...]:
     parts = tuple(dict.fromkeys(p.strip().lower() for p in text.split(",") if p.strip()))
     bad = [p for p in parts if p not in FORMATS]
     if bad or not parts:
-        raise ConfigError(f"bad --format {text!r}: expected a comma-separated list of {', '.join(FORMATS)}")
+        raise ConfigError(
+            f"bad --format {text!r}: expected a comma-separated list of {', '.join(FORMATS)}"
+        )
     return parts
 
 
 def run(args: argparse.Namespace) -> int:
     """Validate, record, extract, write, then print the summary and the rule answers."""
-    from neurosym.envs import canonical_name
     from neurosym.export.thresholds import parse_threshold
 
     formats = parse_formats(args.format)
@@ -76,6 +107,11 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--episodes must be at least 1, got {args.episodes}")
     if args.seed < 0:
         raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
+    if args.batch is not None and args.batch < 1:
+        raise ConfigError(f"--batch must be at least 1, got {args.batch}")
+
+    from neurosym.envs import canonical_name
+
     env = canonical_name(args.env)
     out = Path(args.out) if args.out else Path("kb_out") / env
     if out.exists() and not out.is_dir():
@@ -87,7 +123,15 @@ def run(args: argparse.Namespace) -> int:
 
     agent = load_agent(args.checkpoint, env=env)
     show = not args.quiet
-    rec = record(agent, env, episodes=args.episodes, seed=args.seed, greedy=args.greedy, batch=args.batch, progress=show and _tty())
+    rec = record(
+        agent,
+        env,
+        episodes=args.episodes,
+        seed=args.seed,
+        greedy=args.greedy,
+        batch=args.batch,
+        progress=show and _tty(),
+    )
     facts = extract_facts(rec, threshold=threshold)
     written = write_outputs(out, rec, facts, formats, qlf=args.qlf)
     if show:
@@ -103,7 +147,9 @@ def _tty() -> bool:
     return sys.stderr.isatty()
 
 
-def write_outputs(out: Path, rec: Any, facts: Any, formats: tuple[str, ...], qlf: bool = False) -> dict[str, Path]:
+def write_outputs(
+    out: Path, rec: Any, facts: Any, formats: tuple[str, ...], qlf: bool = False
+) -> dict[str, Path]:
     """Write into a staging folder inside ``out``, then move each product into place by rename.
 
     Only neurosym's own names (kb.pl, kb.qlf, facts/, recording/) are replaced in

@@ -119,7 +119,9 @@ class FactSet:
         oriented = orient(rel)
         keep = self.threshold.keep(oriented, self.thresholds())
         kept = oriented.loc[keep & (oriented["a"] != oriented["b"]).to_numpy()]
-        per_step = kept.groupby(["episode", "t", "j", "a", "b"], sort=False)["value"].max().reset_index()
+        per_step = (
+            kept.groupby(["episode", "t", "j", "a", "b"], sort=False)["value"].max().reset_index()
+        )
         table = (
             per_step.groupby(["j", "a", "b"])["value"]
             .agg(held="size", mean_value="mean")
@@ -131,14 +133,19 @@ class FactSet:
     def thresholds(self) -> pd.Series:
         """Threshold per relation j, as written in ``threshold/2``."""
         thr = self.tables["threshold"]
-        return pd.Series(thr["value"].to_numpy(dtype="float64"), index=pd.Index(thr["j"].astype("int64"), name="j"))
+        return pd.Series(
+            thr["value"].to_numpy(dtype="float64"),
+            index=pd.Index(thr["j"].astype("int64"), name="j"),
+        )
 
     def summary(self) -> str:
         """A few lines for people: episodes and returns, facts per predicate, thresholds."""
         ep = self.tables["episode"]
         lines = []
         if len(ep):
-            outcomes = ", ".join(f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items())
+            outcomes = ", ".join(
+                f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
+            )
             lines.append(
                 f"{len(ep)} episodes, {int(ep['steps'].sum())} steps; return mean "
                 f"{ep['return'].mean():.3f} (min {ep['return'].min():.3f}, max {ep['return'].max():.3f}); "
@@ -147,12 +154,15 @@ class FactSet:
         else:
             lines.append("0 episodes")
         lines.append(
-            "facts: " + ", ".join(f"{k} {v}" for k, v in self.counts().items() if v) + f" ({self.n_facts} in all)"
+            "facts: "
+            + ", ".join(f"{k} {v}" for k, v in self.counts().items() if v)
+            + f" ({self.n_facts} in all)"
         )
         thr = self.thresholds()
         if len(thr):
             lines.append(
-                f"thresholds ({self.threshold}): " + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
+                f"thresholds ({self.threshold}): "
+                + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
             )
         return "\n".join(lines)
 
@@ -195,10 +205,17 @@ class FactSet:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         for name, df in self.tables.items():
-            if name == "kb_meta":  # mixed values (atoms, numbers): Parquet needs one type per column
+            if (
+                name == "kb_meta"
+            ):  # mixed values (atoms, numbers): Parquet needs one type per column
                 df = df.assign(value=df["value"].map(str))
-            _atomic_write_bytes(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
-        text = json.dumps({"meta": self.meta, "threshold": str(self.threshold)}, indent=2, default=str) + "\n"
+            _atomic_write_bytes(
+                out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False)
+            )
+        text = (
+            json.dumps({"meta": self.meta, "threshold": str(self.threshold)}, indent=2, default=str)
+            + "\n"
+        )
         _atomic_write_bytes(out / "meta.json", lambda p: Path(p).write_text(text))
         return out
 
@@ -255,7 +272,9 @@ def holds_table(relations: pd.DataFrame, threshold: Threshold, per_j: pd.Series)
     return _frame("holds", kept)
 
 
-def extract_facts(recording: Recording, threshold: str | float | Threshold = DEFAULT_THRESHOLD) -> FactSet:
+def extract_facts(
+    recording: Recording, threshold: str | float | Threshold = DEFAULT_THRESHOLD
+) -> FactSet:
     """Turn a recording into fact tables; ``threshold`` is a spec such as ``quantile:0.9``.
 
     The thresholds are computed per relation from this recording's own values and
@@ -271,16 +290,29 @@ def extract_facts(recording: Recording, threshold: str | float | Threshold = DEF
         "object": _objects(rec.positions),
         "episode": _frame(
             "episode",
-            {"episode": ep["episode"], "steps": ep["steps"], "return": ep["return"], "outcome": ep["outcome"]},
+            {
+                "episode": ep["episode"],
+                "steps": ep["steps"],
+                "return": ep["return"],
+                "outcome": ep["outcome"],
+            },
         ),
         "step": _frame("step", rec.steps),
-        "at": _frame("at", {**{c: rec.positions[c] for c in ("episode", "t", "row", "col")}, "id": rec.positions["object"]}),
+        "at": _frame(
+            "at",
+            {
+                **{c: rec.positions[c] for c in ("episode", "t", "row", "col")},
+                "id": rec.positions["object"],
+            },
+        ),
         "holding": _frame("holding", rec.holding),
         "event": _frame("event", rec.events),
         "attends": _frame("attends", rec.attends),
         "relation": _frame("relation", rec.relations),
         "holds": holds_table(rec.relations, thr, per_j),
-        "threshold": pd.DataFrame({"j": per_j.index.to_numpy(dtype="int64"), "value": per_j.to_numpy()}),
+        "threshold": pd.DataFrame(
+            {"j": per_j.index.to_numpy(dtype="int64"), "value": per_j.to_numpy()}
+        ),
         "attention": _frame("attention", rec.attention),
     }
     return FactSet(tables=tables, threshold=thr, meta=dict(rec.meta))

@@ -77,12 +77,13 @@ class _Trace:
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
         objects = info["objects"]
-        if not any(obj[0] == "agent" for obj in objects[:1]):  # RGW lists the agent first, Box-World not
+        if not any(
+            obj[0] == "agent" for obj in objects[:1]
+        ):  # RGW lists the agent first, Box-World not
             row, col = info["agent"]
             self.pos.append((episode, t, "agent", "agent", int(row), int(col)))
         self.pos.extend((episode, t, oid, otype, int(r), int(c)) for oid, otype, r, c in objects)
         self.holding.extend((episode, t, item) for item in info["holding"])
-
 
 
 def _resolve_env(agent: Any, env: Any) -> str:
@@ -92,11 +93,15 @@ def _resolve_env(agent: Any, env: Any) -> str:
     if env is None:
         return trained
     if not isinstance(env, str):
-        raise ConfigError(f"env must be an environment name such as {trained!r}, got {type(env).__name__}")
+        raise ConfigError(
+            f"env must be an environment name such as {trained!r}, got {type(env).__name__}"
+        )
     name = canonical_name(env)
     if name != trained:
         where = getattr(agent, "path", None) or "the agent"
-        raise CheckpointError(f"{where} was trained on {trained}, not {name}; record it on --env {trained}")
+        raise CheckpointError(
+            f"{where} was trained on {trained}, not {name}; record it on --env {trained}"
+        )
     return name
 
 
@@ -155,7 +160,13 @@ class _progress_bar:
         if not self.enabled:
             return lambda k: None
         from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+        )
 
         self._progress = Progress(
             TextColumn("recording"),
@@ -233,12 +244,17 @@ class _Recorder:
             self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
         while (live := np.flatnonzero(episode >= 0)).size:
             grid = venv.entity_grid().reshape(n, -1)  # (n, N) entity codes of the current states
-            actions, intro = self.agent.act(obs, greedy=self.greedy, introspect=True, generator=self.generator)
+            actions, intro = self.agent.act(
+                obs, greedy=self.greedy, introspect=True, generator=self.generator
+            )
             actions = np.asarray(actions)
             self._model_outputs(episode[live], t[live], grid, intro, live)
             obs, reward, terminated, truncated, info = venv.step(actions.astype(np.int64))
             self.step_cols.add(
-                episode=episode[live], t=t[live], action=action_names[actions[live]], reward=reward[live]
+                episode=episode[live],
+                t=t[live],
+                action=action_names[actions[live]],
+                reward=reward[live],
             )
             ret[live] += reward[live]
             ended = 0
@@ -253,12 +269,16 @@ class _Recorder:
                     episode[i] = -1
                     ended += 1
                 elif s >= self.max_steps:
-                    raise ConfigError(f"episode {e} ran {s} steps without ending; the env has no time limit")
+                    raise ConfigError(
+                        f"episode {e} ran {s} steps without ending; the env has no time limit"
+                    )
             t[live] += 1
             if ended:
                 self.advance(ended)
 
-    def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any, live: np.ndarray) -> None:
+    def _model_outputs(
+        self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any, live: np.ndarray
+    ) -> None:
         """Keep the live rows' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
         grid = grid[live]
         if self.module == "predinet":
@@ -297,9 +317,16 @@ class _Recorder:
         eps = eps.sort_values("episode", kind="stable")
         sc = self.step_cols
         steps = pd.DataFrame(
-            {"episode": sc.get("episode"), "t": sc.get("t"), "action": sc.get("action"), "reward": sc.get("reward")}
+            {
+                "episode": sc.get("episode"),
+                "t": sc.get("t"),
+                "action": sc.get("action"),
+                "reward": sc.get("reward"),
+            }
         )
-        positions = pd.DataFrame(self.trace.pos, columns=["episode", "t", "object", "type", "row", "col"])
+        positions = pd.DataFrame(
+            self.trace.pos, columns=["episode", "t", "object", "type", "row", "col"]
+        )
         holding = pd.DataFrame(self.trace.holding, columns=["episode", "t", "item"])
         events = pd.DataFrame(self.trace.events, columns=["episode", "t", "event"])
         tables: dict[str, pd.DataFrame] = {}
@@ -372,7 +399,9 @@ class _Recorder:
         top, weight, grid = m.get("top"), m.get("weight"), m.get("grid")  # (S, H, N, k), (S, N)
         S, H, N, k = top.shape
         query_code = np.broadcast_to(grid[:, None, :, None], (S, H, N, k))
-        key_code = np.take_along_axis(np.broadcast_to(grid[:, None, :], (S, H, N)), top.reshape(S, H, N * k), -1)
+        key_code = np.take_along_axis(
+            np.broadcast_to(grid[:, None, :], (S, H, N)), top.reshape(S, H, N * k), -1
+        )
         query_cell = np.broadcast_to(np.arange(N)[None, None, :, None], (S, H, N, k))
         background = np.isin(self.names, _BACKGROUND)
         keep = ~background[query_code].reshape(-1)

@@ -178,7 +178,9 @@ class Recording:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         for name, df in self.tables.items():
-            _atomic_write_bytes(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
+            _atomic_write_bytes(
+                out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False)
+            )
         meta = {"format": _FORMAT, "format_version": _FORMAT_VERSION, "meta": self.meta}
         text = json.dumps(meta, indent=2, sort_keys=True, default=str) + "\n"
         _atomic_write_bytes(out / "meta.json", lambda p: Path(p).write_text(text))
@@ -192,9 +194,13 @@ class Recording:
         try:
             head = json.loads(meta_path.read_text())
         except (OSError, ValueError) as exc:
-            raise ConfigError(f"{src} is not a neurosym recording (cannot read {meta_path.name}: {exc})") from None
+            raise ConfigError(
+                f"{src} is not a neurosym recording (cannot read {meta_path.name}: {exc})"
+            ) from None
         if not isinstance(head, dict) or head.get("format") != _FORMAT:
-            raise ConfigError(f"{src} is not a neurosym recording ({meta_path.name} has no format tag {_FORMAT!r})")
+            raise ConfigError(
+                f"{src} is not a neurosym recording ({meta_path.name} has no format tag {_FORMAT!r})"
+            )
         tables: dict[str, pd.DataFrame] = {}
         for name in SCHEMA:
             path = src / f"{name}.parquet"
@@ -209,4 +215,8 @@ class Recording:
             return NotImplemented
         if self.meta != other.meta:
             return False
-        return all(getattr(self, f.name).equals(getattr(other, f.name)) for f in fields(self) if f.name in SCHEMA)
+        return all(
+            getattr(self, f.name).equals(getattr(other, f.name))
+            for f in fields(self)
+            if f.name in SCHEMA
+        )

@@ -47,7 +47,7 @@ def rules_dir() -> Path | None:
 
 def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]:
     """(title, goal, answers as Prolog text) for the family's queries over the KB at ``kb_path``."""
-    from neurosym.prolog import KnowledgeBase
+    from neurosym.prolog.knowledge_base import KnowledgeBase
 
     folder = rules_dir()
     if folder is None:
@@ -60,10 +60,23 @@ def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]
             text_goal = f"{goal}, format(atom(Text__), '~q', [{var}])"
             answers = [str(row["Text__"]) for row in kb.query(text_goal)]
             out.append((title, goal, answers))
-        visits = [str(r["Text__"]) for r in kb.query("visit_order(_, O), format(atom(Text__), '~q', [O])")] if family == "rgw" else []
+        visits = (
+            [
+                str(r["Text__"])
+                for r in kb.query("visit_order(_, O), format(atom(Text__), '~q', [O])")
+            ]
+            if family == "rgw"
+            else []
+        )
         if visits:
             common = Counter(visits).most_common(3)
-            out.append(("visit orders (most common)", "visit_order(E, Order)", [f"{o} x{n}" for o, n in common]))
+            out.append(
+                (
+                    "visit orders (most common)",
+                    "visit_order(_, Order)",
+                    [f"{o} x{n}" for o, n in common],
+                )
+            )
     finally:
         close = getattr(kb, "close", None)
         if close is not None:
@@ -71,11 +84,14 @@ def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]
     return out
 
 
-def _short(values: list[str], limit: int = 20) -> str:
+def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
+    """Answers on one line; ``of``: the episode count, for goals that answer episodes."""
     if not values:
         return "none"
-    head = ", ".join(values[:limit])
-    return head + (f", ... ({len(values)} in all)" if len(values) > limit else f"  ({len(values)})")
+    head = ", ".join(values[:limit]) + (", ..." if len(values) > limit else "")
+    if of is not None:
+        return f"{head}  ({len(values)} of {of} episodes)"
+    return head if len(values) == 1 else f"{head}  ({len(values)})"
 
 
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
@@ -96,20 +112,33 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
     table = Table(title="episodes", show_edge=False)
     for col in ("episode", "steps", "return", "outcome"):
         table.add_column(col, justify="right" if col != "outcome" else "left")
-    for e, steps, ret, outcome in ep.head(20)[["episode", "steps", "return", "outcome"]].itertuples(index=False, name=None):
+    for e, steps, ret, outcome in ep.head(20)[["episode", "steps", "return", "outcome"]].itertuples(
+        index=False, name=None
+    ):
         table.add_row(str(e), str(steps), f"{ret:.2f}", str(outcome))
     console.print(table)
     if len(ep) > 20:
         console.print(f"... {len(ep) - 20} more episodes")
     if len(ep):
-        outcomes = ", ".join(f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items())
-        console.print(f"return: mean {ep['return'].mean():.3f}, min {ep['return'].min():.3f}, max {ep['return'].max():.3f}; {outcomes}")
+        outcomes = ", ".join(
+            f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
+        )
+        console.print(
+            f"return: mean {ep['return'].mean():.3f}, min {ep['return'].min():.3f}, max {ep['return'].max():.3f}; {outcomes}"
+        )
 
     counts = facts.counts()
-    console.print("facts: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v) + f"  ({facts.n_facts} in all)")
+    console.print(
+        "facts: "
+        + ", ".join(f"{k} {v}" for k, v in counts.items() if v)
+        + f"  ({facts.n_facts} in all)"
+    )
     thr = facts.thresholds()
     if len(thr):
-        console.print(f"thresholds ({facts.threshold}): " + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items()))
+        console.print(
+            f"thresholds ({facts.threshold}): "
+            + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
+        )
 
     strongest = facts.strongest_relations(5)
     if len(strongest):
@@ -120,7 +149,9 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             st.add_row(f"r({r.j})", str(r.a), str(r.b), str(r.held), f"{r.mean_value:.4g}")
         console.print(st)
     elif not facts["attention"].empty:
-        console.print("MHDPA: attention/6 facts hold the strongest key per query (no relation values)")
+        console.print(
+            "MHDPA: attention/6 facts hold the strongest key per query (no relation values)"
+        )
 
     if kb is not None:
         family = env_family(str(meta.get("env")))
@@ -129,10 +160,10 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             qt = Table(title=f"rules/{RULE_FILES[family][0]}", show_edge=False)
             qt.add_column("question")
             qt.add_column("answers")
-            for title, _goal, values in answers:
-                qt.add_row(title, _short(values))
+            for title, goal, values in answers:
+                qt.add_row(title, _short(values, of=len(ep) if goal.endswith("(E)") else None))
             console.print(qt)
         else:
             console.print("rules/ not found beside the package: no rule answers")
-    for name, path in written.items():
+    for path in written.values():
         console.print(f"wrote {path}")

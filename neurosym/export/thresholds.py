@@ -56,7 +56,9 @@ class Threshold:
         Relations with no recorded value get no threshold (they cannot hold).
         """
         if relations.empty:
-            return pd.Series([], index=pd.Index([], dtype="int64", name="j"), dtype="float64", name="threshold")
+            return pd.Series(
+                [], index=pd.Index([], dtype="int64", name="j"), dtype="float64", name="threshold"
+            )
         mag = relations["value"].abs().groupby(relations["j"], sort=True)
         if self.kind == "abs":
             out = pd.Series(self.param, index=mag.size().index, dtype="float64")
@@ -102,5 +104,7 @@ def parse_threshold(spec: str | float | int | Threshold) -> Threshold:
     try:
         param = float(value)
     except ValueError:
-        raise ConfigError(f"bad threshold {spec!r}: {value.strip()!r} is not a number; {_HELP}") from None
+        raise ConfigError(
+            f"bad threshold {spec!r}: {value.strip()!r} is not a number; {_HELP}"
+        ) from None
     return Threshold(kind, param)  # type: ignore[arg-type]

@@ -1,0 +1,133 @@
+"""``neurosym extract`` run for real in a subprocess: outputs, the printed answers, and refusals."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import torch
+
+from neurosym.agent.checkpoint import save_checkpoint
+from neurosym.agent.config import ModelConfig
+from neurosym.agent.model import ActorCritic
+from neurosym.envs import make
+from neurosym.export.recording import Recording
+
+
+@pytest.fixture(scope="module")
+def checkpoint(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A small untrained rgw2 PrediNet checkpoint whose episodes stop after 15 steps."""
+    env = make("rgw2")
+    torch.manual_seed(0)
+    cfg = ModelConfig.for_family(
+        "rgw", "predinet", env.observation_space.shape, env.unwrapped.obs_scale,
+        heads=2, relations=3, key_size=8, conv_channels=(4, 8), hidden_sizes=(16,),
+    )  # fmt: skip
+    path = tmp_path_factory.mktemp("ckpt") / "rgw2-small.pt"
+    return save_checkpoint(
+        path, model=ActorCritic(cfg), config=cfg, env_name="rgw2", env_kwargs={"max_steps": 15}
+    )
+
+
+def one_line_error(proc: subprocess.CompletedProcess[str], *parts: str) -> None:
+    assert proc.returncode == 1, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("neurosym extract: error: ")
+    for part in parts:
+        assert part in lines[0]
+
+
+def test_extract_writes_the_kb_and_prints_the_answers(
+    run_neurosym, checkpoint: Path, tmp_path: Path, swipl: Path
+) -> None:
+    out = tmp_path / "kb"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")  # not neurosym's: must survive
+    args = ["extract", "--checkpoint", checkpoint, "--env", "rgw2", "--episodes", 3, "--seed", 5,
+            "--sample", "--threshold", "z:1", "--out", out, "--format", "pl,parquet", "--qlf"]  # fmt: skip
+    proc = run_neurosym(*args)
+    assert proc.returncode == 0, proc.stderr
+    text = proc.stdout
+    for part in ("rgw2: 3 episodes (sampled, seed 5)", "facts: ", "thresholds (z:1)", "sword before enemy",
+                 "sword-enemy link in the network", f"wrote {out / 'kb.pl'}"):  # fmt: skip
+        assert part in text, part
+    assert sorted(p.name for p in out.iterdir()) == [
+        "facts",
+        "kb.pl",
+        "kb.qlf",
+        "notes.txt",
+        "recording",
+    ]
+    assert (out / "notes.txt").read_text() == "mine"
+    rec = Recording.load(out / "recording")
+    assert rec.episodes["seed"].tolist() == [5, 6, 7]
+    assert rec.meta["checkpoint"] == str(checkpoint)
+    holds = pd.read_parquet(out / "facts" / "holds.parquet")
+    kb_text = (out / "kb.pl").read_text()
+    assert kb_text.count("\nholds(") == len(holds) > 0
+    assert "kb_meta(threshold,'z:1')." in kb_text
+    load = subprocess.run(
+        [swipl, "-q", "-g", "halt", out / "kb.pl"], capture_output=True, text=True, timeout=60
+    )
+    assert (load.returncode, load.stdout, load.stderr) == (0, "", "")
+
+    # Run again with only pl: kb.pl is replaced, the earlier facts/ stay, nothing half-written remains.
+    again = run_neurosym(
+        "extract",
+        "--checkpoint",
+        checkpoint,
+        "--env",
+        "rgw2",
+        "--episodes",
+        1,
+        "--out",
+        out,
+        "--quiet",
+    )
+    assert again.returncode == 0, again.stderr
+    assert again.stdout == ""
+    assert "episode(1," not in (out / "kb.pl").read_text()
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+@pytest.mark.parametrize(
+    ("args", "parts"),
+    [
+        (["--env", "rgw1"], ["was trained on rgw2, not rgw1"]),
+        (["--env", "nowhere"], ["nowhere"]),
+        (["--env", "rgw2", "--threshold", "top:5"], ["bad threshold 'top:5'", "quantile:0.9"]),
+        (["--env", "rgw2", "--format", "pl,csv"], ["bad --format 'pl,csv'", "pl, parquet"]),
+        (["--env", "rgw2", "--episodes", "0"], ["--episodes must be at least 1"]),
+    ],
+)
+def test_bad_input_is_refused_and_nothing_is_written(
+    run_neurosym, checkpoint: Path, tmp_path: Path, args: list[str], parts: list[str]
+) -> None:
+    out = tmp_path / "kb"
+    proc = run_neurosym("extract", "--checkpoint", checkpoint, "--out", out, *args)
+    one_line_error(proc, *parts)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("content", [b"not a checkpoint at all", None])
+def test_unreadable_checkpoint_is_refused(
+    run_neurosym, tmp_path: Path, content: bytes | None
+) -> None:
+    ckpt = tmp_path / "broken.pt"
+    if content is not None:
+        ckpt.write_bytes(content)
+    out = tmp_path / "kb"
+    proc = run_neurosym("extract", "--checkpoint", ckpt, "--env", "rgw2", "--out", out)
+    one_line_error(proc, str(ckpt))
+    assert not out.exists()
+
+
+def test_out_that_is_a_file_is_refused(run_neurosym, checkpoint: Path, tmp_path: Path) -> None:
+    out = tmp_path / "kb.pl"
+    out.write_text("% someone's file\n")
+    proc = run_neurosym("extract", "--checkpoint", checkpoint, "--env", "rgw2", "--out", out)
+    one_line_error(proc, "exists and is not a folder")
+    assert out.read_text() == "% someone's file\n"
