@@ -134,6 +134,18 @@ def test_partial_reset_with_reset_mask():
     assert np.array_equal(again[1], single.reset()[0])  # sub-env 1's second level
 
 
+def test_copy_false_hands_out_the_live_buffer():
+    shared = BoxWorldVectorEnv(3, seed=5, copy=False)
+    copied = BoxWorldVectorEnv(3, seed=5)
+    first, _ = shared.reset()
+    assert np.array_equal(first, copied.reset()[0])
+    actions = np.array([0, 1, 2])
+    obs, *_ = shared.step(actions)
+    expected = copied.step(actions)[0]
+    assert np.shares_memory(obs, first)
+    assert np.array_equal(first, expected)  # the array handed out at reset shows the new state
+
+
 def test_render_modes():
     frames = BoxWorldVectorEnv(2, seed=0, render_mode="rgb_array", tile_size=4)
     frames.reset()

@@ -225,6 +225,9 @@ class BoxWorldVectorEnv(VectorEnv):
 
     Seeding: sub-environment ``i`` of an environment seeded ``s`` (here or in
     ``reset(seed=s)``) plays the levels of ``BoxWorldEnv`` seeded ``s + i``.
+
+    ``copy=False`` returns the internal observation buffer itself, which the next
+    step overwrites (faster; copy it if you keep it).
     """
 
     metadata = {**_METADATA, "autoreset_mode": AutoresetMode.NEXT_STEP}
@@ -241,6 +244,7 @@ class BoxWorldVectorEnv(VectorEnv):
         max_steps: int = 300,
         render_mode: str | None = None,
         tile_size: int = DEFAULT_TILE,
+        copy: bool = True,
     ) -> None:
         if not isinstance(num_envs, int | np.integer) or isinstance(num_envs, bool) or num_envs < 1:
             raise ConfigError(f"num_envs must be a positive integer, got {num_envs!r}")
@@ -249,6 +253,7 @@ class BoxWorldVectorEnv(VectorEnv):
         _check_render_mode(render_mode, tile_size)
         self.render_mode = render_mode
         self.tile_size = tile_size
+        self.copy = bool(copy)
         self.single_observation_space = _observation_space()
         self.single_action_space = spaces.Discrete(4)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -299,7 +304,7 @@ class BoxWorldVectorEnv(VectorEnv):
         self._autoreset[rows] = False
         info = self._state.info()
         self._last_info = info
-        return self._state.observation(), info
+        return self._observation(), info
 
     def step(
         self, actions: np.ndarray
@@ -328,7 +333,12 @@ class BoxWorldVectorEnv(VectorEnv):
         if restart.size:
             info = {**info, "final_info": last, "_final_info": self._autoreset.copy()}
         self._autoreset = terminated | truncated
-        return self._state.observation(), reward, terminated, truncated, info
+        return self._observation(), reward, terminated, truncated, info
+
+    def _observation(self) -> np.ndarray:
+        if self.copy:
+            return self._state.observation()
+        return self._state.obs.reshape(self.num_envs, 3, GRID, GRID)  # the live buffer
 
     def decode_info(self, info: dict[str, Any], i: int) -> dict[str, Any]:
         """The dict :class:`BoxWorldEnv` would give for sub-environment ``i``."""
