@@ -180,3 +180,17 @@ def test_incremental_observation_equals_a_full_redraw(make_vec, obs_mode: str) -
         bad = np.flatnonzero((obs != want).reshape(len(obs), -1).any(axis=1))
         assert not len(bad), f"[{t}] envs {bad.tolist()} differ from a full redraw"
         obs, *_ = env.step(rng.integers(0, 4, 16))
+
+
+def test_final_info_of_an_undecoded_random_level_is_regenerated() -> None:
+    vec = RGWRandomVectorEnv(2, max_steps=3)
+    single = RGWRandomEnv(max_steps=3)
+    vec.reset(seed=4)
+    single.reset(seed=4)
+    for _ in range(3):
+        last = single.step(0)[4]
+        vec.step([0, 0])
+    _, first = single.reset()
+    _, _, _, _, info = vec.step([0, 0])  # autoreset; nothing of the old level was decoded
+    assert vec.decode_info(info["final_info"], 0) == last
+    assert vec.decode_info(info, 0) == first

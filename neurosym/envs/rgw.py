@@ -17,7 +17,7 @@ from gymnasium import spaces
 from neurosym.envs import render as draw
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.actions import Action
-from neurosym.envs.rgw_levels import FixedLevel, LevelSource
+from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource
 from neurosym.envs.rgw_maps import load_map
 from neurosym.errors import ConfigError
 
@@ -183,7 +183,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             key_e = np.array([self.episode_index], dtype=np.int64)
             cells, starts = self._ring.take(np.zeros(1, np.intp), key_s, key_e)
             self._batch.set_levels(np.zeros(1, np.intp), cells, starts)
-            self._objects = self.source.objects(self.level_seed, self.episode_index)
+            self._objects = LevelObjects(cells[0], self.width)
         self._batch.reset_rows()
         return self._batch.obs[0].copy(), self._info(0, False)
 

@@ -35,7 +35,7 @@ from gymnasium.vector.utils import batch_space
 from neurosym.envs import render as draw
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.rgw import check_options, observation_space
-from neurosym.envs.rgw_levels import FixedLevel, LevelSource
+from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, ObjectsCache
 from neurosym.envs.rgw_maps import load_map
 from neurosym.envs.rgw_random import RandomLevels, config_from_kwargs
 from neurosym.errors import ConfigError
@@ -124,6 +124,8 @@ class RGWVectorEnv(VectorEnv):
         self._pending: np.ndarray | None = None  # sub-envs to autoreset on the next step
         self._last_info: dict[str, Any] | None = None
         self._ring = source.ring(self.num_envs) if source.per_episode else None
+        # Named objects of procedural levels by (seed, episode), built on first decode.
+        self._objects = ObjectsCache(size=max(256, 4 * self.num_envs))
 
     # -- gymnasium vector API -------------------------------------------------
 
@@ -214,7 +216,7 @@ class RGWVectorEnv(VectorEnv):
         """The info dict the single env gives, for sub-env ``i`` of a batched info."""
         pos = int(info["pos"][i])
         if self.source.per_episode:
-            objects = self.source.objects(int(info["seed"][i]), int(info["episode_id"][i]))
+            objects = self._level_objects(i, int(info["seed"][i]), int(info["episode_id"][i]))
         else:
             objects = self.source.objects(0, 0)
         return {
@@ -224,6 +226,21 @@ class RGWVectorEnv(VectorEnv):
             "events": rules.EVENT_TUPLES[int(info["events"][i])],
             "outcome": rules.outcome_name(int(info["events"][i]), bool(info["truncated"][i])),
         }
+
+    def _level_objects(self, i: int, seed: int, episode: int) -> LevelObjects:
+        """Objects of level (seed, episode): from sub-env i's cells while it plays it, else regenerated."""
+        key = (seed, episode)
+        objects = self._objects.get(key)
+        if objects is None:
+            current = (
+                self._seeds is not None and (int(self._seeds[i]), int(self._episodes[i])) == key
+            )
+            if current:
+                objects = LevelObjects(self._batch.level_cells[self._batch.slot[i]], self.width)
+            else:
+                objects = self.source.objects(seed, episode)
+            self._objects.put(key, objects)
+        return objects
 
     # -- symbolic views and rendering ----------------------------------------
 
