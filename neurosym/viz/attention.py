@@ -108,5 +108,5 @@ def _strongest(
         if not np.isfinite(row).any():
             continue
         k = int(np.nanargmax(row))
-        parts.append(f"head {hd} -> {names[k]} ({k // w},{k % w}) {row[k]:.2f}")
+        parts.append(f"head {hd} -> {names[k]} ({k // w},{k % w}) {row[k]:.3g}")
     return "strongest: " + ", ".join(parts) if parts else ""

@@ -2,7 +2,7 @@
 
 Both attention pictures (MHDPA: from / onto an object; PrediNet: argument 1 /
 argument 2) have this shape, so they share the layout, the colour scaling
-(one scale per row, so heads can be compared) and the legend line.
+(one min..max scale per row, so heads can be compared) and the legend line.
 
 Size: ``PANEL_INCHES`` per panel plus fixed margins, so a figure of ``heads``
 columns and ``rows`` rows is ``(heads * 2.4 + 1.0) x (rows * 2.4 + 1.0)``
@@ -42,6 +42,23 @@ class Panel:
     """(row, col, colour) of cells to frame"""
 
 
+def row_norm(row: Sequence[Panel]) -> Normalize:
+    """One colour scale for a row, from its smallest to its largest weight.
+
+    Attention of an untrained or uncertain head is close to uniform (1/N
+    everywhere); a scale from 0 would paint it one flat colour, min..max shows
+    where it leans, and the colour bar gives the true range.
+    """
+    finite = [p.values[np.isfinite(p.values)] for p in row]
+    values = np.concatenate(finite) if finite else np.zeros(0)
+    if values.size == 0:
+        return Normalize(0.0, 1.0)
+    lo, hi = float(values.min()), float(values.max())
+    if hi - lo < 1e-12:
+        lo, hi = max(0.0, lo - 0.5 * max(abs(lo), 1e-3)), hi + 0.5 * max(abs(hi), 1e-3)
+    return Normalize(lo, hi)
+
+
 def figure_size(rows: int, cols: int) -> tuple[float, float]:
     """Figure size in inches for ``rows`` x ``cols`` panels."""
     return cols * PANEL_INCHES + MARGIN_INCHES, rows * PANEL_INCHES + MARGIN_INCHES
@@ -62,8 +79,7 @@ def heat_map_figure(
     axes = fig.subplots(n_rows, n_cols, squeeze=False)
     fontsize = label_size(PANEL_INCHES * 0.85, names.shape[1])
     for r, row in enumerate(panels):
-        top = np.nanmax([np.nanmax(p.values) if np.isfinite(p.values).any() else 0.0 for p in row])
-        norm = Normalize(vmin=0.0, vmax=float(top) if top > 0 else 1.0)
+        norm = row_norm(row)
         image = None
         for c, panel in enumerate(row):
             ax = axes[r, c]

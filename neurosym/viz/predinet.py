@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from neurosym.errors import ConfigError
+from neurosym.export.recording import Recording
 from neurosym.viz.panels import Panel, heat_map_figure
 from neurosym.viz.sources import load_trace, require_source_module, trace_from_agent
 from neurosym.viz.style import head_colour
@@ -246,7 +247,7 @@ def relation_values(
     require_source_module(source, "predinet", "a relation-value plot")
     if isinstance(source, EpisodeTrace):
         return _trace_relations([source]), source.title_name
-    if hasattr(source, "episodes") and hasattr(source, "relations"):
+    if isinstance(source, Recording):
         table = source.relations.loc[:, ["episode", "t", "head", "j", "value"]]
         name = str(source.meta.get("checkpoint", "")) or "recording"
         n = int(source.episodes["episode"].nunique())

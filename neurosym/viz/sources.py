@@ -14,6 +14,7 @@ cells nobody recorded are drawn as ``empty``.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
+from neurosym.export.recording import Recording
 from neurosym.viz.trace import EpisodeTrace, require_module
 
 POSITION_COMPONENTS = 4
@@ -31,7 +33,7 @@ POSITION_COMPONENTS = 4
 # from a recording
 
 
-def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
+def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeTrace:
     """The trace of one recorded episode (default: the first one in the recording)."""
     episodes = rec.episodes
     if episodes.empty:
@@ -44,6 +46,11 @@ def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
             f"--episode {episode} is not in the recording: it has episodes {_list(known)}"
         )
     meta = dict(rec.meta)
+    module = str(meta.get("module", ""))
+    if module not in ("predinet", "mhdpa"):
+        raise ConfigError(
+            f"the recording names an unknown module {module!r}: expected predinet or mhdpa"
+        )
     row = episodes.loc[episodes["episode"] == episode].iloc[0]
     steps_tab = _episode_rows(rec.steps, episode).sort_values("t")
     n_steps = int(row["steps"])
@@ -54,10 +61,9 @@ def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
         )
     seed = None if pd.isna(row.get("seed", np.nan)) else int(row["seed"])
     positions = _episode_rows(rec.positions, episode)
-    module = str(meta.get("module", ""))
-    attends = _episode_rows(getattr(rec, "attends", None), episode)
-    attention = _episode_rows(getattr(rec, "attention", None), episode)
-    r_vectors = _episode_rows(getattr(rec, "r_vectors", None), episode)
+    attends = _episode_rows(rec.attends, episode)
+    attention = _episode_rows(rec.attention, episode)
+    r_vectors = _episode_rows(rec.r_vectors, episode)
     env_name = str(meta.get("env", ""))
     base = _reset_layout(env_name, seed)
     shape = base.shape if base is not None else _shape_from_tables(positions, attends, attention)
@@ -73,32 +79,22 @@ def trace_from_recording(rec: Any, episode: int | None = None) -> EpisodeTrace:
         grids=grids,
         actions=tuple(str(a) for a in steps_tab["action"]),
         rewards=steps_tab["reward"].to_numpy(dtype=float),
-        events=_episode_rows(rec.events, episode)[["t", "event"]].reset_index(drop=True)
-        if not _episode_rows(rec.events, episode).empty
-        else pd.DataFrame({"t": pd.Series(dtype=int), "event": pd.Series(dtype=str)}),
+        events=_episode_rows(rec.events, episode)[["t", "event"]].reset_index(drop=True),
         outcome=None if pd.isna(row.get("outcome")) else str(row["outcome"]),
         heads=heads,
         relations=relations,
         complete=False,
     )
-    n_cells = shape[0] * shape[1]
     if module == "predinet":
         a1, a2 = _sparse_argument_maps(attends, n_steps, heads, shape)
         r = _r_vector_array(r_vectors, n_steps, heads, relations)
         return EpisodeTrace(**common, attention1=a1, attention2=a2, r_vectors=r)
-    if module == "mhdpa":
-        lazy = _RecordedAttention(attention, n_steps, heads, shape)
-        focus = _recorded_focus(attention, grids, heads, shape, n_steps)
-        del n_cells
-        return EpisodeTrace(**common, mhdpa=lazy, mhdpa_focus=focus)
-    raise ConfigError(
-        f"the recording names an unknown module {module!r}: expected predinet or mhdpa"
-    )
+    lazy = _RecordedAttention(attention, n_steps, heads, shape)
+    focus = _recorded_focus(attention, grids, heads, shape, n_steps)
+    return EpisodeTrace(**common, mhdpa=lazy, mhdpa_focus=focus)
 
 
-def _episode_rows(table: pd.DataFrame | None, episode: int) -> pd.DataFrame:
-    if table is None or table.empty:
-        return pd.DataFrame() if table is None else table.iloc[0:0]
+def _episode_rows(table: pd.DataFrame, episode: int) -> pd.DataFrame:
     return table.loc[table["episode"] == episode]
 
 
@@ -313,109 +309,155 @@ def trace_from_agent(
     ``env`` is a short name, a registered id or a gymnasium env (default: the
     checkpoint's own environment). ``max_steps`` stops early (a picture of step
     t needs only t + 1 steps). MHDPA maps are (heads, N, N) per state, so only
-    the states in ``keep_attention`` keep them (default: all).
+    the states in ``keep_attention`` keep them (default: all). The model acts
+    on one torch thread: at batch size 1 more threads only cost time.
     """
-    import torch
-
     from neurosym.envs import make
 
-    env_obj, env_name = _open_env(agent, env, make)
-    config = agent.config
-    module = str(config.module)
-    obs, info = env_obj.reset(seed=seed)
-    expected = tuple(getattr(config, "obs_shape", ()) or ())
-    if expected and tuple(obs.shape) != expected:
-        raise ConfigError(
-            f"{Path(str(agent.path)).name} expects observations of shape {expected}, "
-            f"but {env_name} gives {tuple(obs.shape)}: pick the environment it was trained on"
-        )
-    base = env_obj.unwrapped
-    names = np.asarray(base.entity_names, dtype=object)
-    grids = [names[np.asarray(base.entity_grid())]]
-    actions: list[str] = []
-    rewards: list[float] = []
-    events: list[tuple[int, str]] = []
-    intros: list[Any] = []
-    outcome: str | None = None
-    limit = max_steps if max_steps is not None else _step_limit(env_obj)
-    generator = None if greedy else torch.Generator().manual_seed(seed)
-    action_names = _action_names()
-    for t in range(limit):
-        acts, intro = agent.act(obs[None], greedy=greedy, introspect=True, generator=generator)
-        action = int(np.asarray(acts).reshape(-1)[0])
-        intros.append(intro)
-        obs, reward, terminated, truncated, info = env_obj.step(action)
-        actions.append(action_names[action] if action < len(action_names) else str(action))
-        rewards.append(float(reward))
-        events.extend((t, str(e)) for e in info.get("events", ()))
-        grids.append(names[np.asarray(base.entity_grid())])
-        if terminated or truncated:
-            outcome = info.get("outcome")
-            break
-    env_obj.close()
-    n_steps = len(actions)
-    heads = int(getattr(config, "heads", 0) or 0)
-    common = dict(
-        checkpoint=str(agent.path),
-        env=env_name,
-        module=module,
-        episode=0,
-        seed=seed,
-        grids=np.stack(grids),
-        actions=tuple(actions),
-        rewards=np.asarray(rewards, dtype=float),
-        events=pd.DataFrame(events, columns=["t", "event"]).astype({"t": int, "event": str}),
-        outcome=None if outcome is None else str(outcome),
-        complete=True,
-    )
-    if module == "predinet":
-        a1 = _stack(intros, "attention1", n_steps)  # (S, heads, N)
-        a2 = _stack(intros, "attention2", n_steps)
-        rel = _stack(intros, "relations", n_steps)  # (S, heads, J)
-        p1 = _stack(intros, "positions1", n_steps)  # (S, heads, 2)
-        p2 = _stack(intros, "positions2", n_steps)
-        heads = a1.shape[1] if n_steps else heads
-        return EpisodeTrace(
-            **common,
-            heads=tuple(range(heads)),
-            relations=int(rel.shape[2]) if n_steps else int(getattr(config, "relations", 0)),
-            attention1=a1,
-            attention2=a2,
-            r_vectors=np.concatenate([rel, p1, p2], axis=2) if n_steps else np.zeros((0, heads, 0)),
-        )
-    if module == "mhdpa":
-        kept: dict[int, np.ndarray] = {}
-        focus = np.full((n_steps, heads), -1, dtype=np.int64)
-        flat_grids = (np.stack(grids)[:n_steps] == "agent").reshape(n_steps, -1)
-        for t, intro in enumerate(intros):
-            att = _numpy(intro.attention)[0]  # (heads, N, N)
-            heads = att.shape[0]
-            if focus.shape[1] != heads:
-                focus = np.full((n_steps, heads), -1, dtype=np.int64)
-            if flat_grids[t].any():
-                focus[t] = att[:, flat_grids[t].argmax(), :].argmax(axis=1)
-            if keep_attention is None or t in keep_attention:
-                kept[t] = att
-        return EpisodeTrace(
-            **common, heads=tuple(range(heads)), relations=0, mhdpa=kept, mhdpa_focus=focus
-        )
-    raise ConfigError(f"{Path(str(agent.path)).name} has an unknown module {module!r}")
+    env_obj, env_name, owned = _open_env(agent, env, make)
+    try:
+        with _one_torch_thread():
+            play = _Play(agent, env_obj, env_name, seed, greedy, keep_attention)
+            play.run(max_steps if max_steps is not None else _step_limit(env_obj))
+    finally:
+        if owned:
+            env_obj.close()
+    return play.trace()
 
 
-def _open_env(agent: Any, env: Any, make: Any) -> tuple[Any, str]:
-    """A fresh env and its short name: the checkpoint's own when ``env`` is None."""
+class _Play:
+    """One greedy (or seeded sampled) episode, keeping per step only what the plots need."""
+
+    def __init__(
+        self, agent: Any, env: Any, env_name: str, seed: int, greedy: bool, keep: set[int] | None
+    ) -> None:
+        import torch
+
+        self.agent, self.env, self.env_name, self.seed = agent, env, env_name, seed
+        self.greedy, self.keep = greedy, keep
+        self.module = str(agent.config.module)
+        self.generator = None if greedy else torch.Generator().manual_seed(seed)
+        self.names = np.asarray(env.unwrapped.entity_names, dtype=object)
+        self.grids: list[np.ndarray] = []
+        self.actions: list[str] = []
+        self.rewards: list[float] = []
+        self.events: list[tuple[int, str]] = []
+        self.outcome: str | None = None
+        self.predinet: list[Any] = []  # per step: the numpy introspection record (small)
+        self.attention: dict[int, np.ndarray] = {}  # MHDPA, kept steps only
+        self.focus: list[np.ndarray] = []  # MHDPA, per step (heads,)
+
+    def _grid(self) -> np.ndarray:
+        return self.names[np.asarray(self.env.unwrapped.entity_grid())]
+
+    def run(self, limit: int) -> None:
+        obs, _ = self.env.reset(seed=self.seed)
+        expected = tuple(self.agent.config.obs_shape)
+        if tuple(obs.shape) != expected:
+            raise ConfigError(
+                f"{Path(str(self.agent.path)).name} expects observations of shape {expected}, "
+                f"but {self.env_name} gives {tuple(obs.shape)}: pick the environment it was trained on"
+            )
+        action_names = _action_names()
+        self.grids.append(self._grid())
+        for t in range(limit):
+            acts, intro = self.agent.act(
+                obs[None], greedy=self.greedy, introspect=True, generator=self.generator
+            )
+            self._keep(t, intro)
+            action = int(np.asarray(acts).reshape(-1)[0])
+            obs, reward, terminated, truncated, info = self.env.step(action)
+            self.actions.append(action_names[action] if action < len(action_names) else str(action))
+            self.rewards.append(float(reward))
+            self.events.extend((t, str(e)) for e in info.get("events", ()))
+            self.grids.append(self._grid())
+            if terminated or truncated:
+                self.outcome = info.get("outcome") or ("timeout" if truncated else None)
+                break
+
+    def _keep(self, t: int, intro: Any) -> None:
+        if self.module == "predinet":
+            self.predinet.append(intro)
+            return
+        att = _numpy(intro.attention)[0]  # (heads, N, N) query x key
+        agent = (self.grids[t] == "agent").ravel()
+        heads = att.shape[0]
+        self.focus.append(
+            att[:, agent.argmax(), :].argmax(axis=1) if agent.any() else np.full(heads, -1)
+        )
+        if self.keep is None or t in self.keep:
+            self.attention[t] = att
+
+    def trace(self) -> EpisodeTrace:
+        config = self.agent.config
+        n_steps = len(self.actions)
+        heads = tuple(range(int(config.heads)))
+        common = dict(
+            checkpoint=str(self.agent.path or ""),
+            env=self.env_name,
+            module=self.module,
+            episode=0,
+            seed=self.seed,
+            grids=np.stack(self.grids),
+            actions=tuple(self.actions),
+            rewards=np.asarray(self.rewards, dtype=float),
+            events=pd.DataFrame(self.events, columns=["t", "event"]).astype(
+                {"t": int, "event": str}
+            ),
+            outcome=None if self.outcome is None else str(self.outcome),
+            heads=heads,
+            complete=True,
+        )
+        if self.module == "predinet":
+            n, h, j = config.n_entities, len(heads), int(config.relations)
+            field_of = {name: _stack(self.predinet, name) for name in _PREDINET_FIELDS}
+            a1 = field_of["attention1"] if n_steps else np.zeros((0, h, n))  # (S, heads, N)
+            a2 = field_of["attention2"] if n_steps else np.zeros((0, h, n))
+            r = (
+                np.concatenate(
+                    [field_of[k] for k in ("relations", "positions1", "positions2")], axis=2
+                )
+                if n_steps
+                else np.zeros((0, h, j + POSITION_COMPONENTS))
+            )  # (S, heads, J + 4)
+            return EpisodeTrace(**common, relations=j, attention1=a1, attention2=a2, r_vectors=r)
+        focus = np.stack(self.focus) if self.focus else np.zeros((0, len(heads)), dtype=np.int64)
+        return EpisodeTrace(
+            **common, relations=0, mhdpa=self.attention, mhdpa_focus=focus.astype(np.int64)
+        )
+
+
+_PREDINET_FIELDS = ("attention1", "attention2", "relations", "positions1", "positions2")
+
+
+@contextmanager
+def _one_torch_thread() -> Iterator[None]:
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
+
+
+def _open_env(agent: Any, env: Any, make: Any) -> tuple[Any, str, bool]:
+    """(env, short name, whether we made it): a fresh env unless the caller passed one.
+
+    A named env other than the checkpoint's is made without the checkpoint's
+    env options (they belong to the other env); the observation shape is checked.
+    """
     from neurosym.envs import canonical_name
 
     if env is None or isinstance(env, str):
         name = env or agent.env_name
-        try:
-            short = canonical_name(name)
-        except Exception as exc:  # unknown name: let the env registry word the error
-            raise ConfigError(f"unknown environment {name!r}: {exc}") from exc
+        short = canonical_name(name)
         same = short == canonical_name(agent.env_name)
-        return make(short, **(dict(agent.env_kwargs or {}) if same else {})), short
+        return make(short, **(dict(agent.env_kwargs or {}) if same else {})), short, True
     spec = getattr(env, "spec", None)
-    return env, canonical_name(spec.id) if spec is not None else type(env.unwrapped).__name__
+    name = canonical_name(spec.id) if spec is not None else type(env.unwrapped).__name__
+    return env, name, False
 
 
 def _step_limit(env: Any) -> int:
@@ -438,9 +480,10 @@ def _numpy(x: Any) -> np.ndarray:
     return np.asarray(x, dtype=np.float64)
 
 
-def _stack(intros: list[Any], name: str, n_steps: int) -> np.ndarray:
-    if not n_steps:
-        return np.zeros((0, 0, 0))
+def _stack(intros: list[Any], name: str) -> np.ndarray:
+    """(S, ...) one field of per-step introspection records (each with batch axis 1)."""
+    if not intros:
+        return np.zeros(0)
     return np.concatenate([_numpy(getattr(i, name)) for i in intros], axis=0)
 
 
@@ -452,7 +495,7 @@ def require_source_module(source: Any, module: str, what: str) -> None:
     """Refuse early (before playing an episode) a plot that needs the other module."""
     if isinstance(source, EpisodeTrace):
         found, name = source.module, source.checkpoint
-    elif hasattr(source, "episodes") and hasattr(source, "meta"):
+    elif isinstance(source, Recording):
         found, name = str(source.meta.get("module", "")), str(source.meta.get("checkpoint", ""))
     elif hasattr(source, "config"):
         found, name = str(source.config.module), str(getattr(source, "path", ""))
@@ -473,7 +516,7 @@ def load_trace(
     """A trace from an EpisodeTrace (returned as is), a Recording, or an Agent (+ env)."""
     if isinstance(source, EpisodeTrace):
         return source
-    if hasattr(source, "episodes") and hasattr(source, "positions"):
+    if isinstance(source, Recording):
         return trace_from_recording(source, episode)
     if hasattr(source, "act") and hasattr(source, "config"):
         return trace_from_agent(

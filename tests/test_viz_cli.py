@@ -1,0 +1,208 @@
+"""``neurosym plot`` end to end: real checkpoints (random weights) and a real recording.
+
+Each subcommand runs once as ``python -m neurosym`` in a subprocess and once
+in-process; the two files must be byte-identical and of the documented size.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import torch
+from PIL import Image
+
+from neurosym.agent.checkpoint import load_agent, save_checkpoint
+from neurosym.agent.config import ModelConfig
+from neurosym.agent.model import ActorCritic
+from neurosym.cli import main
+from neurosym.envs import env_family, make
+from neurosym.export.recorder import record
+
+ROOT = Path(__file__).resolve().parents[1]
+DPI = "40"
+
+
+def _checkpoint(path: Path, module: str, env: str = "rgw2") -> Path:
+    torch.manual_seed(0)
+    obs, _ = make(env).reset(seed=0)
+    config = ModelConfig.for_family(env_family(env), module, tuple(obs.shape))
+    return save_checkpoint(path, model=ActorCritic(config), config=config, env_name=env)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    tmp = tmp_path_factory.mktemp("plot")
+    out = {m: _checkpoint(tmp / f"rgw2-{m}.pt", m) for m in ("predinet", "mhdpa")}
+    rec = record(load_agent(out["predinet"]), "rgw2", episodes=2, seed=3)
+    out["recording"] = rec.save(tmp / "rec")
+    out["tmp"] = tmp
+    return out
+
+
+def _subprocess(*args: str) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONHASHSEED": "0", "PYTHONPATH": str(ROOT)}
+    return subprocess.run(
+        [sys.executable, "-m", "neurosym", "plot", *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=env,
+    )
+
+
+def _size(data: bytes) -> tuple[int, int, int]:
+    with Image.open(io.BytesIO(data)) as im:
+        return im.width, im.height, getattr(im, "n_frames", 1)
+
+
+CASES = [
+    # (name, source, args, expected (width, height, frames) at 40 dpi)
+    ("mhdpa.png", "mhdpa", ["mhdpa", "--step", "2", "--object", "agent"], (424, 232, 1)),
+    ("predinet.png", "recording", ["predinet", "--episode", "1", "--step", "3"], (424, 232, 1)),
+    ("rvectors.png", "predinet", ["rvectors", "--max-steps", "6"], (320, 296, 1)),
+    ("relations.png", "recording", ["relations", "--threshold", "z:1"], (432, 216, 1)),
+    ("episode.png", "recording", ["episode", "--frames", "4", "--head", "1"], (332, 132, 1)),
+    ("episode.gif", "mhdpa", ["episode", "--max-steps", "5", "--fps", "8"], (320, 368, 6)),
+]
+
+
+@pytest.mark.parametrize(("name", "source", "args", "size"), CASES, ids=[c[0] for c in CASES])
+def test_each_plot_is_reproducible_and_of_the_documented_size(
+    files: dict[str, Path],
+    name: str,
+    source: str,
+    args: list[str],
+    size: tuple[int, int, int],
+    capsys,
+) -> None:
+    flag = (
+        ["--recording", str(files["recording"])]
+        if source == "recording"
+        else ["--checkpoint", str(files[source])]
+    )
+    first, second = files["tmp"] / f"a-{name}", files["tmp"] / f"b-{name}"
+    done = _subprocess(*args, *flag, "--dpi", DPI, "--out", str(first))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"wrote {first} (")
+    assert main(["plot", *args, *flag, "--dpi", DPI, "--out", str(second)]) == 0
+    data = first.read_bytes()
+    assert data == second.read_bytes()
+    assert _size(data) == size
+
+
+def test_svg_is_reproducible_with_the_figure_size_in_points(files: dict[str, Path]) -> None:
+    outs = [files["tmp"] / f"{k}.svg" for k in "ab"]
+    for out in outs:
+        assert (
+            main(
+                [
+                    "plot",
+                    "predinet",
+                    "--checkpoint",
+                    str(files["predinet"]),
+                    "--head",
+                    "0",
+                    "--out",
+                    str(out),
+                ]
+            )
+            == 0
+        )
+    text = outs[0].read_text()
+    assert outs[0].read_bytes() == outs[1].read_bytes()
+    assert 'width="244.8pt" height="417.6pt"' in text  # (2.4 + 1.0) x (2 * 2.4 + 1.0) inches
+
+
+def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> None:
+    done = _subprocess(
+        "mhdpa", "--checkpoint", str(files["predinet"]), "--out", str(files["tmp"] / "x.png")
+    )
+    assert done.returncode == 1
+    assert done.stderr == (
+        "neurosym plot: error: an MHDPA attention plot needs an MHDPA agent, "
+        "but rgw2-predinet.pt is a PrediNet agent\n"
+    )
+    assert not (files["tmp"] / "x.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["predinet", "--checkpoint", "{mhdpa}"],
+            "a PrediNet attention plot needs a PrediNet agent, but rgw2-mhdpa.pt",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--head", "4"],
+            "--head 4 is out of range: this agent has heads 0..3",
+        ),
+        (
+            ["mhdpa", "--checkpoint", "{mhdpa}", "--step", "500"],
+            r"--step 500 is out of range: episode 0 has steps 0\.\.\d+$",
+        ),
+        (
+            ["predinet", "--recording", "{recording}", "--episode", "5"],
+            "--episode 5 is not in the recording: it has episodes 0, 1",
+        ),
+        (
+            ["predinet", "--recording", "{recording}", "--episode-seed", "2"],
+            "--episode-seed goes with --checkpoint",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--episode", "1"],
+            "--episode goes with --recording",
+        ),
+        (
+            ["rvectors", "--checkpoint", "{predinet}", "--env", "bw1"],
+            "expects observations of shape (9, 10, 10), but bw1 gives (3, 14, 14)",
+        ),
+        (
+            ["relations", "--recording", "{recording}", "--threshold", "quantile:2"],
+            "threshold quantile:2.0 is outside [0, 1]",
+        ),
+        (
+            ["episode", "--recording", "{recording}", "--steps", "7:3"],
+            "--steps '7:3': expected 0 <= START <= STOP",
+        ),
+        (["mhdpa", "--checkpoint", "{nowhere}"], "checkpoint not found"),
+        (["predinet", "--recording", "{tmp}"], "is not a neurosym recording"),
+        (["predinet", "--checkpoint", "{predinet}", "--out-as", "gif"], None),
+    ],
+)
+def test_bad_requests_name_what_was_wrong(
+    files: dict[str, Path], args: list[str], message: str | None, capsys
+) -> None:
+    paths = {k: str(v) for k, v in files.items()} | {"nowhere": str(files["tmp"] / "none.pt")}
+    argv = ["plot", *(a.format(**paths) for a in args), "--out", str(files["tmp"] / "bad.png")]
+    if message is None:  # argparse's own usage error
+        with pytest.raises(SystemExit) as info:
+            main(argv)
+        assert info.value.code == 2
+        return
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("neurosym plot: error: ") and err.count("\n") == 1
+    assert re.search(message if message.endswith("$") else re.escape(message), err.strip())
+
+
+def test_gif_only_for_episodes(files: dict[str, Path], capsys) -> None:
+    assert (
+        main(
+            [
+                "plot",
+                "predinet",
+                "--checkpoint",
+                str(files["predinet"]),
+                "--out",
+                str(files["tmp"] / "p.gif"),
+            ]
+        )
+        == 1
+    )
+    assert "the file name must end in .png or .svg" in capsys.readouterr().err
