@@ -259,3 +259,30 @@ def test_written_values_are_found_again_through_query_inputs(cells: list[object]
         with KnowledgeBase(path) as kb:
             for i, value in enumerate(cells):
                 assert {"I": i} in kb.query("v(I, X)", X=value)
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    st.lists(
+        floats | st.sampled_from([0.0, -0.0, 100.0, 1e15, 1e16, 1e-4, 9.99e-5, 5e-324, 2.0**63]),
+        min_size=1,
+    ),
+    st.lists(st.integers(-(2**63), 2**64 - 1), min_size=1),
+)
+def test_numeric_columns_are_spelled_like_format_term(
+    tmp_path: Path, reals: list[float], whole: list[int]
+) -> None:
+    path = tmp_path / "kb.pl"
+    tables = {"r": pd.DataFrame({"x": np.array(reals, dtype=np.float64)})}
+    unsigned = [i for i in whole if i >= 0]
+    signed = [i for i in whole if i < 2**63]
+    tables["u"] = pd.DataFrame({"x": np.array(unsigned or [0], dtype=np.uint64)})
+    tables["s"] = pd.DataFrame({"x": np.array(signed or [0], dtype=np.int64)})
+    write_prolog(path, tables)
+    lines = [ln for ln in path.read_text().splitlines() if ln[:2] in ("r(", "u(", "s(")]
+    expected = [f"r({format_term(x)})." for x in reals]
+    expected += [f"u({format_term(x)})." for x in unsigned or [0]]
+    expected += [f"s({format_term(x)})." for x in signed or [0]]
+    assert lines == expected

@@ -22,10 +22,11 @@ term text              with ``term_columns={"event": ["event"]}``, a str
 
 NaN, infinities, None/NA and other types are refused with a
 :class:`~neurosym.errors.FactError` naming the table, row (0-based position)
-and column. Each column is converted once per distinct value where possible
-(factorised), floats with one ``repr`` each, so a million facts take about a
-second. The file is written to a temporary file beside ``path`` and renamed
-over it, so readers never see half a KB.
+and column. Columns become Arrow string arrays (numbers formatted in C++,
+atoms and terms spelled once per distinct value) and Arrow joins them into
+lines, so a million relation/7 facts take well under a second. The file is
+written to a temporary file beside ``path`` and renamed over it, so readers
+never see half a KB.
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
 
 from neurosym.errors import FactError
 from neurosym.terms import atom_text, float_text, format_value, parse_term
@@ -64,31 +67,42 @@ def _first(mask: np.ndarray) -> int:
     return int(np.flatnonzero(mask)[0])
 
 
-def _ints_text(values: np.ndarray) -> list[str]:
-    codes, uniques = pd.factorize(values)
-    if len(uniques) * 2 > len(values):  # mostly distinct: factorising does not pay
-        return list(map(str, values.tolist()))
-    return np.asarray(list(map(str, uniques.tolist())), dtype=object)[codes].tolist()
+_TEXT = pa.large_string()
+_TRUE, _FALSE = pa.scalar("true", _TEXT), pa.scalar("false", _TEXT)
 
 
-def _floats_text(values: np.ndarray) -> list[str]:
+def _take(spelled: list[str], codes: np.ndarray) -> pa.Array:
+    """The spelled distinct values, one per row (codes index into them)."""
+    return pa.array(spelled, type=_TEXT).take(pa.array(codes))
+
+
+def _floats_text(values: np.ndarray) -> pa.Array:
+    """Shortest round-trip text of every float, exactly as :func:`float_text` spells it.
+
+    Arrow formats in C++ with the same shortest digits as Python's repr; they
+    differ only in where they switch to exponent notation and in dropping
+    '.0', so those few cells are re-spelled by float_text.
+    """
     values = values.astype(np.float64, copy=False)
     bad = ~np.isfinite(values)
     if bad.any():
         row = _first(bad)
-        raise _CellError(
-            row,
-            f"{float(values[row])!r} cannot be written as a Prolog float; replace NaN/inf first",
+        reason = (
+            f"{float(values[row])!r} cannot be written as a Prolog float; replace NaN/inf first"
         )
-    out = list(map(repr, values.tolist()))
-    # repr switches to exponent form outside [1e-4, 1e16); only those may lack a '.'
+        raise _CellError(row, reason)
+    text = pc.cast(pa.array(values), _TEXT)
     magnitude = np.abs(values)
-    for i in np.flatnonzero((magnitude != 0) & ((magnitude < 1e-4) | (magnitude >= 1e16))).tolist():
-        out[i] = float_text(values[i])
-    return out
+    fix = (magnitude != 0) & ((magnitude < 1e-4) | (magnitude >= 1e15))
+    fix |= ~pc.match_substring(text, ".").to_numpy(zero_copy_only=False)
+    where = np.flatnonzero(fix)
+    if len(where) == 0:
+        return text
+    spelled = pa.array([float_text(v) for v in values[where].tolist()], type=_TEXT)
+    return pc.replace_with_mask(text, pa.array(fix), spelled)
 
 
-def _by_unique(values: np.ndarray, spell: Any, key: str) -> list[str]:
+def _by_unique(values: np.ndarray, spell: Any, key: str) -> pa.Array:
     """Spell each distinct value once. ``key='value'`` factorises by equality (exact
     for str and int), ``key='id'`` by object identity (exact for anything: 1, 1.0,
     True and -0.0/0.0 compare equal but are written differently)."""
@@ -98,18 +112,18 @@ def _by_unique(values: np.ndarray, spell: Any, key: str) -> list[str]:
         codes, uniques = pd.factorize(ids)
         first = np.empty(len(uniques), dtype=np.int64)
         first[codes[::-1]] = np.arange(n - 1, -1, -1)  # first position of each object
-        representatives = values[first]
+        representatives = values[first].tolist()
     else:
         codes, representatives = pd.factorize(values)
-        first = None
+        representatives, first = list(representatives), None
     spelled = []
-    for k, value in enumerate(representatives.tolist() if key == "value" else representatives):
+    for k, value in enumerate(representatives):
         try:
             spelled.append(spell(value))
         except FactError as exc:
             row = int(first[k]) if first is not None else _first(codes == k)
             raise _CellError(row, str(exc)) from None
-    return np.asarray(spelled, dtype=object)[codes].tolist()
+    return _take(spelled, codes)
 
 
 def _spell_term_text(value: Any) -> str:
@@ -124,27 +138,35 @@ def _spell(value: Any) -> str:
     return format_value(value)
 
 
-def _column_text(series: pd.Series, term_text: bool) -> list[str]:
+def _column_text(series: pd.Series, term_text: bool) -> pa.Array:
     """Prolog text of every cell of one column (see the module docstring)."""
     dtype = series.dtype
     if isinstance(dtype, pd.CategoricalDtype):
-        if (series.cat.codes.to_numpy() < 0).any():
-            raise _CellError(_first(series.cat.codes.to_numpy() < 0), "missing value (NaN)")
-        cats = _column_text(pd.Series(series.cat.categories), term_text)
-        return np.asarray(cats, dtype=object)[series.cat.codes.to_numpy()].tolist()
+        codes = series.cat.codes.to_numpy()
+        if (codes < 0).any():
+            raise _CellError(_first(codes < 0), "missing value (NaN)")
+        categories = _column_text(pd.Series(series.cat.categories), term_text)
+        return categories.take(pa.array(codes))
     if isinstance(dtype, pd.api.extensions.ExtensionDtype) and not isinstance(dtype, np.dtype):
         missing = series.isna().to_numpy()
         if missing.any():
             raise _CellError(_first(missing), "missing value (NA)")
+        if isinstance(dtype, pd.StringDtype):  # factorise without making a Python str per cell
+            codes, uniques = series.factorize()
+            spell = _spell_term_text if term_text else atom_text
+            try:
+                return _take([spell(u) for u in uniques.tolist()], codes)
+            except FactError:
+                return _by_unique(series.to_numpy(dtype=object), spell, "value")
         np_dtype = getattr(dtype, "numpy_dtype", None)
         target = np_dtype if np_dtype is not None and np_dtype.kind in "biuf" else object
         series = pd.Series(series.to_numpy(dtype=target))
     values = series.to_numpy()
     kind = values.dtype.kind
     if kind == "b":
-        return np.where(values, "true", "false").astype(object).tolist()
+        return pc.if_else(pa.array(values), _TRUE, _FALSE)
     if kind in "iu":
-        return _ints_text(values)
+        return pc.cast(pa.array(values), _TEXT)
     if kind == "f":
         return _floats_text(values)
     if kind in "OSU":
@@ -159,26 +181,33 @@ def _column_text(series: pd.Series, term_text: bool) -> list[str]:
         if inferred == "floating":
             return _floats_text(values.astype(np.float64))
         if inferred == "boolean":
-            return np.where(values.astype(bool), "true", "false").astype(object).tolist()
+            return pc.if_else(pa.array(values.astype(bool)), _TRUE, _FALSE)
         return _by_unique(values, _spell, "id")
     raise _CellError(-1, f"columns of dtype {values.dtype} cannot be written as Prolog terms")
 
 
-def _table_lines(name: str, df: pd.DataFrame, term_cols: set[str]) -> Iterable[str]:
-    """The facts of one table as text blocks of up to CHUNK_ROWS lines."""
-    prefix = atom_text(name) + "("
-    joiner = ").\n" + prefix
+def _table_blocks(name: str, df: pd.DataFrame, term_cols: set[str]) -> Iterable[memoryview]:
+    """The facts of one table as UTF-8 blocks of up to CHUNK_ROWS lines.
+
+    Lines are assembled by Arrow in C++ ("name(" + cells joined by "," +
+    ").\n"); the block is the Arrow string array's data buffer itself.
+    """
+    prefix, end = pa.scalar(atom_text(name) + "(", _TEXT), pa.scalar(").\n", _TEXT)
     columns = list(df.columns)
     for start in range(0, len(df), CHUNK_ROWS):
         block = df.iloc[start : start + CHUNK_ROWS]
-        texts = []
+        cells = []
         for position, col in enumerate(columns):
             try:
-                texts.append(_column_text(block.iloc[:, position], str(col) in term_cols))
+                cells.append(_column_text(block.iloc[:, position], str(col) in term_cols))
             except _CellError as exc:
                 where = f", row {start + exc.row}" if exc.row >= 0 else ""
                 raise FactError(f"table {name!r}{where}, column {col!r}: {exc.reason}") from None
-        yield prefix + joiner.join(map(",".join, zip(*texts, strict=True))) + ").\n"
+        body = pc.binary_join_element_wise(*cells, pa.scalar(",", _TEXT))
+        lines = pc.binary_join_element_wise(prefix, body, end, pa.scalar("", _TEXT))
+        offsets = np.frombuffer(lines.buffers()[1], dtype=np.int64)
+        first, last = offsets[lines.offset], offsets[lines.offset + len(lines)]
+        yield memoryview(lines.buffers()[2])[first:last]
 
 
 def _indicator(spec: str | tuple[str, int]) -> tuple[str, int]:
@@ -244,16 +273,15 @@ def write_prolog(
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with open(fd, "w", encoding="utf-8", newline="\n") as out:
-            for line in (header or "").splitlines():
-                out.write(f"% {line}".rstrip() + "\n")
-            out.write(":- encoding(utf8).\n")
-            for name, arity in declared:
-                out.write(f":- dynamic {atom_text(name)}/{arity}.\n")
+        with open(fd, "wb") as out:
+            lines = [f"% {line}".rstrip() for line in (header or "").splitlines()]
+            lines.append(":- encoding(utf8).")
+            lines += [f":- dynamic {atom_text(name)}/{arity}." for name, arity in declared]
+            out.write(("\n".join(lines) + "\n").encode("utf-8"))
             for name, df in tables.items():
                 if len(df):
-                    out.write("\n")
-                    for block in _table_lines(name, df, term_columns.get(name, set())):
+                    out.write(b"\n")
+                    for block in _table_blocks(name, df, term_columns.get(name, set())):
                         out.write(block)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
