@@ -18,8 +18,16 @@ Values cross the boundary as data, never as goal text:
 Output variables are the goal's named variables that are not inputs; names
 starting with ``_`` are left out. Any Prolog error (syntax, unknown
 procedure, type) raises :class:`~neurosym.errors.PrologError` with Prolog's
-message on one line. Large fact files load from ``.qlf`` with ``qlf=True``
-(compiled on first use, recompiled when the source is newer).
+message on one line; load errors name the file and line, load warnings
+become :class:`PrologWarning`.
+
+Several fact files add up: predicates already loaded are declared multifile
+before the next file, so a second ``relation/7`` file extends the first
+instead of replacing it. Large fact files load from ``.qlf`` with
+``qlf=True`` (compiled by :func:`neurosym.prolog.qlf.qcompile` on first use,
+again when the source is newer or the ``.qlf`` cannot be read); the
+``dynamic``/``discontiguous``/``multifile`` directives in such files apply to
+the KB's module, other directives run in module ``neurosym_qlf``.
 """
 
 from __future__ import annotations
