@@ -183,6 +183,21 @@ def test_mhdpa_trace_builds_maps_on_demand_and_the_agents_focus(mh: Recording) -
     assert tr.mhdpa_focus.tolist() == [[91, 6]] * 5
 
 
+def test_objects_are_found_by_entity_cell_or_id(mh: Recording) -> None:
+    tr = trace_from_recording(mh)
+    ids = mh.positions.loc[
+        (mh.positions["t"] == 0) & (mh.positions["type"] == "teleport"), "object"
+    ].tolist()
+    assert tr.locate(0, "sword") == (0, 6, "sword")
+    assert tr.locate(4, "agent") == (8, 8, "agent")
+    assert tr.locate(0, cell=(8, 8)) == (8, 8, "teleport")
+    assert tr.locate(0, ids[1]) == (8, 8, f"{ids[1]} = teleport")
+    with pytest.raises(
+        ConfigError, match=rf"pick one with --cell \(3,9 8,8\) or an id \({ids[0]}, {ids[1]}\)"
+    ):
+        tr.locate(0, "teleport")
+
+
 def test_unknown_episode_is_refused(pn: Recording) -> None:
     with pytest.raises(
         ConfigError, match=r"--episode 3 is not in the recording: it has episodes 0"

@@ -23,7 +23,7 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
-from neurosym.viz.trace import EpisodeTrace, require_module
+from neurosym.viz.trace import OBJECT_COLUMNS, EpisodeTrace, require_module
 
 POSITION_COMPONENTS = 4
 """R^h ends with the (row, col) of E1 and of E2"""
@@ -84,6 +84,7 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
         heads=heads,
         relations=relations,
         complete=False,
+        objects=positions[OBJECT_COLUMNS].reset_index(drop=True),
     )
     if module == "predinet":
         a1, a2 = _sparse_argument_maps(attends, n_steps, heads, shape)
@@ -346,12 +347,13 @@ class _Play:
         self.predinet: list[Any] = []  # per step: the numpy introspection record (small)
         self.attention: dict[int, np.ndarray] = {}  # MHDPA, kept steps only
         self.focus: list[np.ndarray] = []  # MHDPA, per step (heads,)
+        self.object_rows: list[tuple[int, str, str, int, int]] = []
 
     def _grid(self) -> np.ndarray:
         return self.names[np.asarray(self.env.unwrapped.entity_grid())]
 
     def run(self, limit: int) -> None:
-        obs, _ = self.env.reset(seed=self.seed)
+        obs, info = self.env.reset(seed=self.seed)
         expected = tuple(self.agent.config.obs_shape)
         if tuple(obs.shape) != expected:
             raise ConfigError(
@@ -360,6 +362,7 @@ class _Play:
             )
         action_names = _action_names()
         self.grids.append(self._grid())
+        self._objects(0, info)
         for t in range(limit):
             acts, intro = self.agent.act(
                 obs[None], greedy=self.greedy, introspect=True, generator=self.generator
@@ -371,9 +374,15 @@ class _Play:
             self.rewards.append(float(reward))
             self.events.extend((t, str(e)) for e in info.get("events", ()))
             self.grids.append(self._grid())
+            self._objects(t + 1, info)
             if terminated or truncated:
                 self.outcome = info.get("outcome") or ("timeout" if truncated else None)
                 break
+
+    def _objects(self, t: int, info: dict[str, Any]) -> None:
+        self.object_rows.extend(
+            (t, str(i), str(k), int(r), int(c)) for i, k, r, c in info.get("objects", ())
+        )
 
     def _keep(self, t: int, intro: Any) -> None:
         if self.module == "predinet":
@@ -407,6 +416,7 @@ class _Play:
             outcome=None if self.outcome is None else str(self.outcome),
             heads=heads,
             complete=True,
+            objects=pd.DataFrame(self.object_rows, columns=OBJECT_COLUMNS),
         )
         if self.module == "predinet":
             n, h, j = config.n_entities, len(heads), int(config.relations)

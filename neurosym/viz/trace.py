@@ -23,6 +23,8 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 
+OBJECT_COLUMNS = ["t", "object", "type", "row", "col"]
+
 
 @dataclass(frozen=True)
 class EpisodeTrace:
@@ -64,6 +66,8 @@ class EpisodeTrace:
     """MHDPA state t -> (heads, N, N) query x key weights; NaN where not recorded"""
     mhdpa_focus: np.ndarray | None = None
     """MHDPA (S, heads) cell the agent's cell attends to most; -1 where unknown"""
+    objects: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=OBJECT_COLUMNS))
+    """columns t, object, type, row, col: the named objects (ids such as lock_red_2) per state"""
 
     @property
     def steps(self) -> int:
@@ -118,9 +122,11 @@ class EpisodeTrace:
     def locate(
         self, t: int, name: str | None = None, cell: tuple[int, int] | None = None
     ) -> tuple[int, int, str]:
-        """(row, col, entity) of the object a picture is about, by name or by cell, at state t.
+        """(row, col, label) of the object a picture is about at state t.
 
-        A name held by several cells (walls, pits) needs a cell to pick one.
+        ``name`` is an entity (``enemy``, ``key(red)``) or an object id
+        (``lock_red_2``); an entity held by several cells (walls, pits, the two
+        teleport ends) needs ``cell`` or an id to pick one.
         """
         grid = self.grids[t]
         h, w = self.shape
@@ -131,9 +137,14 @@ class EpisodeTrace:
             return row, col, str(grid[row, col])
         name = name or "agent"
         hits = np.argwhere(grid == name)
+        now = self.objects.loc[self.objects["t"] == t]
         if len(hits) == 1:
             return int(hits[0][0]), int(hits[0][1]), name
         if len(hits) == 0:
+            by_id = now.loc[now["object"] == name]
+            if len(by_id) == 1:
+                r, c = int(by_id["row"].iloc[0]), int(by_id["col"].iloc[0])
+                return r, c, f"{name} = {grid[r, c]}"
             present = ", ".join(sorted(set(grid.ravel().tolist()) - {"empty"}))
             raise ConfigError(
                 f"--object {name}: no {name} on the grid at step {t} (there are: {present})"
@@ -141,8 +152,12 @@ class EpisodeTrace:
         where = " ".join(f"{r},{c}" for r, c in hits[:4].tolist()) + (
             " ..." if len(hits) > 4 else ""
         )
+        ids = now.loc[now["type"] == name, "object"].astype(str).tolist()
+        by = f"--cell ({where})" + (
+            f" or an id ({', '.join(ids[:4])})" if 0 < len(ids) <= 4 else ""
+        )
         raise ConfigError(
-            f"--object {name}: {len(hits)} cells hold {name} at step {t}; pick one with --cell ({where})"
+            f"--object {name}: {len(hits)} cells hold {name} at step {t}; pick one with {by}"
         )
 
     def event_text(self, t: int) -> str:
