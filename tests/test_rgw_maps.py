@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from neurosym.envs.rgw import RGWEnv
@@ -23,11 +24,15 @@ RGW2_OBJECTS = {
 
 
 def objects_by_type(name: str) -> dict[str, list[tuple[int, int]]]:
+    """The layout as the entity grid names it (terrain included)."""
     env = RGWEnv(name)
-    _, info = env.reset(seed=0)
+    env.reset(seed=0)
+    grid = env.entity_grid()
     out: dict[str, list[tuple[int, int]]] = {}
-    for _, kind, r, c in info["objects"]:
-        out.setdefault(kind, []).append((r, c))
+    for (r, c), code in np.ndenumerate(grid):
+        kind = env.entity_names[code]
+        if kind != "empty":
+            out.setdefault(kind, []).append((r, c))
     return {k: sorted(v) for k, v in out.items()}
 
 
@@ -44,21 +49,24 @@ def test_object_ids_are_unique_atoms() -> None:
     env = RGWEnv("rgw2")
     _, info = env.reset(seed=0)
     ids = [o[0] for o in info["objects"]]
+    terrain = ("agent", "wall", "mountain")
     assert (
         len(ids)
         == len(set(ids))
-        == 1 + sum(len(v) for k, v in RGW2_OBJECTS.items() if k != "agent")
+        == 1 + sum(len(v) for k, v in RGW2_OBJECTS.items() if k not in terrain)
     )
-    assert {
+    assert set(ids) == {
         "agent",
         "sword",
         "enemy",
         "terminal",
         "teleport_1",
         "teleport_2",
-        "wall_1",
+        "pit_1",
         "pit_2",
-    } <= set(ids)
+    }
+    # Walls and mountains are terrain: named by the entity grid, not listed as objects.
+    assert not {kind for _, kind, _, _ in info["objects"]} & {"wall", "mountain"}
 
 
 def test_map_text_round_trip() -> None:

@@ -18,6 +18,9 @@ import numpy as np
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.rgw_maps import GridMap
 
+TERRAIN = np.array([rules.EMPTY, rules.WALL, rules.MOUNTAIN])
+"""entity codes that are not named objects (see LevelObjects)"""
+
 ObjectRow = tuple[str, str, int, int]
 """(id, type, row, col) as info["objects"] lists them"""
 
@@ -25,15 +28,18 @@ ObjectRow = tuple[str, str, int, int]
 class LevelObjects:
     """The named objects of one level: unique ids in row-major order.
 
-    An object type that occurs once is named by its type (``sword``, ``terminal``);
-    types that occur several times are numbered ``wall_1``, ``wall_2``, ... The
+    Walls and mountains are terrain, not objects: they never move, a map has
+    dozens of them, and listing them would multiply the ``at/5`` facts of every
+    recorded step; the entity grid still names their cells. An object type that
+    occurs once is named by its type (``sword``, ``terminal``); types that occur
+    several times are numbered ``pit_1``, ``pit_2``, ... The
     agent is always ``agent``. Swords and enemies carry a bit so that the objects
     still on the map can be listed from a ``removed`` bitmask.
     """
 
     def __init__(self, cells: np.ndarray, width: int) -> None:
         codes = rules.ENTITY_OF_CELL[np.asarray(cells)]
-        present = np.flatnonzero(codes != rules.EMPTY)
+        present = np.flatnonzero(~np.isin(codes, TERRAIN))
         counts = np.bincount(codes[present], minlength=len(rules.ENTITY_NAMES))
         seen = [0] * len(rules.ENTITY_NAMES)
         rows: list[tuple[ObjectRow, int]] = []
