@@ -16,8 +16,9 @@ from neurosym.export.thresholds import parse_threshold
 from neurosym.viz import episode as ep_mod
 from neurosym.viz.attention import mhdpa_figure
 from neurosym.viz.output import figure_bytes, gif_bytes, save_figure
-from neurosym.viz.predinet import predinet_figure, r_vectors_figure, relations_figure
-from neurosym.viz.sources import trace_from_recording
+from neurosym.viz.predinet import predinet_figure, r_vectors_figure
+from neurosym.viz.recorded import trace_from_recording
+from neurosym.viz.relations import relations_figure
 
 LAYOUT = (
     "A....MSMMM",

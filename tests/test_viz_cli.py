@@ -235,7 +235,8 @@ def test_a_recording_and_a_live_run_of_the_same_seed_draw_the_same_episode(
     """The grid rebuilt from the recording's positions equals the env's own entity grid, state by state."""
     import numpy as np
 
-    from neurosym.viz.sources import trace_from_agent, trace_from_recording
+    from neurosym.viz.live import trace_from_agent
+    from neurosym.viz.recorded import trace_from_recording
 
     agent = load_agent(files[module])
     recorded = trace_from_recording(record(agent, "rgw2", episodes=2, seed=4), 1)
@@ -248,3 +249,15 @@ def test_a_recording_and_a_live_run_of_the_same_seed_draw_the_same_episode(
         np.testing.assert_allclose(recorded.r_vectors, live.r_vectors, atol=1e-6)
     else:
         assert (recorded.mhdpa_focus == live.mhdpa_focus).all()
+
+
+def test_the_default_threshold_is_extracts() -> None:
+    import argparse
+
+    from neurosym.export.facts import DEFAULT_THRESHOLD
+    from neurosym.viz.cli_plot import configure
+
+    parser = argparse.ArgumentParser()
+    configure(parser)
+    args = parser.parse_args(["relations", "--recording", "r", "--out", "x.png"])
+    assert args.threshold == DEFAULT_THRESHOLD

@@ -21,8 +21,8 @@ _LAZY = {
     "mhdpa_figure": "neurosym.viz.attention",
     "predinet_figure": "neurosym.viz.predinet",
     "r_vectors_figure": "neurosym.viz.predinet",
-    "relations_figure": "neurosym.viz.predinet",
-    "relation_values": "neurosym.viz.predinet",
+    "relations_figure": "neurosym.viz.relations",
+    "relation_values": "neurosym.viz.relations",
     "episode_figure": "neurosym.viz.episode",
     "episode_frames": "neurosym.viz.episode",
     "save_episode_gif": "neurosym.viz.episode",
@@ -30,8 +30,8 @@ _LAZY = {
     "save_gif": "neurosym.viz.output",
     "EpisodeTrace": "neurosym.viz.trace",
     "load_trace": "neurosym.viz.sources",
-    "trace_from_recording": "neurosym.viz.sources",
-    "trace_from_agent": "neurosym.viz.sources",
+    "trace_from_recording": "neurosym.viz.recorded",
+    "trace_from_agent": "neurosym.viz.live",
 }
 
 __all__ = list(_LAZY)

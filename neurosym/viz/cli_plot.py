@@ -39,7 +39,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
             which.add_argument(
                 "--object",
                 default=None,
-                help="entity whose attention to draw, e.g. agent, enemy, key(red) (default: agent)",
+                help="entity or object id whose attention to draw: agent, enemy, key(red), lock_red_2 (default: agent)",
             )
             which.add_argument(
                 "--cell",
@@ -55,6 +55,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
                 "--max-steps",
                 type=int,
                 default=None,
+                metavar="N",
                 help="with --checkpoint: stop the episode after this many steps (default: the env's limit)",
             )
         if name == "relations":
@@ -162,7 +163,7 @@ def _load_source(args: argparse.Namespace) -> Any:
 
 def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
     """Draw and write; returns a short description of what was written."""
-    from neurosym.viz import attention, episode, predinet
+    from neurosym.viz import attention, episode, predinet, relations
     from neurosym.viz.output import save_figure
 
     where = {"episode": args.episode, "seed": args.episode_seed or 0}
@@ -183,7 +184,7 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
             source, args.env, head=args.head, max_steps=_positive(args.max_steps), **where
         )
     elif args.plot == "relations":
-        fig = predinet.relations_figure(
+        fig = relations.relations_figure(
             source, args.env, threshold=args.threshold, episodes=args.episodes, seed=where["seed"]
         )
     elif fmt == "gif":

@@ -1,37 +1,27 @@
-"""PrediNet pictures: where each head looks, its R vectors over time, and the relation values.
+"""PrediNet pictures: where each head looks at one step, and its R vectors over an episode.
 
 * :func:`predinet_figure` -- per head, the two attention maps a1 and a2 over the
   grid at one step, the attended objects named and framed, D^h in the note.
 * :func:`r_vectors_figure` -- R^h of every head over an episode as a heat map:
   the J relation values (diverging colours, one scale for all heads, since W_S
   is shared) above the four position values of E1 and E2 (0..1).
-* :func:`relations_figure` -- each relation's distribution of values over all
-  heads and steps, with the threshold that ``neurosym extract`` would apply
-  drawn at +/- its value (|D_j| above it becomes a ``holds/5`` fact).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from neurosym.errors import ConfigError
-from neurosym.export.recording import Recording
 from neurosym.viz.panels import Panel, heat_map_figure
-from neurosym.viz.sources import load_trace, require_source_module, trace_from_agent
+from neurosym.viz.sources import load_trace, require_source_module
 from neurosym.viz.style import head_colour
 from neurosym.viz.trace import EpisodeTrace
-
-DEFAULT_THRESHOLD = "quantile:0.9"
-"""the threshold spec ``neurosym extract`` uses by default"""
 
 NOT_RECORDED = (
     "grey cells: weight not recorded (the recording keeps only each head's strongest cell)"
@@ -42,14 +32,6 @@ R_WIDTH_INCHES = 8.0
 
 R_HEAD_INCHES = 1.6
 """height of one head's block in the R-vector heat map"""
-
-HIST_PANEL_INCHES = (2.6, 2.2)
-"""(width, height) of one relation's histogram"""
-
-HIST_COLUMNS = 4
-"""relations per row of the histogram figure"""
-
-_BINS = 40
 
 
 # ---------------------------------------------------------------------------
@@ -230,132 +212,3 @@ def _mark_events(axes: Sequence[Any], trace: EpisodeTrace) -> None:
             va="bottom",
         )
         label.set_in_layout(False)
-
-
-# ---------------------------------------------------------------------------
-# distributions of relation values
-
-
-def relation_values(
-    source: Any, env: Any = None, *, episodes: int = 1, seed: int = 0
-) -> tuple[pd.DataFrame, str]:
-    """The relation table (episode, t, head, j, value) and a phrase saying where it came from.
-
-    A Recording gives its ``relations`` table; an Agent plays ``episodes``
-    episodes from seeds ``seed, seed + 1, ...``; an EpisodeTrace gives its own.
-    """
-    require_source_module(source, "predinet", "a relation-value plot")
-    if isinstance(source, EpisodeTrace):
-        return _trace_relations([source]), source.title_name
-    if isinstance(source, Recording):
-        table = source.relations.loc[:, ["episode", "t", "head", "j", "value"]]
-        name = str(source.meta.get("checkpoint", "")) or "recording"
-        n = int(source.episodes["episode"].nunique())
-        return (
-            table,
-            f"{_base(name)} on {source.meta.get('env', '?')}, {n} recorded episode{'s' * (n != 1)}",
-        )
-    if episodes < 1:
-        raise ConfigError(f"--episodes must be at least 1, got {episodes}")
-    traces = [trace_from_agent(source, env, seed=seed + e) for e in range(episodes)]
-    traces = [replace(t, episode=e) for e, t in enumerate(traces)]  # number the episodes 0..n-1
-    seeds = f"seed {seed}" if episodes == 1 else f"seeds {seed}..{seed + episodes - 1}"
-    env_name = traces[0].env
-    return (
-        _trace_relations(traces),
-        f"{_base(str(source.path))} on {env_name}, {episodes} greedy episode{'s' * (episodes != 1)} ({seeds})",
-    )
-
-
-def _base(path: str) -> str:
-    return Path(path).name or path
-
-
-def _trace_relations(traces: Sequence[EpisodeTrace]) -> pd.DataFrame:
-    frames = []
-    for tr in traces:
-        assert tr.r_vectors is not None
-        d = tr.r_vectors[:, :, : tr.relations]  # (S, heads, J)
-        s, h, j = d.shape
-        t_idx, h_idx, j_idx = np.meshgrid(
-            np.arange(s), np.asarray(tr.heads), np.arange(j), indexing="ij"
-        )
-        frames.append(
-            pd.DataFrame(
-                {
-                    "episode": tr.episode,
-                    "t": t_idx.ravel(),
-                    "head": h_idx.ravel(),
-                    "j": j_idx.ravel(),
-                    "value": d.ravel(),
-                }
-            )
-        )
-    table = pd.concat(frames, ignore_index=True)
-    return table.loc[np.isfinite(table["value"].to_numpy())]
-
-
-def relations_figure(
-    source: Any,
-    env: Any = None,
-    *,
-    threshold: Any = DEFAULT_THRESHOLD,
-    episodes: int = 1,
-    seed: int = 0,
-) -> Figure:
-    """Histogram of each relation's values, per head and together, with its threshold marked.
-
-    Size: (2.6 * columns + 0.4) x (2.2 * rows + 1.0) inches, 4 relations per row.
-    """
-    from neurosym.export.thresholds import parse_threshold
-
-    rule = parse_threshold(threshold)
-    table, where = relation_values(source, env, episodes=episodes, seed=seed)
-    if table.empty:
-        raise ConfigError("there are no relation values to plot (the episodes have no steps)")
-    per_j = rule.per_relation(table)
-    js = sorted(int(j) for j in table["j"].unique())
-    heads = sorted(int(h) for h in table["head"].unique())
-    n_cols = min(HIST_COLUMNS, len(js))
-    n_rows = -(-len(js) // n_cols)
-    fig = Figure(
-        figsize=(HIST_PANEL_INCHES[0] * n_cols + 0.4, HIST_PANEL_INCHES[1] * n_rows + 1.0),
-        layout="constrained",
-    )
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
-    values = table["value"].to_numpy()
-    j_col = table["j"].to_numpy()
-    h_col = table["head"].to_numpy()
-    for k, ax in enumerate(axes.ravel()):
-        if k >= len(js):
-            ax.set_axis_off()
-            continue
-        j = js[k]
-        mine = j_col == j
-        v = values[mine]
-        edges = np.histogram_bin_edges(v, bins=_BINS)
-        ax.hist(v, bins=edges, color="#d0d0d0", label="all heads")
-        for i, hd in enumerate(heads):
-            ax.hist(
-                v[h_col[mine] == hd],
-                bins=edges,
-                histtype="step",
-                color=head_colour(i),
-                linewidth=1.0,
-                label=f"head {hd}",
-            )
-        thr = float(per_j.get(j, np.nan))
-        kept = int(np.sum(np.abs(v) > thr)) if np.isfinite(thr) else 0
-        if np.isfinite(thr):
-            for x in (-thr, thr):
-                ax.axvline(x, color="black", linestyle="--", linewidth=1.0)
-        ax.set_title(f"r({j}): threshold ±{thr:.3g}, {kept} of {len(v)} kept", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7)
-    axes[0, 0].set_ylabel("steps x heads", fontsize=7)
-    axes[0, 0].legend(fontsize=6, frameon=False, loc="upper left")
-    fig.suptitle(
-        f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}",
-        fontsize=10,
-    )
-    return fig

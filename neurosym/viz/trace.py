@@ -24,6 +24,10 @@ import pandas as pd
 from neurosym.errors import ConfigError
 
 OBJECT_COLUMNS = ["t", "object", "type", "row", "col"]
+"""columns of :attr:`EpisodeTrace.objects` (the recording's ``positions`` without ``episode``)"""
+
+POSITION_COMPONENTS = 4
+"""R^h ends with the (row, col) of E1 and of E2"""
 
 
 @dataclass(frozen=True)
