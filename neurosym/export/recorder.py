@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import datetime as _dt
 from collections.abc import Callable
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -65,25 +66,77 @@ class _Columns:
         parts = self.chunks.get(name, [])
         return np.concatenate(parts) if parts else np.zeros(0)
 
+    def sorted_by(self, key: str) -> dict[str, np.ndarray]:
+        """Every column, rows ordered by ``key`` (stable: rows were appended in time order)."""
+        cols = {name: self.get(name) for name in self.chunks}
+        if key not in cols:
+            return cols
+        order = np.argsort(cols[key], kind="stable")
+        return {name: col[order] for name, col in cols.items()}
+
 
 class _Trace:
-    """The symbolic side of the episodes (positions, holding, events), from decoded infos."""
+    """The symbolic side of the episodes (positions, holding, events), from decoded infos.
+
+    Per state it keeps one reference to the decoded tuples; the columns are
+    built at the end by chaining them (no Python object per table row until then).
+    """
 
     def __init__(self) -> None:
-        self.pos: list[tuple[int, int, str, str, int, int]] = []
-        self.holding: list[tuple[int, int, str]] = []
-        self.events: list[tuple[int, int, str]] = []
+        self.keys: list[tuple[int, int]] = []  # (episode, t) of each state
+        self.objects: list[tuple] = []  # (id, type, row, col) rows of each state
+        self.held: list[tuple] = []  # held items of each state
+        self.event_keys: list[tuple[int, int]] = []  # (episode, t) of each transition
+        self.events: list[tuple] = []  # event texts of each transition
 
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
-        objects = info["objects"]
-        if not any(
-            obj[0] == "agent" for obj in objects[:1]
-        ):  # RGW lists the agent first, Box-World not
-            row, col = info["agent"]
-            self.pos.append((episode, t, "agent", "agent", int(row), int(col)))
-        self.pos.extend((episode, t, oid, otype, int(r), int(c)) for oid, otype, r, c in objects)
-        self.holding.extend((episode, t, item) for item in info["holding"])
+        objects = tuple(info["objects"])
+        if not objects or objects[0][0] != "agent":  # the envs list the agent first; be sure
+            objects = (("agent", "agent", *info["agent"]), *objects)
+        self.keys.append((episode, t))
+        self.objects.append(objects)
+        self.held.append(tuple(info["holding"]))
+
+    def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
+        """Events of the step taken in state t."""
+        self.event_keys.append((episode, t))
+        self.events.append(tuple(info["events"]))
+
+    @staticmethod
+    def _expand(
+        keys: list[tuple[int, int]], groups: list[tuple]
+    ) -> tuple[np.ndarray, np.ndarray, list]:
+        """(episode, t) repeated per row of each group, and the rows chained."""
+        lens = np.fromiter(map(len, groups), dtype=np.int64, count=len(groups))
+        key = np.array(keys, dtype=np.int64).reshape(-1, 2)
+        return (
+            np.repeat(key[:, 0], lens),
+            np.repeat(key[:, 1], lens),
+            list(chain.from_iterable(groups)),
+        )
+
+    def tables(self) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+        """positions, holding and events, ordered by episode then t."""
+        ep, t, rows = self._expand(self.keys, self.objects)
+        ids, types, r, c = (
+            (list(col) for col in zip(*rows, strict=True)) if rows else ([], [], [], [])
+        )
+        positions = pd.DataFrame(
+            {
+                "episode": ep,
+                "t": t,
+                "object": ids,
+                "type": types,
+                "row": np.asarray(r, np.int64),
+                "col": np.asarray(c, np.int64),
+            }
+        )
+        ep, t, items = self._expand(self.keys, self.held)
+        holding = pd.DataFrame({"episode": ep, "t": t, "item": items})
+        ep, t, events = self._expand(self.event_keys, self.events)
+        events_df = pd.DataFrame({"episode": ep, "t": t, "event": events})
+        return _by_episode(positions), _by_episode(holding), _by_episode(events_df)
 
 
 def _resolve_env(agent: Any, env: Any) -> str:
@@ -185,6 +238,12 @@ class _progress_bar:
             self._progress.stop()
 
 
+def _by_episode(df: pd.DataFrame) -> pd.DataFrame:
+    """Rows ordered by episode, then time: rows were appended in time order, so a stable sort suffices."""
+    order = np.argsort(df["episode"].to_numpy(), kind="stable")
+    return df.take(order).reset_index(drop=True)
+
+
 class _Recorder:
     """One recording run: the stepping loop and the table building."""
 
@@ -261,7 +320,7 @@ class _Recorder:
             for i in live.tolist():
                 d = venv.decode_info(info, i)
                 e, s = int(episode[i]), int(t[i]) + 1
-                self.trace.events.extend((e, s - 1, ev) for ev in d["events"])
+                self.trace.transition(e, s - 1, d)
                 self.trace.state(e, s, d)
                 if terminated[i] or truncated[i]:
                     outcome = d["outcome"] or ("timeout" if truncated[i] else "terminal")
@@ -315,49 +374,38 @@ class _Recorder:
         W = self.venv.entity_grid().shape[-1]
         eps = pd.DataFrame(self.ep_rows, columns=["episode", "steps", "return", "outcome", "seed"])
         eps = eps.sort_values("episode", kind="stable")
-        sc = self.step_cols
+        sc = self.step_cols.sorted_by("episode")
         steps = pd.DataFrame(
-            {
-                "episode": sc.get("episode"),
-                "t": sc.get("t"),
-                "action": sc.get("action"),
-                "reward": sc.get("reward"),
-            }
+            {c: sc.get(c, np.zeros(0)) for c in ("episode", "t", "action", "reward")}
         )
-        positions = pd.DataFrame(
-            self.trace.pos, columns=["episode", "t", "object", "type", "row", "col"]
-        )
-        holding = pd.DataFrame(self.trace.holding, columns=["episode", "t", "item"])
-        events = pd.DataFrame(self.trace.events, columns=["episode", "t", "event"])
+        positions, holding, events = self.trace.tables()
         tables: dict[str, pd.DataFrame] = {}
         if self.module == "predinet":
             tables.update(self._predinet_tables(W))
         else:
             tables["attention"] = self._attention_table(W)
-        order = ["episode", "t"]
-        rec = Recording(
+        return Recording(
             episodes=eps,
-            steps=steps.sort_values(order, kind="stable"),
-            positions=positions.sort_values(order, kind="stable"),
-            holding=holding.sort_values(order, kind="stable"),
-            events=events.sort_values(order, kind="stable"),
-            **{k: v.sort_values(order, kind="stable") for k, v in tables.items()},
+            steps=steps,
+            positions=positions,
+            holding=holding,
+            events=events,
+            **tables,  # built from state arrays already in episode order
         )
-        return rec
 
     def _predinet_tables(self, W: int) -> dict[str, pd.DataFrame]:
-        m = self.model
-        ep, t = m.get("ep"), m.get("t")  # (S,)
-        i1, i2 = m.get("i1"), m.get("i2")  # (S, H)
+        m = self.model.sorted_by("ep")
+        ep, t = m["ep"], m["t"]  # (S,) states in episode order
+        i1, i2 = m["i1"], m["i2"]  # (S, H)
         S, H = i1.shape
-        rel = m.get("rel")  # (S, H, J)
-        rvec = m.get("rvec")  # (S, H, J + 4)
+        rel = m["rel"]  # (S, H, J)
+        rvec = m["rvec"]  # (S, H, J + 4)
         J = rel.shape[-1]
         names = self.names
         # attends: per (state, head, arg); arg 1 rows then arg 2 rows, sorted later
         idx = np.stack([i1, i2], axis=-1)  # (S, H, 2)
-        ent = np.stack([m.get("e1"), m.get("e2")], axis=-1)
-        wgt = np.stack([m.get("w1"), m.get("w2")], axis=-1)
+        ent = np.stack([m["e1"], m["e2"]], axis=-1)
+        wgt = np.stack([m["w1"], m["w2"]], axis=-1)
         attends = pd.DataFrame(
             {
                 "episode": np.repeat(ep, H * 2),
@@ -376,8 +424,8 @@ class _Recorder:
                 "t": np.repeat(t, H * J),
                 "head": np.tile(np.repeat(np.arange(H), J), S),
                 "j": np.tile(np.arange(J), S * H),
-                "a": names[np.repeat(m.get("e1").reshape(-1), J)],
-                "b": names[np.repeat(m.get("e2").reshape(-1), J)],
+                "a": names[np.repeat(m["e1"].reshape(-1), J)],
+                "b": names[np.repeat(m["e2"].reshape(-1), J)],
                 "value": rel.reshape(-1).astype(np.float64),
             }
         )
@@ -394,9 +442,9 @@ class _Recorder:
         return {"attends": attends, "relations": relations, "r_vectors": r_vectors}
 
     def _attention_table(self, W: int) -> pd.DataFrame:
-        m = self.model
-        ep, t = m.get("ep"), m.get("t")  # (S,)
-        top, weight, grid = m.get("top"), m.get("weight"), m.get("grid")  # (S, H, N, k), (S, N)
+        m = self.model.sorted_by("ep")
+        ep, t = m["ep"], m["t"]  # (S,) states in episode order
+        top, weight, grid = m["top"], m["weight"], m["grid"]  # (S, H, N, k), (S, N)
         S, H, N, k = top.shape
         query_code = np.broadcast_to(grid[:, None, :, None], (S, H, N, k))
         key_code = np.take_along_axis(
