@@ -174,6 +174,18 @@ def test_trace_rebuilds_grids_route_and_sparse_maps(pn: Recording) -> None:
     assert tr.event_text(3) == "teleported"
 
 
+def test_without_its_env_a_recording_is_drawn_from_its_positions_alone(pn: Recording) -> None:
+    from dataclasses import replace
+
+    orphan = replace(pn, meta={**pn.meta, "env": "rgw-from-another-version"})
+    tr = trace_from_recording(orphan)
+    assert tr.shape == (10, 10) and tr.env == "rgw-from-another-version"
+    assert (
+        tr.grids[0, 0, 6] == "sword" and tr.grids[0, 6, 0] == "wall"
+    )  # listed in this recording's positions
+    assert tr.agent_path.tolist() == [list(p) for p in ROUTE]
+
+
 def test_mhdpa_trace_builds_maps_on_demand_and_the_agents_focus(mh: Recording) -> None:
     tr = trace_from_recording(mh)
     att = tr.mhdpa[2]  # (heads, N, N)

@@ -13,6 +13,7 @@ environment cannot be built), the cells nobody recorded are drawn as ``empty``.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -54,7 +55,7 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
     attention = _episode_rows(rec.attention, episode)
     r_vectors = _episode_rows(rec.r_vectors, episode)
     env_name = str(meta.get("env", ""))
-    base = _reset_layout(env_name, seed)
+    base = _reset_layout(env_name, seed, meta.get("env_kwargs") or {})
     shape = base.shape if base is not None else _shape_from_tables(positions, attends, attention)
     grids = _grids_from_positions(positions, n_steps, shape, base)
     heads = _head_numbers(meta, attends, attention, r_vectors)
@@ -98,22 +99,26 @@ def _list(values: list[int]) -> str:
     return ", ".join(map(str, values))
 
 
-def _reset_layout(env_name: str, seed: int | None) -> np.ndarray | None:
-    """(H, W) entity names right after ``reset(seed)``, or None when the env cannot be built."""
+def _reset_layout(env_name: str, seed: int | None, kwargs: dict[str, Any]) -> np.ndarray | None:
+    """(H, W) entity names right after ``reset(seed)``, or None when the env cannot be built.
+
+    Env options come from ``meta["env_kwargs"]`` when the recording has them
+    (a checkpoint trained on a custom map); without them the registered env is used.
+    """
+    import gymnasium
+
+    from neurosym.envs import make
+    from neurosym.errors import NeurosymError
+
     try:
-        from neurosym.envs import make
-    except ImportError:
-        return None
-    try:
-        env = make(env_name)
+        env = make(env_name, **kwargs)
         env.reset(seed=seed)
-        base = env.unwrapped
-        names = np.asarray(base.entity_names, dtype=object)
-        grid = names[np.asarray(base.entity_grid())]
-        env.close()
-        return grid
-    except Exception:  # an env name from another version, a missing map: draw without a layout
-        return None
+    except (NeurosymError, gymnasium.error.Error, TypeError, OSError):
+        return None  # an env of another version, a map file that moved: draw without terrain
+    base = env.unwrapped
+    grid = np.asarray(base.entity_names, dtype=object)[np.asarray(base.entity_grid())]
+    env.close()
+    return grid
 
 
 def _shape_from_tables(*tables: pd.DataFrame) -> tuple[int, int]:
