@@ -266,7 +266,10 @@ def test_written_values_are_found_again_through_query_inputs(cells: list[object]
 )
 @given(
     st.lists(
-        floats | st.sampled_from([0.0, -0.0, 100.0, 1e15, 1e16, 1e-4, 9.99e-5, 5e-324, 2.0**63]),
+        floats
+        | st.sampled_from(
+            [0.0, -0.0, 100.0, 1e15, 1e16, 1e-4, 9.99e-5, 5e-324, 2.0**63, 10000000001.0]
+        ),
         min_size=1,
     ),
     st.lists(st.integers(-(2**63), 2**64 - 1), min_size=1),

@@ -93,8 +93,9 @@ def _floats_text(values: np.ndarray) -> pa.Array:
         raise _CellError(row, reason)
     text = pc.cast(pa.array(values), _TEXT)
     magnitude = np.abs(values)
-    fix = (magnitude != 0) & ((magnitude < 1e-4) | (magnitude >= 1e15))
-    fix |= ~pc.match_substring(text, ".").to_numpy(zero_copy_only=False)
+    fix = (magnitude != 0) & ((magnitude < 1e-4) | (magnitude >= 1e16))  # repr's exponent range
+    fix |= ~pc.match_substring(text, ".").to_numpy(zero_copy_only=False)  # '100', '-0'
+    fix |= pc.match_substring(text, "e").to_numpy(zero_copy_only=False)  # Arrow's exponent range
     where = np.flatnonzero(fix)
     if len(where) == 0:
         return text
