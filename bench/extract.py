@@ -62,7 +62,9 @@ def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
     from neurosym.agent.checkpoint import Agent, load_agent
 
     if path.is_file():
-        return load_agent(path, env=env), str(path.relative_to(ROOT) if path.is_relative_to(ROOT) else path)
+        return load_agent(path, env=env), str(
+            path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+        )
     import torch
 
     from neurosym.agent.config import ModelConfig
@@ -71,8 +73,12 @@ def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
 
     probe = make(env)
     torch.manual_seed(0)
-    cfg = ModelConfig.for_family(env_family(env), "predinet", probe.observation_space.shape, probe.unwrapped.obs_scale)
-    return Agent(model=ActorCritic(cfg).eval(), config=cfg, env_name=env, env_kwargs={}, path=None), "untrained"
+    cfg = ModelConfig.for_family(
+        env_family(env), "predinet", probe.observation_space.shape, probe.unwrapped.obs_scale
+    )
+    return Agent(
+        model=ActorCritic(cfg).eval(), config=cfg, env_name=env, env_kwargs={}, path=None
+    ), "untrained"
 
 
 def model_rate(agent: Any, env: str, batch: int, repeats: int = 5) -> float:
@@ -163,10 +169,16 @@ def main() -> None:
     ap.add_argument("--checkpoint", type=Path, default=ROOT / "checkpoints" / "rgw2-predinet.pt")
     ap.add_argument("--env", default="rgw2")
     ap.add_argument("--episodes", type=int, default=256, help="episodes recorded (default 256)")
-    ap.add_argument("--batch", type=int, default=None, help="recorder batch (default: the recorder's)")
+    ap.add_argument(
+        "--batch", type=int, default=None, help="recorder batch (default: the recorder's)"
+    )
     ap.add_argument("--sizes", default="1000,10000,100000", help="KB sizes in episodes")
-    ap.add_argument("--full-max", type=int, default=1000, help="largest KB with every predicate (default 1000)")
-    ap.add_argument("--consult-max", type=int, default=10000, help="largest KB also consulted from source")
+    ap.add_argument(
+        "--full-max", type=int, default=1000, help="largest KB with every predicate (default 1000)"
+    )
+    ap.add_argument(
+        "--consult-max", type=int, default=10000, help="largest KB also consulted from source"
+    )
     args = ap.parse_args()
 
     import torch

@@ -131,3 +131,23 @@ def test_out_that_is_a_file_is_refused(run_neurosym, checkpoint: Path, tmp_path:
     proc = run_neurosym("extract", "--checkpoint", checkpoint, "--env", "rgw2", "--out", out)
     one_line_error(proc, "exists and is not a folder")
     assert out.read_text() == "% someone's file\n"
+
+
+def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
+    """examples/extract_and_query.py goes from a checkpoint to rule answers."""
+    import os
+    import sys
+
+    repo = Path(__file__).resolve().parents[1]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")])),
+    }
+    proc = subprocess.run(
+        [sys.executable, repo / "examples" / "extract_and_query.py", checkpoint, tmp_path / "kb"],
+        capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "sword before enemy in episodes: [" in proc.stdout
+    assert "how the network links sword and enemy:" in proc.stdout
+    assert (tmp_path / "kb" / "kb.pl").is_file()

@@ -1,0 +1,42 @@
+"""From a trained checkpoint to rule answers in a few lines.
+
+    python examples/extract_and_query.py [CHECKPOINT] [OUT_DIR]
+
+Records greedy episodes of the agent on the environment it was trained on,
+thresholds each relation at the 0.9 quantile of its |values|, writes the
+knowledge base and asks the rules what the agent did and what its network
+relates. Defaults: checkpoints/rgw2-predinet.pt, kb_out/example.
+"""
+
+import sys
+from pathlib import Path
+
+import neurosym
+from neurosym.envs import env_family
+
+root = Path(__file__).resolve().parents[1]
+checkpoint = sys.argv[1] if len(sys.argv) > 1 else root / "checkpoints" / "rgw2-predinet.pt"
+out = Path(sys.argv[2] if len(sys.argv) > 2 else "kb_out/example")
+
+agent = neurosym.load_agent(checkpoint)
+recording = neurosym.record(agent, episodes=10, seed=0)  # on the env it was trained on
+facts = neurosym.extract_facts(recording, threshold="quantile:0.9")
+print(facts.summary())
+kb_path = facts.to_prolog(out / "kb.pl")
+
+family = env_family(agent.env_name)  # "rgw" or "boxworld"
+rules = [root / "rules" / f"{family}.pl", root / "rules" / "relations.pl"]
+with neurosym.KnowledgeBase(kb_path, rules=rules) as kb:
+    if family == "rgw":
+        print(
+            "sword before enemy in episodes:", [a["E"] for a in kb.query("sword_before_enemy(E)")]
+        )
+        print("how the network links sword and enemy:", kb.once("sword_enemy_link(A)")["A"])
+    else:
+        print(
+            "reached the gem along the solution:",
+            [a["E"] for a in kb.query("followed_solution(E)")],
+        )
+        print("key-lock links in the network:", kb.query("key_lock_link(C, L)"))
+    print("relations that consistently order two object types:")
+    print(kb.query_df("consistently_orders(J, A, B), A \\== empty, B \\== empty"))
