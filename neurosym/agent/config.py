@@ -147,6 +147,8 @@ class TrainConfig:
     """rollout length per update (Table 4 "buffer": 40)"""
     value_coef: float = 0.5
     """weight of the value loss"""
+    explore: float = 0.0
+    """count-based exploration bonus beta (intrinsic reward beta / sqrt(visits)); 0 = none"""
     rms_eps: float = 0.1
     """RMSprop epsilon (Table 4: 0.1)"""
     rms_alpha: float = 0.99
@@ -166,8 +168,8 @@ class TrainConfig:
                 raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
         if not 0 < self.gamma <= 1 or not 0 < self.rms_alpha < 1:
             raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
-        if self.entropy < 0 or self.value_coef < 0:
-            raise ConfigError("entropy and value_coef must be >= 0")
+        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0:
+            raise ConfigError("entropy, value_coef and explore must be >= 0")
         for name in ("n_steps", "workers", "envs"):
             if int(getattr(self, name)) < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {getattr(self, name)}")

@@ -1,0 +1,181 @@
+"""A3C: the n-step actor-critic update, a shared RMSprop, and the worker process.
+
+Each of W worker processes steps K environments (K = 1 is the classic
+algorithm with one env per worker; the same batched env code runs it) for
+``n_steps`` steps with a local copy of the shared model, then computes the
+loss on that rollout and writes its gradients into the shared model, where a
+:class:`SharedRMSprop` (statistics in shared memory too) applies them without
+locks (Hogwild). Workers run one torch thread each.
+
+Loss per update, over the valid transitions of the rollout (the autoreset
+steps of the batched env are masked out), summed over time and averaged over
+the K envs so that the gradient scale does not grow with K::
+
+    G_t = r_t + gamma * (0 if terminated_t else V(o_{t+1}) if truncated_t else G_{t+1})
+    loss = -sum log pi(a_t|o_t) (G_t - V(o_t)) + value_coef * sum 0.5 (G_t - V(o_t))^2
+           - entropy * sum H(pi(.|o_t))
+
+with G at the rollout's end bootstrapped from V of the last observation.
+Truncated episodes (time limit) bootstrap from V of their final observation.
+"""
+
+from __future__ import annotations
+
+import signal
+import traceback
+from collections.abc import Iterable
+from typing import Any, NamedTuple
+
+import torch
+import torch.nn.functional as F
+
+from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.exploration import CountBonus
+from neurosym.agent.model import ActorCritic
+from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
+
+
+class SharedRMSprop(torch.optim.RMSprop):
+    """RMSprop without momentum whose statistics are created eagerly and can live in shared memory.
+
+    torch's RMSprop creates its state lazily on the first step, inside each
+    process; here the state exists up front so that :meth:`share_memory`
+    can move it to shared memory before the workers start.
+    """
+
+    def __init__(
+        self, params: Iterable[torch.nn.Parameter], lr: float, alpha: float, eps: float
+    ) -> None:
+        super().__init__(
+            params, lr=lr, alpha=alpha, eps=eps, momentum=0.0, centered=False, foreach=False
+        )
+        self._init_state()
+
+    def _init_state(self) -> None:
+        for group in self.param_groups:
+            for p in group["params"]:
+                state = self.state[p]
+                if not state:
+                    state["step"] = torch.zeros(())
+                    state["square_avg"] = torch.zeros_like(p, memory_format=torch.preserve_format)
+
+    def share_memory(self) -> SharedRMSprop:
+        """Move the statistics to shared memory (call again after load_state_dict)."""
+        for state in self.state.values():
+            for value in state.values():
+                value.share_memory_()
+        return self
+
+    def set_hyperparameters(self, lr: float, alpha: float, eps: float) -> None:
+        """Apply settings after loading a state dict (which carries the old ones)."""
+        for group in self.param_groups:
+            group.update(lr=lr, alpha=alpha, eps=eps)
+
+
+class LossStats(NamedTuple):
+    """Per-update diagnostics (per env, summed over time)."""
+
+    policy_loss: float
+    value_loss: float
+    entropy: float
+    grad_norm: float
+
+
+def n_step_returns(rollout: Rollout, gamma: float) -> torch.Tensor:
+    """(T, K) bootstrapped n-step returns G_t (see the module docstring)."""
+    T = rollout.rewards.shape[0]
+    returns = torch.empty_like(rollout.rewards)
+    G = rollout.next_values[-1]  # (K,) V of the observation after the last step
+    for t in range(T - 1, -1, -1):
+        after = torch.where(rollout.truncated[t], rollout.next_values[t], G)
+        G = rollout.rewards[t] + gamma * torch.where(rollout.terminated[t], 0.0, after)
+        returns[t] = G
+    return returns
+
+
+def a3c_loss(rollout: Rollout, config: TrainConfig) -> tuple[torch.Tensor, LossStats]:
+    """The scalar loss of one rollout and its parts (grad_norm left at 0)."""
+    K = rollout.values.shape[1]
+    returns = n_step_returns(rollout, config.gamma)  # (T, K)
+    mask = rollout.valid.to(torch.float32)  # (T, K)
+    logp = F.log_softmax(rollout.logits, dim=-1)  # (T, K, A)
+    logp_a = logp.gather(-1, rollout.actions.unsqueeze(-1)).squeeze(-1)  # (T, K)
+    entropy = -(logp.exp() * logp).sum(-1)  # (T, K)
+    delta = returns - rollout.values  # (T, K)
+    policy_loss = -(logp_a * delta.detach() * mask).sum() / K
+    value_loss = 0.5 * (delta.pow(2) * mask).sum() / K
+    entropy_sum = (entropy * mask).sum() / K
+    loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
+    parts = torch.stack([policy_loss, value_loss, entropy_sum]).tolist()
+    return loss, LossStats(parts[0], parts[1], parts[2], 0.0)
+
+
+def apply_update(
+    local: torch.nn.Module,
+    shared: torch.nn.Module,
+    optimizer: torch.optim.Optimizer,
+    loss: torch.Tensor,
+    clip: float,
+) -> float:
+    """Backpropagate on the local model, hand its gradients to the shared one, step; the gradient norm."""
+    local.zero_grad(set_to_none=True)
+    loss.backward()
+    norm = torch.nn.utils.clip_grad_norm_(local.parameters(), clip)
+    for shared_p, local_p in zip(shared.parameters(), local.parameters(), strict=True):
+        shared_p.grad = local_p.grad
+    optimizer.step()
+    return float(norm)
+
+
+def worker(
+    rank: int,
+    shared: ActorCritic,
+    optimizer: SharedRMSprop,
+    model_config: ModelConfig,
+    train_config: TrainConfig,
+    env_name: str,
+    env_kwargs: dict[str, Any],
+    env_seed: int,
+    stop: Any,
+    queue: Any,
+) -> None:
+    """One A3C worker: rollouts and updates until ``stop`` is set; reports to ``queue``.
+
+    Messages: ``("update", rank, frames, returns, lengths, outcomes, LossStats tuple)``
+    per update, ``("error", rank, traceback text)`` if anything fails.
+    Ctrl-C is the parent's business: the worker ignores SIGINT.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    torch.set_num_threads(1)
+    try:
+        from neurosym.envs import make_batched
+
+        torch.manual_seed(env_seed)
+        generator = torch.Generator().manual_seed(env_seed)
+        venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
+        local = ActorCritic(model_config)
+        state = RolloutState(venv, env_seed)
+        bonus = (
+            CountBonus(train_config.explore, seed=env_seed) if train_config.explore > 0 else None
+        )
+        while not stop.is_set():
+            local.load_state_dict(shared.state_dict())
+            rollout, finished = collect_rollout(
+                local, state, train_config.n_steps, generator, bonus
+            )
+            loss, stats = a3c_loss(rollout, train_config)
+            norm = apply_update(local, shared, optimizer, loss, train_config.grad_clip)
+            frames = int(rollout.valid.sum())
+            queue.put(
+                (
+                    "update",
+                    rank,
+                    frames,
+                    finished.returns,
+                    finished.lengths,
+                    finished.outcomes,
+                    tuple(stats._replace(grad_norm=norm)),
+                )
+            )
+    except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
+        queue.put(("error", rank, traceback.format_exc()))

@@ -1,0 +1,298 @@
+"""Checkpoints: save atomically, read safely, and load a trained :class:`Agent`.
+
+A checkpoint is a dict of tensors and plain values (DESIGN.md "Checkpoint"):
+
+=================== ==========================================================
+``format``          ``"neurosym-checkpoint"``
+``format_version``  1
+``model_config``    ``ModelConfig.to_dict()``
+``train_config``    ``TrainConfig.to_dict()``
+``env``             short env name (``rgw2``), ``env_kwargs`` its keyword args
+``state_dict``      the model's tensors
+``optimizer``       RMSprop state (``None`` in slim checkpoints)
+``frames``          training frames (env steps) so far; ``episodes`` likewise
+``metrics``         plain summary values (last metrics row, stop reason, ...)
+``version``         neurosym version; ``torch_version``; ``created`` (ISO time)
+``command``         the command line that made it
+=================== ==========================================================
+
+It is always read with ``torch.load(weights_only=True)``, so a pickled object
+(a malicious ``__reduce__``) is refused without running it. Every way a file
+can be wrong (missing, truncated, foreign, for another env, another model
+config) is one line of :class:`~neurosym.errors.CheckpointError`.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import pickle
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.introspection import Introspection
+from neurosym.agent.model import ActorCritic
+from neurosym.agent.rollout import select_actions
+from neurosym.errors import CheckpointError, ConfigError
+
+FORMAT = "neurosym-checkpoint"
+FORMAT_VERSION = 1
+
+_PLAIN = (str, int, float, bool, type(None))
+
+
+def _one_line(text: object) -> str:
+    lines = [ln.strip() for ln in str(text).strip().splitlines() if ln.strip()]
+    return lines[0] if lines else type(text).__name__
+
+
+def _check_plain(value: Any, where: str) -> None:
+    """Refuse anything but tensors, plain scalars, lists and str-keyed dicts (saving side)."""
+    if isinstance(value, (torch.Tensor, *_PLAIN)):
+        return
+    if isinstance(value, list | tuple):
+        for i, v in enumerate(value):
+            _check_plain(v, f"{where}[{i}]")
+        return
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str | int):
+                raise ConfigError(f"checkpoint key {where}.{k!r} is not a str or int")
+            _check_plain(v, f"{where}.{k}")
+        return
+    raise ConfigError(
+        f"checkpoint value {where} is a {type(value).__name__}; only tensors and plain values"
+    )
+
+
+def save_checkpoint(
+    path: str | os.PathLike[str],
+    *,
+    model: torch.nn.Module,
+    config: ModelConfig,
+    env_name: str,
+    env_kwargs: dict[str, Any] | None = None,
+    train_config: TrainConfig | None = None,
+    optimizer_state: dict[str, Any] | None = None,
+    frames: int = 0,
+    episodes: int = 0,
+    metrics: dict[str, Any] | None = None,
+    command: str = "",
+    state_dict: dict[str, torch.Tensor] | None = None,
+) -> Path:
+    """Write a checkpoint atomically (temp file in the same directory, then os.replace).
+
+    ``state_dict`` overrides ``model.state_dict()`` (the trainer passes the
+    snapshot that was evaluated).
+    """
+    from neurosym import __version__
+
+    path = Path(path)
+    weights = state_dict if state_dict is not None else model.state_dict()
+    payload: dict[str, Any] = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "model_config": config.to_dict(),
+        "train_config": train_config.to_dict() if train_config is not None else None,
+        "env": env_name,
+        "env_kwargs": dict(env_kwargs or {}),
+        "state_dict": {k: v.detach().clone().cpu() for k, v in weights.items()},
+        "optimizer": optimizer_state,
+        "frames": int(frames),
+        "episodes": int(episodes),
+        "metrics": dict(metrics or {}),
+        "version": __version__,
+        "torch_version": torch.__version__.split("+")[0],
+        "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
+        "command": command,
+    }
+    _check_plain(payload, "checkpoint")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            torch.save(payload, fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _load_raw(path: Path) -> Any:
+    if not path.exists():
+        raise CheckpointError(f"checkpoint not found: {path}")
+    if not path.is_file():
+        raise CheckpointError(f"checkpoint {path} is not a file")
+    try:
+        return torch.load(path, map_location="cpu", weights_only=True)
+    except pickle.UnpicklingError as exc:
+        if "weights only" in str(exc).lower() or "weights_only" in str(exc).lower():
+            raise CheckpointError(
+                f"refused {path}: it holds pickled Python objects, not only tensors and plain values "
+                "(a foreign or unsafe file; nothing in it was run)"
+            ) from None
+        raise CheckpointError(
+            f"cannot read {path}: not a torch checkpoint ({_one_line(exc)})"
+        ) from None
+    except (
+        RuntimeError,
+        EOFError,
+        OSError,
+        ValueError,
+        AttributeError,
+        ImportError,
+        IndexError,
+        KeyError,
+    ) as exc:
+        raise CheckpointError(
+            f"cannot read {path}: truncated, corrupt or not a torch checkpoint ({_one_line(exc)})"
+        ) from None
+
+
+def _require(payload: dict[str, Any], path: Path, key: str, kind: type | tuple[type, ...]) -> Any:
+    value = payload.get(key)
+    if not isinstance(value, kind) or isinstance(value, bool) and kind is int:
+        raise CheckpointError(
+            f"checkpoint {path} is damaged: {key!r} is missing or has the wrong type"
+        )
+    return value
+
+
+def read_checkpoint(
+    path: str | os.PathLike[str],
+    env: str | None = None,
+    config: ModelConfig | dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Read and validate a checkpoint; the payload dict with ``model_config`` as a ModelConfig.
+
+    ``env``: refuse a checkpoint trained on another environment. ``config``:
+    refuse one whose model config differs (named field by field).
+    """
+    path = Path(path)
+    payload = _load_raw(path)
+    if not isinstance(payload, dict):
+        raise CheckpointError(
+            f"{path} is not a neurosym checkpoint (it holds a {type(payload).__name__})"
+        )
+    if "format" not in payload:
+        if payload and all(isinstance(v, torch.Tensor) for v in payload.values()):
+            raise CheckpointError(
+                f"{path} is a plain torch state dict, not a neurosym checkpoint (make one with `neurosym train`)"
+            )
+        raise CheckpointError(f"{path} is not a neurosym checkpoint (no 'format' entry)")
+    if payload["format"] != FORMAT:
+        raise CheckpointError(f"{path} is not a neurosym checkpoint (format {payload['format']!r})")
+    version = payload.get("format_version")
+    if not isinstance(version, int) or version > FORMAT_VERSION or version < 1:
+        raise CheckpointError(
+            f"{path} has checkpoint format version {version!r}; this neurosym reads version {FORMAT_VERSION}"
+        )
+    raw_config = _require(payload, path, "model_config", dict)
+    env_name = _require(payload, path, "env", str)
+    _require(payload, path, "env_kwargs", dict)
+    state = _require(payload, path, "state_dict", dict)
+    _require(payload, path, "frames", int)
+    _require(payload, path, "episodes", int)
+    if not all(isinstance(v, torch.Tensor) for v in state.values()):
+        raise CheckpointError(
+            f"checkpoint {path} is damaged: its state_dict holds values other than tensors"
+        )
+    try:
+        model_config = ModelConfig.from_dict(raw_config)
+    except ConfigError as exc:
+        raise CheckpointError(f"checkpoint {path} has a bad model config: {exc}") from None
+    if env is not None:
+        from neurosym.envs import canonical_name
+
+        want = canonical_name(env)
+        if canonical_name(env_name) != want:
+            raise CheckpointError(f"{path} was trained on {env_name}, not {want}")
+    if config is not None:
+        expected = config if isinstance(config, ModelConfig) else ModelConfig.from_dict(config)
+        mine, theirs = model_config.to_dict(), expected.to_dict()
+        diffs = [f"{k} {mine[k]!r} (asked for {theirs[k]!r})" for k in mine if mine[k] != theirs[k]]
+        if diffs:
+            raise CheckpointError(f"{path} has a different model config: {'; '.join(diffs)}")
+    payload = dict(payload)
+    payload["model_config"] = model_config
+    return payload
+
+
+def build_model(payload: dict[str, Any], path: str | os.PathLike[str]) -> ActorCritic:
+    """The model of a validated payload with its weights loaded (strict)."""
+    model = ActorCritic(payload["model_config"])
+    try:
+        model.load_state_dict(payload["state_dict"], strict=True)
+    except RuntimeError as exc:
+        msg = " ".join(_one_line(line) for line in str(exc).splitlines()[1:3]) or _one_line(exc)
+        raise CheckpointError(f"{path}: the weights do not fit its model config ({msg})") from None
+    return model
+
+
+@dataclass(frozen=True)
+class Agent:
+    """A trained model ready to act (docs/interfaces.md)."""
+
+    model: ActorCritic
+    """the network, in eval mode"""
+    config: ModelConfig
+    env_name: str
+    """short name of the env it was trained on"""
+    env_kwargs: dict[str, Any]
+    meta: dict[str, Any] = field(default_factory=dict)
+    """everything else in the checkpoint but the tensors: frames, episodes, metrics, command, ..."""
+    path: str | None = None
+
+    def act(
+        self,
+        obs: np.ndarray,
+        greedy: bool = True,
+        introspect: bool = False,
+        generator: torch.Generator | None = None,
+    ) -> tuple[np.ndarray, Introspection | None]:
+        """Actions (B,) for a batch of observations (B, C, H, W); a single (C, H, W) counts as B = 1.
+
+        ``greedy`` takes the most likely action, otherwise one is sampled from
+        the policy with ``generator``. With ``introspect`` the second value is
+        the module's introspection record with numpy arrays.
+        """
+        x = torch.as_tensor(np.asarray(obs))
+        if x.dim() == 3:
+            x = x.unsqueeze(0)  # (1, C, H, W)
+        with torch.inference_mode():
+            out = self.model(x, introspect=introspect)
+            actions = select_actions(out[0], greedy, generator)
+        return actions.numpy(), (out[2].numpy() if introspect else None)
+
+
+def load_agent(
+    path: str | os.PathLike[str], env: str | None = None, config: ModelConfig | None = None
+) -> Agent:
+    """Load a checkpoint as an :class:`Agent` (CheckpointError, one line, for every bad file).
+
+    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
+    """
+    payload = read_checkpoint(path, env=env, config=config)
+    model = build_model(payload, path)
+    model.eval()
+    meta = {
+        k: v for k, v in payload.items() if k not in ("state_dict", "optimizer", "model_config")
+    }
+    meta["train_config"] = payload.get("train_config")
+    return Agent(
+        model=model,
+        config=payload["model_config"],
+        env_name=payload["env"],
+        env_kwargs=dict(payload["env_kwargs"]),
+        meta=meta,
+        path=str(path),
+    )

@@ -1,0 +1,179 @@
+"""``neurosym train``: train a PrediNet or MHDPA agent with A3C.
+
+A thin wrapper over :func:`neurosym.agent.trainer.train`. Unset options take
+the env family's defaults (``neurosym.agent.config``); with ``--resume`` they
+take the checkpoint's settings. The command line is stored in the checkpoint.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import os
+import shlex
+from typing import Any
+
+from neurosym.errors import ConfigError
+
+# (flag, dest, kind) for the settings passed through as overrides; kind: train | model
+_OVERRIDES = (
+    ("--workers", "workers", "train"),
+    ("--envs", "envs", "train"),
+    ("--seed", "seed", "train"),
+    ("--lr", "lr", "train"),
+    ("--entropy", "entropy", "train"),
+    ("--gamma", "gamma", "train"),
+    ("--n-steps", "n_steps", "train"),
+    ("--grad-clip", "grad_clip", "train"),
+    ("--value-coef", "value_coef", "train"),
+    ("--rms-eps", "rms_eps", "train"),
+    ("--explore", "explore", "train"),
+    ("--heads", "heads", "model"),
+    ("--key-size", "key_size", "model"),
+    ("--relations", "relations", "model"),
+    ("--value-size", "value_size", "model"),
+)
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--env", help="environment short name or id, e.g. rgw2 (required unless --resume)"
+    )
+    parser.add_argument(
+        "--module",
+        choices=("predinet", "mhdpa"),
+        help="relational module (required unless --resume)",
+    )
+    parser.add_argument(
+        "--out", required=True, help="run directory: checkpoint.pt and metrics.csv go here"
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="continue the run in --out from its checkpoint"
+    )
+    stop = parser.add_argument_group("stopping (any that is reached; none: run until Ctrl-C)")
+    stop.add_argument(
+        "--frames", type=int, help="total training frames (env steps), counting resumed ones"
+    )
+    stop.add_argument("--minutes", type=float, help="wall-clock minutes for this session")
+    stop.add_argument(
+        "--target-return", type=float, help="stop when the greedy policy's mean return reaches this"
+    )
+    a3c = parser.add_argument_group(
+        "A3C (defaults: the env family's, see neurosym/agent/config.py)"
+    )
+    a3c.add_argument("--workers", type=int, help="worker processes W (default: CPU cores)")
+    a3c.add_argument("--envs", type=int, help="environments per worker K (1 = classic A3C)")
+    a3c.add_argument("--seed", type=int, help="base seed (default 0)")
+    a3c.add_argument("--lr", type=float, help="RMSprop learning rate")
+    a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
+    a3c.add_argument("--gamma", type=float, help="discount")
+    a3c.add_argument("--n-steps", type=int, help="rollout length per update (Table 4: 40)")
+    a3c.add_argument("--grad-clip", type=float, help="gradient norm clip")
+    a3c.add_argument("--value-coef", type=float, help="value loss weight")
+    a3c.add_argument("--rms-eps", type=float, help="RMSprop epsilon")
+    a3c.add_argument("--explore", type=float, help="count-based exploration bonus beta (0: none)")
+    model = parser.add_argument_group("model (defaults: Table 4)")
+    model.add_argument("--heads", type=int, help="attention heads (4)")
+    model.add_argument("--key-size", type=int, help="query/key size (32 RGW, 64 Box-World)")
+    model.add_argument("--relations", type=int, help="PrediNet relations per head (8)")
+    model.add_argument("--value-size", type=int, help="MHDPA value size (64)")
+    watch = parser.add_argument_group("watching")
+    watch.add_argument(
+        "--env-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="keyword argument for the env, e.g. obs_mode=grey (repeatable)",
+    )
+    watch.add_argument(
+        "--eval-interval", type=float, default=2.0, help="seconds between greedy evaluations (2)"
+    )
+    watch.add_argument(
+        "--eval-episodes", type=int, default=8, help="episodes per greedy evaluation (8)"
+    )
+    watch.add_argument(
+        "--checkpoint-interval", type=float, default=60.0, help="seconds between checkpoints (60)"
+    )
+    watch.add_argument(
+        "--slim", action="store_true", help="leave the optimizer state out of checkpoints"
+    )
+    watch.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def parse_env_options(items: list[str]) -> dict[str, Any]:
+    """KEY=VALUE strings -> kwargs; values are Python literals when they parse as one, else strings."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key.isidentifier():
+            raise ConfigError(f"--env-option wants KEY=VALUE with KEY a name, got {item!r}")
+        try:
+            out[key] = ast.literal_eval(text)
+        except (ValueError, SyntaxError):
+            out[key] = text
+    return out
+
+
+def command_line(args: argparse.Namespace) -> str:
+    """The command as a user would type it, from the parsed options that were given."""
+    parts = ["neurosym", "train"]
+    for flag, dest in (("--env", "env"), ("--module", "module"), ("--out", "out")):
+        if getattr(args, dest) is not None:
+            parts += [flag, str(getattr(args, dest))]
+    if args.resume:
+        parts.append("--resume")
+    for flag, dest in (
+        ("--frames", "frames"),
+        ("--minutes", "minutes"),
+        ("--target-return", "target_return"),
+    ):
+        if getattr(args, dest) is not None:
+            parts += [flag, str(getattr(args, dest))]
+    for flag, dest, _ in _OVERRIDES:
+        if getattr(args, dest) is not None:
+            parts += [flag, str(getattr(args, dest))]
+    for item in args.env_option:
+        parts += ["--env-option", item]
+    for flag, dest, default in (
+        ("--eval-interval", "eval_interval", 2.0),
+        ("--eval-episodes", "eval_episodes", 8),
+        ("--checkpoint-interval", "checkpoint_interval", 60.0),
+    ):
+        if getattr(args, dest) != default:
+            parts += [flag, str(getattr(args, dest))]
+    if args.slim:
+        parts.append("--slim")
+    return shlex.join(parts)
+
+
+def run(args: argparse.Namespace) -> int:
+    from neurosym.agent.trainer import RunOptions, train
+
+    overrides: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
+    for _, dest, kind in _OVERRIDES:
+        overrides[kind][dest] = getattr(args, dest)
+    if overrides["train"]["workers"] is None and not args.resume:
+        overrides["train"]["workers"] = os.cpu_count() or 1
+    options = RunOptions(
+        frames=args.frames,
+        minutes=args.minutes,
+        target_return=args.target_return,
+        eval_interval=args.eval_interval,
+        eval_episodes=args.eval_episodes,
+        checkpoint_interval=args.checkpoint_interval,
+        slim=args.slim,
+        progress=not args.quiet,
+    )
+    result = train(
+        args.env,
+        args.module,
+        args.out,
+        train_overrides=overrides["train"],
+        model_overrides=overrides["model"],
+        env_kwargs=parse_env_options(args.env_option) if args.env_option else None,
+        options=options,
+        resume=args.resume,
+        command=command_line(args),
+        print_fn=print,
+    )
+    return 130 if result.stop_reason == "interrupted" else 0

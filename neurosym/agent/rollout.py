@@ -1,0 +1,218 @@
+"""Batched acting shared by training, evaluation and recording.
+
+* :func:`select_actions`: greedy or sampled actions from logits, for a batch.
+* :class:`EpisodeTracker`: returns, lengths and outcomes of the episodes that
+  end in a batched env with gymnasium's next-step autoreset (the step after an
+  episode ends is not a real transition; ``valid`` says which are).
+* :func:`collect_rollout`: n steps of K envs with the model's graph kept, for
+  the A3C update (one forward per step, no second pass over the rollout).
+* :func:`play_episodes`: play N whole episodes, one per sub-env, for evaluation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import torch
+
+SUCCESS_OUTCOMES = ("terminal", "gem")
+"""Outcomes that count as solving an episode (RGW terminal, Box-World gem)."""
+
+
+def select_actions(
+    logits: torch.Tensor, greedy: bool, generator: torch.Generator | None = None
+) -> torch.Tensor:
+    """(B,) int64 actions: argmax, or one draw per row from softmax(logits) with ``generator``."""
+    if greedy:
+        return logits.argmax(dim=-1)
+    probs = torch.softmax(logits.detach().float(), dim=-1)  # (B, A)
+    u = torch.rand(probs.shape[0], 1, generator=generator)  # (B, 1)
+    # inverse CDF; the clamp guards against cumsum ending a hair below u
+    return (probs.cumsum(-1) < u).sum(-1).clamp_(max=probs.shape[-1] - 1)
+
+
+def outcome_of(venv: Any, info: dict[str, Any], i: int, truncated: bool) -> str:
+    """Outcome name of sub-env i's episode that ended on this step."""
+    decode = getattr(venv, "decode_info", None)
+    outcome = decode(info, i).get("outcome") if decode is not None else None
+    return str(outcome) if outcome else ("timeout" if truncated else "terminal")
+
+
+@dataclass
+class Finished:
+    """Episodes that ended: one entry per episode."""
+
+    returns: list[float]
+    lengths: list[int]
+    outcomes: list[str]
+
+    @classmethod
+    def empty(cls) -> Finished:
+        return cls([], [], [])
+
+    def extend(self, other: Finished) -> None:
+        self.returns += other.returns
+        self.lengths += other.lengths
+        self.outcomes += other.outcomes
+
+    def __len__(self) -> int:
+        return len(self.returns)
+
+
+class EpisodeTracker:
+    """Running return and length per sub-env of a next-step-autoreset batched env."""
+
+    def __init__(self, n: int) -> None:
+        self.ret = np.zeros(n, dtype=np.float64)
+        self.length = np.zeros(n, dtype=np.int64)
+        self.pending = np.zeros(
+            n, dtype=bool
+        )  # True: the next step is an autoreset, not a transition
+
+    def step(
+        self,
+        venv: Any,
+        reward: np.ndarray,
+        terminated: np.ndarray,
+        truncated: np.ndarray,
+        info: dict[str, Any],
+    ) -> tuple[np.ndarray, Finished]:
+        """Account one env step; (valid mask of this step's transitions, episodes that ended)."""
+        valid = ~self.pending
+        self.ret += np.where(valid, reward, 0.0)
+        self.length += valid
+        done = (terminated | truncated) & valid
+        finished = Finished.empty()
+        for i in np.flatnonzero(done).tolist():
+            finished.returns.append(float(self.ret[i]))
+            finished.lengths.append(int(self.length[i]))
+            finished.outcomes.append(outcome_of(venv, info, i, bool(truncated[i])))
+        self.ret[done] = 0.0
+        self.length[done] = 0
+        self.pending = done
+        return valid, finished
+
+
+class Rollout(NamedTuple):
+    """n steps of K envs; tensors are (T, K) unless noted."""
+
+    logits: torch.Tensor
+    """(T, K, A) with the model's graph"""
+    values: torch.Tensor
+    """(T, K) with the model's graph"""
+    actions: torch.Tensor
+    rewards: torch.Tensor
+    terminated: torch.Tensor
+    truncated: torch.Tensor
+    valid: torch.Tensor
+    """False for the autoreset steps that are not transitions"""
+    next_values: torch.Tensor
+    """(T, K) V(o_{t+1}), detached: the bootstrap for truncated episodes and the rollout's end"""
+
+
+class RolloutState:
+    """What a worker carries from one rollout to the next: env, current observation, episode tracker."""
+
+    def __init__(self, venv: Any, seed: int) -> None:
+        self.venv = venv
+        obs, _ = venv.reset(seed=seed)
+        self.obs = torch.from_numpy(np.ascontiguousarray(obs))
+        self.tracker = EpisodeTracker(venv.num_envs)
+
+
+def collect_rollout(
+    model: torch.nn.Module,
+    state: RolloutState,
+    n_steps: int,
+    generator: torch.Generator | None,
+    bonus: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+) -> tuple[Rollout, Finished]:
+    """Act ``n_steps`` steps in every sub-env with sampled actions, keeping the graph for the update.
+
+    ``bonus(next_obs, valid) -> (K,)`` adds an intrinsic reward to the
+    rollout's rewards (the training signal); the finished episodes' returns
+    are the environment's own.
+    """
+    venv, tracker = state.venv, state.tracker
+    logits_t, values_t, actions_t = [], [], []
+    rewards, terms, truncs, valids = [], [], [], []
+    finished = Finished.empty()
+    for _ in range(n_steps):
+        logits, value = model(state.obs)  # (K, A), (K,)
+        actions = select_actions(logits, greedy=False, generator=generator)
+        obs, reward, terminated, truncated, info = venv.step(actions.numpy())
+        valid, done = tracker.step(venv, reward, terminated, truncated, info)
+        finished.extend(done)
+        if bonus is not None:
+            reward = reward + bonus(obs, valid)
+        logits_t.append(logits)
+        values_t.append(value)
+        actions_t.append(actions)
+        rewards.append(reward)
+        terms.append(terminated)
+        truncs.append(truncated)
+        valids.append(valid)
+        state.obs = torch.from_numpy(np.ascontiguousarray(obs))
+    with torch.no_grad():
+        _, last_value = model(state.obs)  # (K,)
+    values = torch.stack(values_t)  # (T, K)
+    next_values = torch.cat([values[1:].detach(), last_value.unsqueeze(0)])  # (T, K)
+    rollout = Rollout(
+        logits=torch.stack(logits_t),
+        values=values,
+        actions=torch.stack(actions_t),
+        rewards=torch.from_numpy(np.stack(rewards).astype(np.float32)),
+        terminated=torch.from_numpy(np.stack(terms)),
+        truncated=torch.from_numpy(np.stack(truncs)),
+        valid=torch.from_numpy(np.stack(valids)),
+        next_values=next_values,
+    )
+    return rollout, finished
+
+
+def play_episodes(
+    act: Callable[[np.ndarray], np.ndarray],
+    make_venv: Callable[[int], Any],
+    episodes: int,
+    seed: int,
+    batch: int = 64,
+    max_steps: int = 100_000,
+) -> Finished:
+    """Play ``episodes`` whole episodes in waves of at most ``batch`` sub-envs.
+
+    Episode k is played from ``reset(seed=seed + k)``. ``act`` maps a batch of
+    observations to actions; ``make_venv(n)`` builds a batched env of n.
+    Results are in episode order.
+    """
+    out = Finished.empty()
+    venvs: dict[int, Any] = {}
+    for start in range(0, episodes, batch):
+        n = min(batch, episodes - start)
+        venv = venvs.setdefault(n, make_venv(n))
+        obs, _ = venv.reset(seed=[seed + start + i for i in range(n)])
+        ret = np.zeros(n)
+        length = np.zeros(n, dtype=np.int64)
+        outcome: list[str | None] = [None] * n
+        live = np.ones(n, dtype=bool)
+        for _ in range(max_steps):
+            actions = np.asarray(act(obs), dtype=np.int64)
+            obs, reward, terminated, truncated, info = venv.step(actions)
+            ret += np.where(live, reward, 0.0)
+            length += live
+            ended = live & (terminated | truncated)
+            for i in np.flatnonzero(ended).tolist():
+                outcome[i] = outcome_of(venv, info, i, bool(truncated[i]))
+            live &= ~ended
+            if not live.any():
+                break
+        else:
+            raise RuntimeError(
+                f"an episode ran {max_steps} steps without ending; the env has no time limit"
+            )
+        out.returns += ret.tolist()
+        out.lengths += length.tolist()
+        out.outcomes += [str(o) for o in outcome]
+    return out

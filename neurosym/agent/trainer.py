@@ -1,0 +1,534 @@
+"""The training run: start the A3C workers, watch them, evaluate, checkpoint, stop.
+
+:func:`train` is the plain function behind ``neurosym train``. The parent
+process owns everything the user sees: the progress bar, ``metrics.csv``,
+``checkpoint.pt`` in the output directory, and the periodic greedy evaluation
+that decides when a target return is reached. It evaluates a snapshot of the
+shared weights, and when that snapshot reaches the target it is exactly what
+the final checkpoint holds (the workers keep changing the shared weights).
+
+Stops on: a frame budget (total frames, counting those before a resume), a
+time budget (this session), the greedy return reaching ``target_return``, or
+Ctrl-C (the workers ignore SIGINT; the parent stops them and checkpoints).
+"""
+
+from __future__ import annotations
+
+import collections
+import csv
+import io
+import math
+import multiprocessing as _mp
+import os
+import queue as _queue
+import signal
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import torch.multiprocessing as mp
+
+from neurosym.agent.a3c import SharedRMSprop, worker
+from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpoint
+from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.model import ActorCritic
+from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, play_episodes, select_actions
+from neurosym.errors import CheckpointError, ConfigError
+
+CHECKPOINT_NAME = "checkpoint.pt"
+METRICS_NAME = "metrics.csv"
+METRIC_COLUMNS = (
+    "wall_s",
+    "frames",
+    "episodes",
+    "fps",
+    "mean_return",
+    "success_rate",
+    "mean_length",
+    "greedy_return",
+    "greedy_success",
+    "policy_loss",
+    "value_loss",
+    "entropy",
+    "grad_norm",
+)
+TARGET_TOLERANCE = 1e-6
+"""A greedy mean return within this of the target counts as reaching it (10.7 is not exact in binary)."""
+
+
+@dataclass
+class RunOptions:
+    """How long to train and how to watch it (everything but the model and A3C settings)."""
+
+    frames: int | None = None
+    """stop once this many frames (env steps, all workers, counting earlier sessions) are done"""
+    minutes: float | None = None
+    """stop after this many minutes of this session"""
+    target_return: float | None = None
+    """stop when the greedy policy's mean return reaches this"""
+    eval_interval: float = 2.0
+    """seconds between greedy evaluations"""
+    eval_episodes: int = 8
+    """episodes per greedy evaluation (played side by side)"""
+    checkpoint_interval: float = 60.0
+    """seconds between periodic checkpoints"""
+    log_interval: float = 2.0
+    """seconds between metrics rows"""
+    window: int = 100
+    """recent episodes behind mean_return and success_rate"""
+    slim: bool = False
+    """leave the optimizer state out of checkpoints"""
+    progress: bool = True
+    """show a rich progress bar on stderr"""
+
+    def __post_init__(self) -> None:
+        if self.frames is not None and self.frames < 1:
+            raise ConfigError(f"--frames must be a positive integer, got {self.frames}")
+        if self.minutes is not None and not self.minutes > 0:
+            raise ConfigError(f"--minutes must be positive, got {self.minutes}")
+        for name in ("eval_interval", "checkpoint_interval", "log_interval"):
+            if not getattr(self, name) > 0:
+                raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
+        if self.eval_episodes < 1 or self.window < 1:
+            raise ConfigError("eval_episodes and window must be positive integers")
+
+
+@dataclass
+class TrainResult:
+    """What a run did; also printed by the CLI."""
+
+    checkpoint: Path
+    frames: int
+    episodes: int
+    wall_s: float
+    stop_reason: str
+    """frames, time, target, interrupted"""
+    greedy_return: float | None
+    solved_frames: int | None = None
+    solved_wall_s: float | None = None
+    metrics: dict[str, Any] = field(default_factory=dict)
+
+
+def probe_env(env: str, env_kwargs: dict[str, Any]) -> tuple[str, str, tuple[int, int, int], float]:
+    """(short name, family, obs shape, obs scale) of an environment, checking the name and kwargs."""
+    from neurosym.envs import canonical_name, env_family, make
+
+    name = canonical_name(env)
+    probe = make(name, **env_kwargs)
+    try:
+        shape = tuple(int(v) for v in probe.observation_space.shape)
+        scale = float(getattr(probe.unwrapped, "obs_scale", 1.0))
+    finally:
+        probe.close()
+    if len(shape) != 3:
+        raise ConfigError(
+            f"env {name} has observations of shape {shape}; the agent needs (C, H, W)"
+        )
+    return name, env_family(name), shape, scale  # type: ignore[return-value]
+
+
+def greedy_evaluator(
+    model: ActorCritic, env: str, env_kwargs: dict[str, Any], episodes: int, seed: int
+) -> Callable[[], Finished]:
+    """A function playing ``episodes`` greedy episodes with ``model`` (reused env)."""
+    from neurosym.envs import make_batched
+
+    def act(obs: np.ndarray) -> np.ndarray:
+        with torch.inference_mode():
+            logits, _ = model(torch.from_numpy(obs))
+            return select_actions(logits, greedy=True).numpy()
+
+    venv = make_batched(env, episodes, seed=seed, **env_kwargs)
+    return lambda: play_episodes(act, lambda n: venv, episodes, seed, batch=episodes)
+
+
+def _read_rows(path: Path) -> list[dict[str, str]]:
+    if not path.exists():
+        return []
+    with path.open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
+    buf = io.StringIO()
+    writer = csv.DictWriter(
+        buf, fieldnames=METRIC_COLUMNS, extrasaction="ignore", lineterminator="\n"
+    )
+    writer.writeheader()
+    writer.writerows(rows)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(buf.getvalue())
+    os.replace(tmp, path)
+
+
+def _fmt(value: float | None, spec: str = ".3f") -> str:
+    return (
+        ""
+        if value is None or (isinstance(value, float) and math.isnan(value))
+        else format(value, spec)
+    )
+
+
+class _Stats:
+    """Running figures in the parent, fed by the workers' messages."""
+
+    def __init__(self, frames: int, episodes: int, window: int) -> None:
+        self.frames, self.episodes = frames, episodes
+        self.returns: collections.deque[float] = collections.deque(maxlen=window)
+        self.success: collections.deque[bool] = collections.deque(maxlen=window)
+        self.lengths: collections.deque[int] = collections.deque(maxlen=window)
+        self.losses: list[tuple[float, ...]] = []
+
+    def add(
+        self,
+        frames: int,
+        returns: list[float],
+        lengths: list[int],
+        outcomes: list[str],
+        losses: tuple,
+    ) -> None:
+        self.frames += frames
+        self.episodes += len(returns)
+        self.returns.extend(returns)
+        self.lengths.extend(lengths)
+        self.success.extend(o in SUCCESS_OUTCOMES for o in outcomes)
+        self.losses.append(losses)
+
+    def mean_return(self) -> float | None:
+        return float(np.mean(self.returns)) if self.returns else None
+
+    def success_rate(self) -> float | None:
+        return float(np.mean(self.success)) if self.success else None
+
+    def take_losses(self) -> tuple[float, ...] | None:
+        if not self.losses:
+            return None
+        out = tuple(float(v) for v in np.mean(np.asarray(self.losses), axis=0))
+        self.losses = []
+        return out
+
+
+def _env_seed(seed: int, rank: int, frames_before: int) -> int:
+    """A distinct env/sampling seed per (run seed, worker, session start)."""
+    return int((seed * 1_000_003 + rank * 7_919 + frames_before) % (2**31 - 1))
+
+
+def train(
+    env: str | None,
+    module: str | None,
+    out: str | os.PathLike[str],
+    *,
+    train_overrides: dict[str, Any] | None = None,
+    model_overrides: dict[str, Any] | None = None,
+    env_kwargs: dict[str, Any] | None = None,
+    options: RunOptions | None = None,
+    resume: bool = False,
+    command: str = "",
+    print_fn: Callable[[str], None] | None = None,
+) -> TrainResult:
+    """Train an agent with A3C into ``out`` (``checkpoint.pt``, ``metrics.csv``).
+
+    ``train_overrides`` / ``model_overrides``: TrainConfig / ModelConfig fields
+    to change from the family defaults (None values are ignored). With
+    ``resume`` the run continues ``out/checkpoint.pt``: its model and settings,
+    unless overridden (a model override that differs is an error), its frame
+    and episode counts, its metrics rows.
+    """
+    options = options or RunOptions()
+    out = Path(out)
+    ckpt_path = out / CHECKPOINT_NAME
+    train_overrides = {k: v for k, v in (train_overrides or {}).items() if v is not None}
+    model_overrides = {k: v for k, v in (model_overrides or {}).items() if v is not None}
+    torch.set_num_threads(1)
+
+    payload: dict[str, Any] | None = None
+    if resume:
+        payload = read_checkpoint(ckpt_path, env=env)
+        env_name = payload["env"]
+        kwargs = dict(payload["env_kwargs"]) if env_kwargs is None else dict(env_kwargs)
+        name, family, shape, scale = probe_env(env_name, kwargs)
+        model_config: ModelConfig = payload["model_config"]
+        wanted = {"module": module, **model_overrides} if module else dict(model_overrides)
+        diffs = [
+            f"{k} {getattr(model_config, k)!r} (asked for {v!r})"
+            for k, v in wanted.items()
+            if getattr(model_config, k) != v
+        ]
+        if diffs:
+            raise CheckpointError(f"{ckpt_path} has a different model config: {'; '.join(diffs)}")
+        if model_config.obs_shape != shape:
+            raise CheckpointError(
+                f"{ckpt_path} expects observations {model_config.obs_shape}, env gives {shape}"
+            )
+        base = payload.get("train_config") or TrainConfig.for_family(family).to_dict()
+        train_config = TrainConfig.from_dict(base).replace(**train_overrides)
+        frames0, episodes0 = int(payload["frames"]), int(payload["episodes"])
+        wall0 = float(payload["metrics"].get("wall_s", 0.0))
+    else:
+        if env is None or module is None:
+            raise ConfigError("--env and --module are needed unless --resume continues a run")
+        if ckpt_path.exists():
+            raise ConfigError(
+                f"{ckpt_path} already exists; pass --resume to continue it or choose another --out"
+            )
+        kwargs = dict(env_kwargs or {})
+        name, family, shape, scale = probe_env(env, kwargs)
+        model_config = ModelConfig.for_family(family, module, shape, scale, **model_overrides)
+        train_config = TrainConfig.for_family(family, **train_overrides)
+        frames0 = episodes0 = 0
+        wall0 = 0.0
+    if options.frames is not None and options.frames <= frames0:
+        raise ConfigError(
+            f"--frames {options.frames} is not above the {frames0} frames already trained"
+        )
+
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(train_config.seed)
+    shared = ActorCritic(model_config) if payload is None else build_model(payload, ckpt_path)
+    shared.share_memory()
+    optimizer = SharedRMSprop(
+        shared.parameters(), train_config.lr, train_config.rms_alpha, train_config.rms_eps
+    )
+    if payload is not None and payload.get("optimizer"):
+        try:
+            optimizer.load_state_dict(payload["optimizer"])
+        except (ValueError, KeyError, RuntimeError) as exc:
+            raise CheckpointError(
+                f"{ckpt_path}: its optimizer state does not fit the model ({exc})"
+            ) from None
+        optimizer._init_state()
+        optimizer.set_hyperparameters(train_config.lr, train_config.rms_alpha, train_config.rms_eps)
+    optimizer.share_memory()
+
+    rows: list[dict[str, Any]] = _read_rows(out / METRICS_NAME) if resume else []
+    stats = _Stats(frames0, episodes0, options.window)
+    eval_model = ActorCritic(model_config)
+    eval_model.eval()
+    evaluate = greedy_evaluator(
+        eval_model, name, kwargs, options.eval_episodes, seed=10_000 + train_config.seed
+    )
+    say = print_fn or (lambda text: print(text, file=sys.stderr))
+
+    def checkpoint(state_dict: dict[str, torch.Tensor] | None, extra: dict[str, Any]) -> None:
+        metrics = {**(rows[-1] if rows else {}), **extra}
+        metrics = {
+            k: (float(v) if isinstance(v, np.floating) else v)
+            for k, v in metrics.items()
+            if v is not None
+        }
+        save_checkpoint(
+            ckpt_path,
+            model=shared,
+            config=model_config,
+            env_name=name,
+            env_kwargs=kwargs,
+            train_config=train_config,
+            optimizer_state=None if options.slim else optimizer.state_dict(),
+            frames=stats.frames,
+            episodes=stats.episodes,
+            metrics=metrics,
+            command=command,
+            state_dict=state_dict,
+        )
+
+    ctx = mp.get_context("fork" if "fork" in _mp.get_all_start_methods() else "spawn")
+    stop = ctx.Event()
+    messages = ctx.Queue()
+    procs = []
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # children start with Ctrl-C ignored
+    try:
+        for rank in range(train_config.workers):
+            seed = _env_seed(train_config.seed, rank, frames0)
+            args = (
+                rank,
+                shared,
+                optimizer,
+                model_config,
+                train_config,
+                name,
+                kwargs,
+                seed,
+                stop,
+                messages,
+            )
+            proc = ctx.Process(target=worker, args=args, daemon=True, name=f"neurosym-a3c-{rank}")
+            proc.start()
+            procs.append(proc)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    total = (
+        options.frames - frames0
+        if options.frames
+        else (options.minutes * 60 if options.minutes else None)
+    )
+    progress = Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TextColumn("{task.fields[stats]}"),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        disable=not options.progress,
+    )
+    task = progress.add_task(f"{name} {model_config.module}", total=total, stats="starting workers")
+
+    start = time.monotonic()
+    last_log = last_eval = last_ckpt = start
+    last_frames = stats.frames
+    greedy: float | None = None
+    greedy_success: float | None = None
+    best_state: dict[str, torch.Tensor] | None = None
+    solved_frames = solved_wall = None
+    stop_reason = ""
+    failure: str | None = None
+
+    def drain(block_s: float) -> None:
+        nonlocal failure
+        deadline = time.monotonic() + block_s
+        while True:
+            timeout = max(0.0, deadline - time.monotonic())
+            try:
+                msg = messages.get(timeout=timeout) if timeout > 0 else messages.get_nowait()
+            except _queue.Empty:
+                return
+            if msg[0] == "update":
+                _, _, frames, rets, lens, outs, losses = msg
+                stats.add(frames, rets, lens, outs, losses)
+            elif msg[0] == "error" and failure is None:
+                failure = f"worker {msg[1]} failed:\n{msg[2]}"
+
+    try:
+        with progress:
+            while True:
+                drain(0.1)
+                now = time.monotonic()
+                if failure:
+                    stop_reason = "error"
+                    break
+                if not any(p.is_alive() for p in procs):
+                    failure = "all workers exited unexpectedly"
+                    stop_reason = "error"
+                    break
+                if now - last_eval >= options.eval_interval:
+                    snapshot = {k: v.detach().clone() for k, v in shared.state_dict().items()}
+                    eval_model.load_state_dict(snapshot)
+                    done = evaluate()
+                    greedy = float(np.mean(done.returns))
+                    greedy_success = float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes]))
+                    last_eval = time.monotonic()
+                    if (
+                        options.target_return is not None
+                        and greedy >= options.target_return - TARGET_TOLERANCE
+                    ):
+                        best_state, stop_reason = snapshot, "target"
+                        solved_frames, solved_wall = stats.frames, wall0 + (last_eval - start)
+                now = time.monotonic()
+                if now - last_log >= options.log_interval or stop_reason:
+                    fps = (stats.frames - last_frames) / max(now - last_log, 1e-9)
+                    losses = stats.take_losses() or (None, None, None, None)
+                    rows.append(
+                        {
+                            "wall_s": _fmt(wall0 + now - start, ".2f"),
+                            "frames": stats.frames,
+                            "episodes": stats.episodes,
+                            "fps": _fmt(fps, ".1f"),
+                            "mean_return": _fmt(stats.mean_return(), ".4f"),
+                            "success_rate": _fmt(stats.success_rate(), ".4f"),
+                            "mean_length": _fmt(
+                                float(np.mean(stats.lengths)) if stats.lengths else None, ".2f"
+                            ),
+                            "greedy_return": _fmt(greedy, ".4f"),
+                            "greedy_success": _fmt(greedy_success, ".4f"),
+                            "policy_loss": _fmt(losses[0], ".5g"),
+                            "value_loss": _fmt(losses[1], ".5g"),
+                            "entropy": _fmt(losses[2], ".5g"),
+                            "grad_norm": _fmt(losses[3], ".5g"),
+                        }
+                    )
+                    _write_rows(out / METRICS_NAME, rows)
+                    last_log, last_frames = now, stats.frames
+                    progress.update(
+                        task,
+                        completed=min(
+                            stats.frames - frames0 if options.frames else now - start, total or 0
+                        )
+                        if total
+                        else None,
+                        stats=(
+                            f"{stats.frames:,} frames  {fps:,.0f}/s  {stats.episodes:,} ep  "
+                            f"return {_fmt(stats.mean_return(), '.2f') or '-'}  "
+                            f"success {_fmt(stats.success_rate(), '.0%') or '-'}  greedy {_fmt(greedy, '.2f') or '-'}"
+                        ),
+                    )
+                if stop_reason:
+                    break
+                if options.frames is not None and stats.frames >= options.frames:
+                    stop_reason = "frames"
+                elif options.minutes is not None and now - start >= options.minutes * 60:
+                    stop_reason = "time"
+                elif now - last_ckpt >= options.checkpoint_interval:
+                    checkpoint(None, {"wall_s": wall0 + now - start, "stop_reason": "running"})
+                    last_ckpt = now
+    except KeyboardInterrupt:
+        stop_reason = "interrupted"
+    finally:
+        stop.set()
+        deadline = time.monotonic() + 30
+        while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
+            try:
+                drain(0.05)
+            except KeyboardInterrupt:
+                continue
+            for p in procs:
+                p.join(timeout=0.01)
+        for p in procs:
+            if p.is_alive():
+                p.terminate()
+                p.join(timeout=5)
+        drain(0.0)
+    wall = wall0 + time.monotonic() - start
+    if failure:
+        raise RuntimeError(failure)
+    summary = {
+        "wall_s": round(wall, 2),
+        "stop_reason": stop_reason,
+        "greedy_return": greedy,
+        "greedy_success": greedy_success,
+        "mean_return": stats.mean_return(),
+        "success_rate": stats.success_rate(),
+        "solved_frames": solved_frames,
+        "solved_wall_s": None if solved_wall is None else round(solved_wall, 2),
+    }
+    if solved_frames is None and payload is not None:
+        prior = payload["metrics"]
+        summary["solved_frames"], summary["solved_wall_s"] = (
+            prior.get("solved_frames"),
+            prior.get("solved_wall_s"),
+        )
+    checkpoint(best_state, summary)
+    result = TrainResult(
+        checkpoint=ckpt_path,
+        frames=stats.frames,
+        episodes=stats.episodes,
+        wall_s=wall,
+        stop_reason=stop_reason,
+        greedy_return=greedy,
+        solved_frames=summary["solved_frames"],
+        solved_wall_s=summary["solved_wall_s"],
+        metrics=summary,
+    )
+    say(
+        f"stopped ({stop_reason}) after {stats.frames:,} frames, {stats.episodes:,} episodes, {wall:.1f} s; "
+        f"greedy return {_fmt(greedy, '.2f') or '-'}; checkpoint {ckpt_path}"
+    )
+    return result

@@ -1,0 +1,212 @@
+"""Checkpoints: round trip, safe loading, and one clear line for every bad file."""
+
+from __future__ import annotations
+
+import os
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from neurosym.agent.checkpoint import FORMAT, load_agent, read_checkpoint, save_checkpoint
+from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.introspection import PrediNetIntrospection
+from neurosym.agent.model import ActorCritic
+from neurosym.errors import CheckpointError
+
+CONFIG = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
+
+
+def write(path: Path, config: ModelConfig = CONFIG, **kw) -> ActorCritic:
+    torch.manual_seed(0)
+    model = ActorCritic(config)
+    save_checkpoint(
+        path,
+        model=model,
+        config=config,
+        env_name=kw.pop("env_name", "rgw2"),
+        env_kwargs={"max_steps": 100},
+        train_config=TrainConfig.for_family("rgw"),
+        frames=1234,
+        episodes=12,
+        metrics={"wall_s": 1.5, "greedy_return": None},
+        command="neurosym train --env rgw2 --module predinet --out runs/x",
+        **kw,
+    )
+    return model
+
+
+def error_of(path: Path, **kw) -> str:
+    with pytest.raises(CheckpointError) as info:
+        load_agent(path, **kw)
+    message = str(info.value)
+    assert "\n" not in message, message
+    return message
+
+
+def test_round_trip_and_act(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    model = write(path)
+    assert [p.name for p in tmp_path.iterdir()] == ["a.pt"]  # no temp file left behind
+    raw = torch.load(path, weights_only=True)
+    assert raw["format"] == FORMAT and raw["format_version"] == 1 and raw["frames"] == 1234
+    assert raw["model_config"] == CONFIG.to_dict() and raw["env"] == "rgw2"
+    assert raw["command"].startswith("neurosym train")
+    agent = load_agent(path)
+    assert (
+        agent.config == CONFIG
+        and agent.env_name == "rgw2"
+        and agent.env_kwargs == {"max_steps": 100}
+    )
+    assert agent.meta["frames"] == 1234 and agent.meta["metrics"]["wall_s"] == 1.5
+    assert not agent.model.training
+    for name, tensor in model.state_dict().items():
+        assert torch.equal(agent.model.state_dict()[name], tensor), name
+    obs = np.random.default_rng(0).integers(0, 2, (5, 9, 10, 10)).astype(np.uint8)
+    actions, intro = agent.act(obs)
+    logits, _ = model(torch.from_numpy(obs))
+    assert actions.shape == (5,) and np.array_equal(actions, logits.argmax(-1).numpy())
+    actions_i, intro = agent.act(obs, introspect=True)
+    assert np.array_equal(actions, actions_i)
+    assert isinstance(intro, PrediNetIntrospection) and isinstance(intro.attention1, np.ndarray)
+    assert intro.r_vectors().shape == (5, 4, 12)
+    one, _ = agent.act(obs[0])  # a single observation is a batch of one
+    assert one.shape == (1,) and one[0] == actions[0]
+    g1, g2 = torch.Generator().manual_seed(3), torch.Generator().manual_seed(3)
+    assert np.array_equal(
+        agent.act(obs, greedy=False, generator=g1)[0], agent.act(obs, greedy=False, generator=g2)[0]
+    )
+
+
+def test_overwrite_is_atomic_replacement(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    write(path, env_name="rgw1")
+    assert read_checkpoint(path)["env"] == "rgw1"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.pt"]
+
+
+def test_optimizer_state_round_trips_or_is_left_out(tmp_path: Path) -> None:
+    from neurosym.agent.a3c import SharedRMSprop
+
+    model = ActorCritic(CONFIG)
+    opt = SharedRMSprop(model.parameters(), lr=1e-3, alpha=0.99, eps=0.1)
+    write(tmp_path / "a.pt", optimizer_state=opt.state_dict())
+    saved = read_checkpoint(tmp_path / "a.pt")["optimizer"]
+    assert saved["param_groups"][0]["eps"] == 0.1 and len(saved["state"]) == len(
+        list(model.parameters())
+    )
+    write(tmp_path / "b.pt")  # slim: no optimizer state
+    assert read_checkpoint(tmp_path / "b.pt")["optimizer"] is None
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    assert error_of(tmp_path / "nope.pt") == f"checkpoint not found: {tmp_path / 'nope.pt'}"
+    assert "is not a file" in error_of(tmp_path)
+
+
+def test_truncated_file(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    assert "truncated, corrupt or not a torch checkpoint" in error_of(path)
+    path.write_bytes(b"")
+    assert "cannot read" in error_of(path)
+
+
+def test_text_file(tmp_path: Path) -> None:
+    path = tmp_path / "notes.pt"
+    path.write_text("hello, these are my notes\nline two\n")
+    assert error_of(path).startswith(f"cannot read {path}")
+
+
+def test_plain_state_dict_is_foreign(tmp_path: Path) -> None:
+    path = tmp_path / "sd.pt"
+    torch.save(ActorCritic(CONFIG).state_dict(), path)
+    assert "plain torch state dict, not a neurosym checkpoint" in error_of(path)
+    torch.save({"format": "something-else"}, path)
+    assert "not a neurosym checkpoint (format 'something-else')" in error_of(path)
+    torch.save([1, 2, 3], path)
+    assert "not a neurosym checkpoint (it holds a list)" in error_of(path)
+
+
+class _Exploit:
+    """Unpickling this would create the marker file."""
+
+    def __init__(self, marker: Path) -> None:
+        self.marker = marker
+
+    def __reduce__(self):
+        return (Path.touch, (self.marker,))
+
+
+@pytest.mark.filterwarnings("ignore:Detected pickle protocol")
+@pytest.mark.parametrize("how", ["pickle", "torch.save"])
+def test_malicious_pickle_runs_no_code(tmp_path: Path, how: str) -> None:
+    marker = tmp_path / "pwned"
+    path = tmp_path / "evil.pt"
+    payload = {"format": FORMAT, "format_version": 1, "state_dict": _Exploit(marker)}
+    if how == "pickle":
+        path.write_bytes(pickle.dumps(payload))
+    else:
+        torch.save(payload, path)
+    # the payload really is armed: unpickling it unsafely creates the marker
+    pickle.loads(pickle.dumps(_Exploit(tmp_path / "armed")))
+    assert (tmp_path / "armed").exists()
+    message = error_of(path)
+    assert not marker.exists()
+    assert (
+        message.startswith(f"refused {path}: it holds pickled Python objects")
+        and "nothing in it was run" in message
+    )
+
+
+def test_damaged_fields_and_newer_format(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    raw = torch.load(path, weights_only=True)
+    torch.save({**raw, "format_version": 99}, path)
+    assert "format version 99; this neurosym reads version 1" in error_of(path)
+    torch.save({**raw, "frames": "many"}, path)
+    assert "'frames' is missing or has the wrong type" in error_of(path)
+    torch.save({**raw, "model_config": {**raw["model_config"], "module": "lstm"}}, path)
+    assert "bad model config: unknown module 'lstm'" in error_of(path)
+    state = dict(raw["state_dict"])
+    state["policy.weight"] = torch.zeros(7, 64)
+    torch.save({**raw, "state_dict": state}, path)
+    assert "the weights do not fit its model config" in error_of(path)
+
+
+def test_model_config_mismatch(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    other = ModelConfig.for_family("rgw", "mhdpa", (9, 10, 10), heads=2)
+    message = error_of(path, config=other)
+    assert (
+        message
+        == f"{path} has a different model config: module 'predinet' (asked for 'mhdpa'); heads 4 (asked for 2)"
+    )
+
+
+def test_checkpoint_for_another_env(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    assert error_of(path, env="rgw1") == f"{path} was trained on rgw2, not rgw1"
+    assert load_agent(path, env="neurosym/RGW2-v0").env_name == "rgw2"
+
+
+def test_save_refuses_objects(tmp_path: Path) -> None:
+    from neurosym.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="only tensors and plain values"):
+        save_checkpoint(
+            tmp_path / "a.pt",
+            model=ActorCritic(CONFIG),
+            config=CONFIG,
+            env_name="rgw2",
+            metrics={"when": object()},
+        )
+    assert not os.listdir(tmp_path)
