@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib import patheffects
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Colormap, Normalize, to_rgb
 from matplotlib.image import AxesImage
 from matplotlib.patches import FancyArrowPatch, Patch, Rectangle
+from matplotlib.text import Text
 
 from neurosym.viz.style import entity_colour, entity_label, split_entity, text_colour_on
 
@@ -51,14 +53,17 @@ def _frame(ax: Axes, shape: tuple[int, int]) -> None:
     )
 
 
-def _patch(ax: Axes, patch: Patch) -> None:
+def _patch(ax: Axes, patch: Patch) -> Patch:
     """A patch inside the axes, left out of the layout computation."""
     ax.add_patch(patch).set_in_layout(False)
+    return patch
 
 
-def _cell_text(ax: Axes, x: float, y: float, text: str, **kwargs: object) -> None:
+def _cell_text(ax: Axes, x: float, y: float, text: str, **kwargs: object) -> Text:
     """Text inside a cell; left out of the layout computation (it never leaves the axes)."""
-    ax.text(x, y, text, ha="center", va="center", **kwargs).set_in_layout(False)
+    artist = ax.text(x, y, text, ha="center", va="center", **kwargs)
+    artist.set_in_layout(False)
+    return artist
 
 
 def entity_rgb(names: np.ndarray) -> np.ndarray:
@@ -151,54 +156,46 @@ def head_arrow(
     colour: str,
     label: str,
     fontsize: float,
-) -> None:
+) -> list[Artist]:
     """An arrow from one attended cell to the other, with the head number at its middle.
 
-    When both arguments are the same cell, a ring marks it instead.
+    When both arguments are the same cell, a square marks it instead. Returns the artists drawn.
     """
     (x0, y0), (x1, y1) = start, end
+    text = dict(color=colour, fontsize=fontsize, fontweight="bold", path_effects=_STROKE)
     if (x0, y0) == (x1, y1):
-        _patch(
-            ax,
-            Rectangle(
-                (x0 - 0.38, y0 - 0.38), 0.76, 0.76, fill=False, edgecolor=colour, linewidth=1.5
-            ),
+        ring = Rectangle(
+            (x0 - 0.38, y0 - 0.38), 0.76, 0.76, fill=False, edgecolor=colour, linewidth=1.5
         )
-        _cell_text(
-            ax,
-            x0 + 0.38,
-            y0 - 0.38,
-            label,
-            color=colour,
-            fontsize=fontsize,
-            fontweight="bold",
-            path_effects=_STROKE,
-        )
-        return
-    _patch(
-        ax,
-        FancyArrowPatch(
-            (x0, y0),
-            (x1, y1),
-            arrowstyle="-|>",
-            mutation_scale=8,
-            color=colour,
-            linewidth=1.4,
-            shrinkA=2,
-            shrinkB=2,
-            connectionstyle="arc3,rad=0.15",
-        ),
-    )
-    _cell_text(
-        ax,
-        (x0 + x1) / 2,
-        (y0 + y1) / 2,
-        label,
+        return [_patch(ax, ring), _cell_text(ax, x0 + 0.38, y0 - 0.38, label, **text)]
+    arrow = FancyArrowPatch(
+        (x0, y0),
+        (x1, y1),
+        arrowstyle="-|>",
+        mutation_scale=8,
         color=colour,
-        fontsize=fontsize,
-        fontweight="bold",
-        path_effects=_STROKE,
+        linewidth=1.4,
+        shrinkA=2,
+        shrinkB=2,
+        connectionstyle="arc3,rad=0.15",
     )
+    return [_patch(ax, arrow), _cell_text(ax, (x0 + x1) / 2, (y0 + y1) / 2, label, **text)]
+
+
+def mark_agent(ax: Axes, row: int, col: int, *, fontsize: float) -> list[Artist]:
+    """The agent's cell drawn on top of the terrain (the moving part of an animation)."""
+    fill = entity_colour("agent")
+    cell = Rectangle((col - 0.5, row - 0.5), 1, 1, facecolor=fill, edgecolor="none")
+    label = _cell_text(
+        ax,
+        col,
+        row,
+        entity_label("agent"),
+        fontsize=fontsize,
+        color=text_colour_on(fill),
+        fontweight="bold",
+    )
+    return [_patch(ax, cell), label]
 
 
 def draw_route(ax: Axes, path: np.ndarray, *, colour: str = "#1f77b4") -> LineCollection:
