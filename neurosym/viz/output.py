@@ -58,16 +58,6 @@ def figure_bytes(fig: Figure, fmt: str, dpi: float) -> bytes:
     return buf.getvalue()
 
 
-def figure_rgb(fig: Figure, dpi: float) -> np.ndarray:
-    """Rasterise ``fig`` to an ``(height, width, 3)`` uint8 array (frames of an animation)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
-    fig.set_dpi(dpi)
-    canvas.draw()
-    return np.asarray(canvas.buffer_rgba())[..., :3].copy()
-
-
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file in the same folder and ``os.replace``."""
     target = Path(path)
