@@ -91,7 +91,7 @@ key_opens(Key, Lock) :-
 
 got_order(E, Items) :-
     bw_episode_(E),
-    findall(T-I, event(E, T, got(I)), Pairs0),
+    findall(T-I, ( event(E, T, Ev), Ev = got(I) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Items).
 
@@ -127,7 +127,7 @@ followed_solution(E) :-
 
 distractor_taken(E) :-
     bw_episode_(E),
-    once(event(E, _, hit(distractor))).
+    bw_event_(E, hit(distractor)).
 
 %!  distractor_avoided(?Episode) is nondet.
 %
@@ -140,8 +140,8 @@ distractor_taken(E) :-
 distractor_avoided(E) :-
     bw_episode_(E),
     once(distractor_box(E, _, _)),
-    once(event(E, _, got(gem))),
-    \+ event(E, _, hit(distractor)).
+    bw_event_(E, got(gem)),
+    \+ bw_event_(E, hit(distractor)).
 
 %!  key_lock_link(?Colour, ?Link) is nondet.
 %
@@ -200,6 +200,11 @@ matching_lock_rate(Attended, Holding) :-
 
 bw_episode_(E) :-
     episode(E, _, _, _).
+
+%   bw_event_(+E, +Event): Event happened in E. Looked up by episode only, so
+%   SWI-Prolog needs no composite (episode, event) index (see rgw.pl).
+bw_event_(E, Event) :-
+    once(( event(E, _, Ev), Ev == Event )).
 
 %   bw_box_(?E, ?Lock, ?Content, ?Row, ?Col): a box at the start of E, its
 %   lock at (Row, Col) and its content at (Row, Col - 1).

@@ -32,6 +32,7 @@
 %       E = 3.
 
 sword_before_enemy(E) :-
+    rgw_episode_(E),
     rgw_first_event_(E, picked(sword), Ts),
     rgw_first_enemy_(E, Te),
     Ts < Te.
@@ -44,6 +45,7 @@ sword_before_enemy(E) :-
 %       true.
 
 teleport_before_enemy(E) :-
+    rgw_episode_(E),
     rgw_first_event_(E, teleported, Tt),
     rgw_first_enemy_(E, Te),
     Tt < Te.
@@ -58,8 +60,11 @@ teleport_before_enemy(E) :-
 
 enemy_beaten_with_sword(E) :-
     rgw_episode_(E),
-    once(( event(E, T, defeated(enemy)),
-           holding(E, T, sword) )).
+    once(( event(E, T, Event),
+           Event == defeated(enemy),
+           holding(E, T1, Item),
+           T1 == T,
+           Item == sword )).
 
 %!  visit_order(?Episode, -Order:list) is nondet.
 %
@@ -158,12 +163,15 @@ sword_enemy_link(Answer) :-
 rgw_episode_(E) :-
     episode(E, _, _, _).
 
-%   rgw_first_event_(?E, +Event, -T): T is the first time Event happened in E.
-%   Unbound E walks the events (indexed on Event); bound E uses the first
-%   argument index. The \+ keeps one answer per episode.
+%   rgw_first_event_(+E, +Event, -T): T is the first time Event happened in E;
+%   fails when it never did.
+%
+%   Speed: the rules look events up by episode only (event(E, T, Ev) with E
+%   bound, then compare Ev), so SWI-Prolog builds one just-in-time index, on
+%   the first argument, and no composite index on (E, Event), whose
+%   construction dominated the first call over large KBs.
 rgw_first_event_(E, Event, T) :-
-    event(E, T, Event),
-    \+ ( event(E, T0, Event), T0 < T ).
+    aggregate_all(min(T0), ( event(E, T0, Ev), Ev == Event ), T).
 
 %   rgw_first_enemy_(+E, -T): the first time the agent met the enemy in E.
 rgw_first_enemy_(E, T) :-
