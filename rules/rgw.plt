@@ -50,6 +50,15 @@ test(visit_order_all, Os == [0-[sword, teleport, enemy, terminal],
 test(optimal_order, Es == [0]) :-
     findall(E, optimal_order(E), Es).
 
+% The rules look events up by episode only: after running all of them,
+% SWI-Prolog's just-in-time indexes on event/3 are on the first argument alone.
+test(event_indexed_on_the_episode_only, Kinds == [single(1)]) :-
+    forall(member(G, [sword_before_enemy(_), teleport_before_enemy(_),
+                      enemy_beaten_with_sword(_), visit_order(_, _)]),
+           forall(G, true)),
+    predicate_property(user:event(_, _, _), indexed(Indexes)),
+    findall(K, member(K-_, Indexes), Kinds).
+
 :- end_tests(rgw_behaviour).
 
 :- begin_tests(rgw_network).
