@@ -6,6 +6,8 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from neurosym.errors import ConfigError
 from neurosym.export.facts import PREDICATES, FactSet, extract_facts
@@ -184,3 +186,36 @@ def test_to_parquet(tmp_path: Path) -> None:
     back = pd.read_parquet(tmp_path / "facts" / "holds.parquet")
     assert rows(back) == rows(facts["holds"])
     assert isinstance(facts, FactSet)
+
+
+# --------------------------------------------------------------------------- property
+
+
+relation_rows = st.lists(
+    st.tuples(
+        st.integers(0, 2),  # episode
+        st.integers(0, 3),  # t
+        st.integers(0, 1),  # head
+        st.integers(0, 2),  # j
+        st.sampled_from(["agent", "sword", "enemy", "key(red)"]),
+        st.sampled_from(["agent", "sword", "enemy", "key(red)"]),
+        st.floats(-2, 2, allow_nan=False).filter(lambda v: v != 0),
+    ),
+    max_size=40,
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(rows=relation_rows, spec=st.sampled_from(["abs:0.5", "quantile:0.5", "z:0", "abs:0"]))
+def test_holds_is_exactly_the_oriented_rows_above_threshold(rows: list[tuple], spec: str) -> None:
+    rel = pd.DataFrame(rows, columns=["episode", "t", "head", "j", "a", "b", "value"])
+    facts = extract_facts(Recording(relations=rel), threshold=spec)
+    thr = dict(facts.thresholds().items())
+    expected = set()
+    for e, t, _h, j, a, b, v in rows:
+        if abs(v) > thr[j]:
+            expected.add((e, t, j, a, b) if v > 0 else (e, t, j, b, a))
+    got = [tuple(r) for r in facts["holds"].itertuples(index=False)]
+    assert len(got) == len(set(got))  # one fact per (E, T, J, A, B)
+    assert set(got) == expected
+    assert got == sorted(got, key=lambda r: (r[0], r[1], r[2], r[3], r[4]))
