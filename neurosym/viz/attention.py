@@ -9,13 +9,11 @@ grid, with the objects labelled and the chosen object framed.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from matplotlib.figure import Figure
 
 from neurosym.viz.panels import Panel, heat_map_figure
-from neurosym.viz.sources import load_trace, require_source_module
+from neurosym.viz.sources import EnvLike, Source, load_trace, require_source_module
 from neurosym.viz.trace import EpisodeTrace
 
 OBJECT_FRAME = "#ff2d2d"
@@ -27,8 +25,8 @@ NOT_RECORDED = (
 
 
 def mhdpa_figure(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     step: int = 0,
     object: str | None = "agent",

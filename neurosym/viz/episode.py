@@ -29,7 +29,7 @@ from neurosym.viz.grid import (
     mark_agent,
 )
 from neurosym.viz.output import save_gif
-from neurosym.viz.sources import load_trace
+from neurosym.viz.sources import EnvLike, Source, load_trace
 from neurosym.viz.style import head_colour, legend_text
 from neurosym.viz.trace import EpisodeTrace
 
@@ -154,8 +154,8 @@ def _arrow_note(trace: EpisodeTrace, heads: Sequence[int]) -> str:
 
 
 def episode_figure(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     head: int | None = None,
     episode: int | None = None,
@@ -295,9 +295,9 @@ class _Film:
 
 
 def save_episode_gif(
-    source: Any,
+    source: Source,
     path: str | os.PathLike[str],
-    env: Any = None,
+    env: EnvLike = None,
     *,
     head: int | None = None,
     episode: int | None = None,

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -19,10 +19,15 @@ import pandas as pd
 from neurosym.errors import ConfigError
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
+if TYPE_CHECKING:
+    import gymnasium
+
+    from neurosym.agent.checkpoint import Agent
+
 
 def trace_from_agent(
-    agent: Any,
-    env: Any = None,
+    agent: Agent,
+    env: str | gymnasium.Env | None = None,
     *,
     seed: int = 0,
     max_steps: int | None = None,
@@ -54,7 +59,13 @@ class _Play:
     """One greedy (or seeded sampled) episode, keeping per step only what the plots need."""
 
     def __init__(
-        self, agent: Any, env: Any, env_name: str, seed: int, greedy: bool, keep: set[int] | None
+        self,
+        agent: Agent,
+        env: gymnasium.Env,
+        env_name: str,
+        seed: int,
+        greedy: bool,
+        keep: set[int] | None,
     ) -> None:
         import torch
 
@@ -176,7 +187,9 @@ def _one_torch_thread() -> Iterator[None]:
         torch.set_num_threads(before)
 
 
-def _open_env(agent: Any, env: Any, make: Any) -> tuple[Any, str, bool]:
+def _open_env(
+    agent: Agent, env: str | gymnasium.Env | None, make: Any
+) -> tuple[gymnasium.Env, str, bool]:
     """(env, short name, whether we made it): a fresh env unless the caller passed one.
 
     A named env other than the checkpoint's is made without the checkpoint's

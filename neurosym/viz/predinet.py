@@ -19,7 +19,7 @@ from matplotlib.ticker import MaxNLocator
 
 from neurosym.errors import ConfigError
 from neurosym.viz.panels import Panel, heat_map_figure
-from neurosym.viz.sources import load_trace, require_source_module
+from neurosym.viz.sources import EnvLike, Source, load_trace, require_source_module
 from neurosym.viz.style import head_colour
 from neurosym.viz.trace import EpisodeTrace
 
@@ -39,8 +39,8 @@ R_HEAD_INCHES = 1.6
 
 
 def predinet_figure(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     step: int = 0,
     head: int | None = None,
@@ -113,8 +113,8 @@ def _pairs(lines: list[str]) -> list[str]:
 
 
 def r_vectors_figure(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     head: int | None = None,
     episode: int | None = None,

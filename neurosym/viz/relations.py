@@ -22,7 +22,7 @@ from neurosym.errors import ConfigError
 from neurosym.export.facts import DEFAULT_THRESHOLD
 from neurosym.export.recording import Recording
 from neurosym.viz.live import trace_from_agent
-from neurosym.viz.sources import require_source_module
+from neurosym.viz.sources import EnvLike, Source, require_source_module
 from neurosym.viz.style import head_colour
 from neurosym.viz.trace import EpisodeTrace
 
@@ -36,7 +36,7 @@ _BINS = 40
 
 
 def relation_values(
-    source: Any, env: Any = None, *, episodes: int = 1, seed: int = 0
+    source: Source, env: EnvLike = None, *, episodes: int = 1, seed: int = 0
 ) -> tuple[pd.DataFrame, str]:
     """The relation table (episode, t, head, j, value) and a phrase saying where it came from.
 
@@ -95,8 +95,8 @@ def _trace_relations(traces: Sequence[EpisodeTrace]) -> pd.DataFrame:
 
 
 def relations_figure(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     threshold: Any = DEFAULT_THRESHOLD,
     episodes: int = 1,

@@ -8,7 +8,7 @@ relational module before any episode is played.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, TypeAlias
 
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
@@ -16,10 +16,28 @@ from neurosym.viz.live import trace_from_agent
 from neurosym.viz.recorded import trace_from_recording
 from neurosym.viz.trace import EpisodeTrace, require_module
 
-__all__ = ["load_trace", "require_source_module", "trace_from_agent", "trace_from_recording"]
+if TYPE_CHECKING:
+    import gymnasium
+
+    from neurosym.agent.checkpoint import Agent
+
+Source: TypeAlias = "Recording | Agent | EpisodeTrace"
+"""what every plotting function draws from"""
+
+EnvLike: TypeAlias = "str | gymnasium.Env | None"
+"""a short env name or registered id, an env object, or None for the checkpoint's own env"""
+
+__all__ = [
+    "EnvLike",
+    "Source",
+    "load_trace",
+    "require_source_module",
+    "trace_from_agent",
+    "trace_from_recording",
+]
 
 
-def require_source_module(source: Any, module: str, what: str) -> None:
+def require_source_module(source: Source, module: str, what: str) -> None:
     """Refuse early (before playing an episode) a plot that needs the other module."""
     if isinstance(source, EpisodeTrace):
         found, name = source.module, source.checkpoint
@@ -33,8 +51,8 @@ def require_source_module(source: Any, module: str, what: str) -> None:
 
 
 def load_trace(
-    source: Any,
-    env: Any = None,
+    source: Source,
+    env: EnvLike = None,
     *,
     episode: int | None = None,
     seed: int = 0,
