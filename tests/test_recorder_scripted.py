@@ -88,12 +88,16 @@ class ScriptedAgent:
     def act(
         self, obs: np.ndarray, greedy: bool = True, introspect: bool = False, generator: Any = None
     ) -> Any:
+        """The recorder passes only the sub-envs still playing: a plan's episode ends with its
+        last action (the timeout plan's at MAX_STEPS), so the live plans at step k are known."""
         _, intro = self.inner.act(obs, greedy=True, introspect=introspect)
         k = self.step
         self.step += 1
-        actions = np.array(
-            [p[k] if k < len(p) else U for p in self.plans[: len(obs)]], dtype=np.int64
+        live = [p for p in self.plans if (k < len(p) if p else k < MAX_STEPS)]
+        assert len(live) == len(obs), (
+            f"step {k}: {len(obs)} observations, {len(live)} live episodes"
         )
+        actions = np.array([p[k] if k < len(p) else U for p in live], dtype=np.int64)
         return actions, intro
 
 
@@ -183,7 +187,8 @@ class ExplorerAgent:
         from neurosym.envs.boxworld_solver import nearest_interaction
 
         _, intro = self.inner.act(obs, greedy=True, introspect=introspect)
-        grids = self.venv.entity_grid().reshape(len(obs), -1)
+        grids = self.venv.entity_grid().reshape(self.venv.num_envs, -1)[~self.venv.idle]
+        assert len(grids) == len(obs)
         actions = np.zeros(len(obs), dtype=np.int64)
         for i, grid in enumerate(grids):
             agent = int(np.flatnonzero(grid == AGENT)[0])
@@ -191,6 +196,27 @@ class ExplorerAgent:
             step = nearest_interaction(grid, agent, held)
             actions[i] = U if step is None else step
         return actions, intro
+
+
+class _Tracking:
+    """A batched env that remembers which sub-envs ended their episode since the last reset
+    (the recorder then stops passing their observations to the agent)."""
+
+    def __init__(self, venv: Any) -> None:
+        self.venv = venv
+        self.idle = np.zeros(venv.num_envs, dtype=bool)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.venv, name)
+
+    def reset(self, **kwargs: Any) -> Any:
+        self.idle[:] = False
+        return self.venv.reset(**kwargs)
+
+    def step(self, actions: np.ndarray) -> Any:
+        out = self.venv.step(actions)
+        self.idle |= out[2] | out[3]
+        return out
 
 
 @cache
@@ -204,7 +230,7 @@ def explorer_recording(env: str = "bw2", episodes: int = 8) -> Recording:
     real = envs.make_batched
 
     def capture(*args: Any, **kwargs: Any) -> Any:
-        agent.venv = real(*args, **kwargs)
+        agent.venv = _Tracking(real(*args, **kwargs))
         return agent.venv
 
     envs.make_batched = capture

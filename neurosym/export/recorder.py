@@ -302,13 +302,18 @@ class _Recorder:
         for i in range(count):
             self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
         while (live := np.flatnonzero(episode >= 0)).size:
-            grid = venv.entity_grid().reshape(n, -1)  # (n, N) entity codes of the current states
-            actions, intro = self.agent.act(
-                obs, greedy=self.greedy, introspect=True, generator=self.generator
+            grid = venv.entity_grid().reshape(n, -1)[live]  # (m, N) entity codes of the live states
+            # the model sees only the live sub-envs: idle ones at a wave's end cost nothing
+            acted, intro = self.agent.act(
+                obs[live] if live.size < n else obs,
+                greedy=self.greedy,
+                introspect=True,
+                generator=self.generator,
             )
-            actions = np.asarray(actions)
-            self._model_outputs(episode[live], t[live], grid, intro, live)
-            obs, reward, terminated, truncated, info = venv.step(actions.astype(np.int64))
+            actions = np.zeros(n, dtype=np.int64)  # idle sub-envs step "up"; nothing is recorded
+            actions[live] = np.asarray(acted)
+            self._model_outputs(episode[live], t[live], grid, intro)
+            obs, reward, terminated, truncated, info = venv.step(actions)
             self.step_cols.add(
                 episode=episode[live],
                 t=t[live],
@@ -335,14 +340,11 @@ class _Recorder:
             if ended:
                 self.advance(ended)
 
-    def _model_outputs(
-        self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any, live: np.ndarray
-    ) -> None:
-        """Keep the live rows' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
-        grid = grid[live]
+    def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any) -> None:
+        """Keep the live states' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
         if self.module == "predinet":
-            a1 = np.asarray(intro.attention1)[live]  # (m, H, N)
-            a2 = np.asarray(intro.attention2)[live]
+            a1 = np.asarray(intro.attention1)  # (m, H, N)
+            a2 = np.asarray(intro.attention2)
             i1, i2 = a1.argmax(-1), a2.argmax(-1)  # (m, H)
             self.model.add(
                 ep=ep,
@@ -353,11 +355,11 @@ class _Recorder:
                 w2=np.take_along_axis(a2, i2[..., None], -1)[..., 0],
                 e1=np.take_along_axis(grid, i1, 1),
                 e2=np.take_along_axis(grid, i2, 1),
-                rel=np.asarray(intro.relations)[live],  # (m, H, J)
-                rvec=np.asarray(intro.r_vectors())[live],  # (m, H, J + 4)
+                rel=np.asarray(intro.relations),  # (m, H, J)
+                rvec=np.asarray(intro.r_vectors()),  # (m, H, J + 4)
             )
         else:
-            att = np.asarray(intro.attention)[live]  # (m, H, N, N) query x key
+            att = np.asarray(intro.attention)  # (m, H, N, N) query x key
             k = min(self.top_keys, att.shape[-1])
             if k == 1:
                 top = att.argmax(-1)[..., None]  # (m, H, N, 1)
