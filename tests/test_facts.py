@@ -59,12 +59,12 @@ def recording() -> Recording:
         ),
         positions=pd.DataFrame(
             {
-                "episode": [0, 0, 0, 0],
-                "t": [0, 0, 1, 1],
-                "object": ["agent", "sword", "agent", "sword"],
-                "type": ["agent", "sword", "agent", "sword"],
-                "row": [0, 0, 0, 0],
-                "col": [0, 6, 1, 6],
+                "episode": [0, 0, 0, 0, 0],
+                "t": [0, 0, 0, 1, 1],
+                "object": ["agent", "sword", "enemy", "agent", "sword"],
+                "type": ["agent", "sword", "enemy", "agent", "sword"],
+                "row": [0, 0, 9, 0, 0],
+                "col": [0, 6, 1, 1, 6],
             }
         ),
         holding=pd.DataFrame({"episode": [0], "t": [2], "item": ["sword"]}),
@@ -116,7 +116,7 @@ def test_quantile_threshold_keeps_the_strongest_per_relation() -> None:
 def test_trace_tables() -> None:
     facts = extract_facts(recording())
     assert rows(facts["episode"]) == [(0, 3, 10.5, "terminal"), (1, 1, -1.0, "pit")]
-    assert rows(facts["object"]) == [("agent", "agent"), ("sword", "sword")]
+    assert rows(facts["object"]) == [("agent", "agent"), ("enemy", "enemy"), ("sword", "sword")]
     assert rows(facts["at"])[:2] == [(0, 0, "agent", 0, 0), (0, 0, "sword", 0, 6)]
     assert rows(facts["event"]) == [(0, 1, "picked(sword)"), (1, 0, "fell(pit)")]
     assert rows(facts["step"])[1] == (0, 1, "right", 0.5)
@@ -161,10 +161,23 @@ def test_strongest_relations_between_types() -> None:
     ]
 
 
+def test_strongest_relations_leave_out_background_cells() -> None:
+    rec = recording()
+    extra = pd.DataFrame(
+        [(0, 2, 1, 0, "sword", "empty", 5.0), (0, 2, 1, 1, "wall", "enemy", 5.0)],
+        columns=rec.relations.columns,
+    )
+    rel = pd.concat([rec.relations, extra], ignore_index=True)
+    facts = extract_facts(Recording(**{**rec.tables, "relations": rel}, meta=rec.meta), "abs:0.3")
+    top = facts.strongest_relations(10)
+    assert not top["a"].isin(["empty", "wall"]).any() and not top["b"].isin(["empty", "wall"]).any()
+    assert len(facts["holds"]) == len(HOLDS) + 2  # holds/5 itself keeps them
+
+
 def test_object_with_two_types_is_refused() -> None:
     rec = recording()
     pos = rec.positions.copy()
-    pos.loc[3, "type"] = "enemy"
+    pos.loc[4, "type"] = "enemy"
     with pytest.raises(ValueError, match="object 'sword' has more than one type"):
         extract_facts(Recording(**{**rec.tables, "positions": pos}, meta=rec.meta))
 

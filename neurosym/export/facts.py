@@ -107,18 +107,25 @@ class FactSet:
         return sum(self.counts().values())
 
     def strongest_relations(self, n: int = 5) -> pd.DataFrame:
-        """Oriented type pairs most often related above threshold, between different types.
+        """Oriented pairs of object types most often related above threshold.
 
-        Columns: j, a, b, held (holds facts, i.e. steps at which r(j)(a, b) held),
-        mean_value (mean of the positive oriented values that held). Sorted by held,
-        then mean_value, descending.
+        Only types of the map's named objects (``object/2``) and the agent count,
+        two different ones; background cells (empty, wall, terrain) do not. When
+        the KB lists no objects, every entity counts. Columns: j, a, b, held
+        (holds facts: states at which r(j)(a, b) held), mean_value (mean of the
+        positive oriented values that held). Sorted by held, then mean_value.
         """
         rel = self.tables["relation"]
         if rel.empty:
             return pd.DataFrame({"j": [], "a": [], "b": [], "held": [], "mean_value": []})
         oriented = orient(rel)
         keep = self.threshold.keep(oriented, self.thresholds())
-        kept = oriented.loc[keep & (oriented["a"] != oriented["b"]).to_numpy()]
+        keep &= (oriented["a"] != oriented["b"]).to_numpy()
+        types = self.tables["object"]["type"]
+        if len(types):
+            named = set(types) | {"agent"}
+            keep &= (oriented["a"].isin(named) & oriented["b"].isin(named)).to_numpy()
+        kept = oriented.loc[keep]
         per_step = (
             kept.groupby(["episode", "t", "j", "a", "b"], sort=False)["value"].max().reset_index()
         )

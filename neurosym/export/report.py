@@ -165,5 +165,7 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             console.print(qt)
         else:
             console.print("rules/ not found beside the package: no rule answers")
+    if kb is None:
+        console.print("rule answers: none (they need the Prolog KB: --format pl)")
     for path in written.values():
         console.print(f"wrote {path}")
