@@ -5,9 +5,9 @@ Lines, in order:
 * ``machine``: cores, load average, torch threads (figures are wall times on a
   machine that may be shared: compare with the load average);
 * ``record``: steps per second recorded with introspection by
-  :func:`neurosym.record` (batched env + model + table building), beside the
-  model's own forward rate with introspection at the same batch size, which
-  bounds it;
+  :func:`neurosym.record` (batched env + model + table building), best and
+  median of ``--repeat`` runs, beside the model's own forward rate with
+  introspection at the same batch size (``agent.act`` alone), which bounds it;
 * ``extract``: ``extract_facts`` time and the facts per second written by
   ``FactSet.to_prolog``;
 * ``kb`` (one line per KB): a KB of N episodes made by replicating the recorded
@@ -81,17 +81,23 @@ def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
     ), "untrained"
 
 
-def model_rate(agent: Any, env: str, batch: int, repeats: int = 5) -> float:
-    """Steps per second of agent.act(introspect=True) alone on a batch of real observations."""
+def model_rate(agent: Any, env: str, batch: int, repeats: int) -> tuple[float, float]:
+    """Best and median steps per second of agent.act(introspect=True) alone on real observations,
+    with the torch threads the recorder uses (one)."""
+    import torch
+
     from neurosym.envs import make_batched
 
     venv = make_batched(env, batch, seed=0, **agent.env_kwargs)
     obs, _ = venv.reset(seed=0)
-    agent.act(obs, introspect=True)
-    t0 = time.perf_counter()
-    for _ in range(repeats):
+    saved = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
         agent.act(obs, introspect=True)
-    return batch * repeats / (time.perf_counter() - t0)
+        times = [timed(lambda: agent.act(obs, introspect=True))[1] for _ in range(10 * repeats)]
+    finally:
+        torch.set_num_threads(saved)
+    return batch / min(times), batch / statistics.median(times)
 
 
 def replicate(facts: FactSet, episodes: int, names: tuple[str, ...]) -> FactSet:
@@ -174,6 +180,13 @@ def main() -> None:
     )
     ap.add_argument("--sizes", default="1000,10000,100000", help="KB sizes in episodes")
     ap.add_argument(
+        "--repeat",
+        type=int,
+        default=3,
+        help="timed recordings; best and median reported (default 3)",
+    )
+    ap.add_argument("--threads", type=int, default=None, help="torch threads (default: torch's)")
+    ap.add_argument(
         "--full-max", type=int, default=1000, help="largest KB with every predicate (default 1000)"
     )
     ap.add_argument(
@@ -184,6 +197,9 @@ def main() -> None:
     import torch
 
     from neurosym.export.recorder import DEFAULT_BATCH
+
+    if args.threads:
+        torch.set_num_threads(args.threads)
 
     emit(
         bench="machine",
@@ -196,8 +212,14 @@ def main() -> None:
     agent, source = load_or_build_agent(args.checkpoint, args.env)
     batch = args.batch or DEFAULT_BATCH
     record(agent, args.env, episodes=min(8, args.episodes), seed=0, batch=batch)  # warm-up
-    rec, rec_s = timed(lambda: record(agent, args.env, episodes=args.episodes, seed=0, batch=batch))
+    runs = []
+    for _ in range(args.repeat):
+        rec, seconds = timed(
+            lambda: record(agent, args.env, episodes=args.episodes, seed=0, batch=batch)
+        )
+        runs.append(seconds)
     steps = rec.n_steps
+    model_best, model_median = model_rate(agent, args.env, min(batch, args.episodes), args.repeat)
     emit(
         bench="record",
         checkpoint=source,
@@ -208,9 +230,11 @@ def main() -> None:
         episodes=args.episodes,
         batch=batch,
         steps=steps,
-        seconds=round(rec_s, 3),
-        steps_per_s=round(steps / rec_s),
-        model_steps_per_s=round(model_rate(agent, args.env, min(batch, args.episodes))),
+        seconds=[round(x, 3) for x in runs],
+        steps_per_s=round(steps / min(runs)),
+        steps_per_s_median=round(steps / statistics.median(runs)),
+        model_steps_per_s=round(model_best),
+        model_steps_per_s_median=round(model_median),
         returns_mean=round(float(rec.episodes["return"].mean()), 3),
     )
     facts, extract_s = timed(lambda: extract_facts(rec, threshold="quantile:0.9"))

@@ -197,6 +197,12 @@ def test_mhdpa_attention_table() -> None:
     assert rec.meta["module"] == "mhdpa" and rec.meta["relations"] == 0
 
 
+def test_torch_threads_are_restored() -> None:
+    before = torch.get_num_threads()
+    record(small_agent("rgw2"), "rgw2", episodes=1, threads=1)
+    assert torch.get_num_threads() == before
+
+
 def test_env_the_agent_was_not_trained_on_is_refused() -> None:
     with pytest.raises(CheckpointError, match="was trained on rgw2, not rgw1"):
         record(small_agent("rgw2"), "rgw1", episodes=1)
@@ -208,6 +214,7 @@ def test_env_the_agent_was_not_trained_on_is_refused() -> None:
         ({"episodes": 0}, "episodes must be a positive integer"),
         ({"seed": -1}, "seed must be a non-negative integer"),
         ({"batch": 0}, "batch must be a positive integer"),
+        ({"threads": 0}, "threads must be a positive integer or None"),
     ],
 )
 def test_bad_arguments(kwargs: dict, message: str) -> None:
