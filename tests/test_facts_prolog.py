@@ -33,11 +33,13 @@ def rgw(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[FactSet, Pat
 
 
 @pytest.fixture(scope="module")
-def boxworld(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[FactSet, KnowledgeBase]]:
+def boxworld(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> Iterator[tuple[FactSet, Path, KnowledgeBase]]:
     facts = extract_facts(explorer_recording(), threshold="quantile:0.9")
-    path = facts.to_prolog(tmp_path_factory.mktemp("kb") / "kb.pl")
+    path = facts.to_prolog(tmp_path_factory.mktemp("kb") / "kb.pl", qlf=True)
     with KnowledgeBase(path, rules=[RULES / "boxworld.pl", RULES / "relations.pl"]) as kb:
-        yield facts, kb
+        yield facts, path, kb
 
 
 def values(kb: KnowledgeBase, goal: str, var: str) -> list:
@@ -48,9 +50,11 @@ def first_t(events: pd.DataFrame, which: tuple[str, ...]) -> pd.Series:
     return events[events["event"].isin(which)].groupby("episode")["t"].min()
 
 
-def test_kb_loads_in_plain_swipl_without_messages(rgw: tuple, swipl: Path) -> None:
+def test_kb_loads_in_plain_swipl_without_messages(rgw: tuple, boxworld: tuple, swipl: Path) -> None:
     _, path, _ = rgw
-    for files in ([path], [path, RULES / "rgw.pl", RULES / "relations.pl", RULES / "boxworld.pl"]):
+    bw_path = boxworld[1]
+    rules = [RULES / "rgw.pl", RULES / "relations.pl", RULES / "boxworld.pl"]
+    for files in ([path], [path, *rules], [bw_path, *rules], [bw_path.with_suffix(".qlf"), *rules]):
         proc = subprocess.run(
             [swipl, "-q", "-g", "halt", *files], capture_output=True, text=True, timeout=60
         )
@@ -156,7 +160,7 @@ def test_relation_statistics_match_pandas(rgw: tuple) -> None:
 
 
 def test_boxworld_rules_match_pandas(boxworld: tuple) -> None:
-    facts, kb = boxworld
+    facts, _, kb = boxworld
     at0 = facts["at"][facts["at"]["t"] == 0].merge(facts["object"], on="id")
     locks = at0[at0["type"].str.startswith("lock(")]
     left = at0.assign(col=at0["col"] + 1)[["episode", "row", "col", "type"]].rename(
@@ -194,7 +198,7 @@ def test_boxworld_rules_match_pandas(boxworld: tuple) -> None:
 
 
 def test_boxworld_solution_chain_is_consistent_with_the_gem_episodes(boxworld: tuple) -> None:
-    _, kb = boxworld
+    _, _, kb = boxworld
     for row in kb.query("gem_chain(E, C)"):
         chains = [r["S"] for r in kb.query("solution_chain(E, S)", E=row["E"])]
         assert chains, row["E"]
