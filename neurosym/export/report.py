@@ -95,47 +95,50 @@ def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
 
 
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
-    """Print the summary of an extract run with rich (plain text when not a terminal)."""
+    """Print the summary of an extract run with rich (plain text when not a terminal).
+
+    Every value printed is escaped: Prolog lists such as ``[sword,enemy]`` would
+    otherwise be read as rich markup and vanish.
+    """
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
 
     from neurosym.envs import env_family
 
-    console = Console()
+    console = Console(highlight=False)
+    say = console.print
     meta = rec.meta
     ep = rec.episodes
-    console.print(
-        f"[bold]{meta.get('env')}[/]: {len(ep)} episodes ({'greedy' if meta.get('greedy', True) else 'sampled'}, "
-        f"seed {meta.get('seed')}) of {meta.get('checkpoint')} "
-        f"({meta.get('module')}, {meta.get('heads')} heads, {meta.get('relations')} relations)"
+    mode = "greedy" if meta.get("greedy", True) else "sampled"
+    say(
+        f"[bold]{escape(str(meta.get('env')))}[/]: {len(ep)} episodes ({mode}, seed {meta.get('seed')}) "
+        f"of {escape(str(meta.get('checkpoint')))} ({meta.get('module')}, {meta.get('heads')} heads, "
+        f"{meta.get('relations')} relations)"
     )
     table = Table(title="episodes", show_edge=False)
     for col in ("episode", "steps", "return", "outcome"):
-        table.add_column(col, justify="right" if col != "outcome" else "left")
-    for e, steps, ret, outcome in ep.head(20)[["episode", "steps", "return", "outcome"]].itertuples(
-        index=False, name=None
-    ):
-        table.add_row(str(e), str(steps), f"{ret:.2f}", str(outcome))
-    console.print(table)
+        table.add_column(col, justify="left" if col == "outcome" else "right")
+    shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
+    for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
+        table.add_row(str(e), str(steps), f"{ret:.2f}", escape(str(outcome)))
+    say(table)
     if len(ep) > 20:
-        console.print(f"... {len(ep) - 20} more episodes")
+        say(f"... {len(ep) - 20} more episodes")
     if len(ep):
         outcomes = ", ".join(
             f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
         )
-        console.print(
-            f"return: mean {ep['return'].mean():.3f}, min {ep['return'].min():.3f}, max {ep['return'].max():.3f}; {outcomes}"
+        r = ep["return"]
+        say(
+            f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {escape(outcomes)}"
         )
 
-    counts = facts.counts()
-    console.print(
-        "facts: "
-        + ", ".join(f"{k} {v}" for k, v in counts.items() if v)
-        + f"  ({facts.n_facts} in all)"
-    )
+    counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
+    say(f"facts: {counts}  ({facts.n_facts} in all)")
     thr = facts.thresholds()
     if len(thr):
-        console.print(
+        say(
             f"thresholds ({facts.threshold}): "
             + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
         )
@@ -146,14 +149,18 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
         for col in ("relation", "from", "to", "states", "mean value"):
             st.add_column(col)
         for r in strongest.itertuples(index=False):
-            st.add_row(f"r({r.j})", str(r.a), str(r.b), str(r.held), f"{r.mean_value:.4g}")
-        console.print(st)
+            st.add_row(
+                f"r({r.j})", escape(str(r.a)), escape(str(r.b)), str(r.held), f"{r.mean_value:.4g}"
+            )
+        say(st)
     elif not facts["attention"].empty:
-        console.print(
-            "MHDPA: attention/6 facts hold the strongest key per query (no relation values)"
-        )
+        say("MHDPA: attention/6 holds the strongest key of every query cell (no relation values)")
+    elif not facts["relation"].empty:
+        say("strongest relations between object types: none held above threshold")
 
-    if kb is not None:
+    if kb is None:
+        say("rule answers: none (they need the Prolog KB: --format pl)")
+    else:
         family = env_family(str(meta.get("env")))
         answers = rule_answers(kb, family)
         if answers:
@@ -161,11 +168,10 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             qt.add_column("question")
             qt.add_column("answers")
             for title, goal, values in answers:
-                qt.add_row(title, _short(values, of=len(ep) if goal.endswith("(E)") else None))
-            console.print(qt)
+                of = len(ep) if goal.endswith("(E)") else None
+                qt.add_row(title, escape(_short(values, of=of)))
+            say(qt)
         else:
-            console.print("rules/ not found beside the package: no rule answers")
-    if kb is None:
-        console.print("rule answers: none (they need the Prolog KB: --format pl)")
+            say("rule answers: none (rules/ is not beside the package)")
     for path in written.values():
-        console.print(f"wrote {path}")
+        say(f"wrote {escape(str(path))}")
