@@ -109,8 +109,9 @@ class FactSet:
     def strongest_relations(self, n: int = 5) -> pd.DataFrame:
         """Oriented pairs of object types most often related above threshold.
 
-        Only types of the map's named objects (``object/2``) and the agent count,
-        two different ones; background cells (empty, wall, terrain) do not. When
+        Only types of the map's named objects (``object/2``), the agent and
+        Box-World's held key count, two different ones; background cells (empty,
+        wall, terrain) do not. When
         the KB lists no objects, every entity counts. Columns: j, a, b, held
         (holds facts: states at which r(j)(a, b) held), mean_value (mean of the
         positive oriented values that held). Sorted by held, then mean_value.
@@ -124,7 +125,11 @@ class FactSet:
         types = self.tables["object"]["type"]
         if len(types):
             named = set(types) | {"agent"}
-            keep &= (oriented["a"].isin(named) & oriented["b"].isin(named)).to_numpy()
+
+            def is_named(col: pd.Series) -> np.ndarray:  # Box-World's held key counts too
+                return (col.isin(named) | col.str.startswith("held(")).to_numpy()
+
+            keep &= is_named(oriented["a"]) & is_named(oriented["b"])
         kept = oriented.loc[keep]
         per_step = (
             kept.groupby(["episode", "t", "j", "a", "b"], sort=False)["value"].max().reset_index()
