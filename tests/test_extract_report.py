@@ -1,0 +1,45 @@
+"""The summary ``neurosym extract`` prints, in process, for Box-World and for an MHDPA agent."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from test_recorder_scripted import explorer_recording, scripted_recording
+
+from neurosym.export.cli_extract import write_outputs
+from neurosym.export.facts import extract_facts
+from neurosym.export.report import QUERIES, print_report
+
+
+def report(rec, tmp_path: Path, capsys: pytest.CaptureFixture[str], formats=("pl",)) -> str:  # noqa: ANN001
+    facts = extract_facts(rec, threshold="quantile:0.9")
+    written = write_outputs(tmp_path / "out", rec, facts, formats)
+    print_report(rec, facts, written, kb=written.get("kb.pl"))
+    return capsys.readouterr().out
+
+
+def test_boxworld_report_answers_every_question(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = explorer_recording()
+    text = report(rec, tmp_path, capsys)
+    for title, _goal, _var in QUERIES["boxworld"]:
+        assert title in text
+    assert "key(" in text and "lock(" in text  # key opens lock answers, as Prolog text
+    taken = int((rec.episodes["outcome"] == "distractor").sum())
+    assert re.search(rf"distractor taken\s+│ [0-9, ]+\({taken} of {len(rec.episodes)} episodes\)", text)
+
+
+def test_mhdpa_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = report(scripted_recording("mhdpa"), tmp_path, capsys)
+    assert "MHDPA: attention/6 holds the strongest key of every query cell" in text
+    assert "sword before enemy" in text and "0  (1 of 5 episodes)" in text
+
+
+def test_report_without_a_prolog_kb(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = report(scripted_recording(), tmp_path, capsys, formats=("parquet",))
+    assert "rule answers: none (they need the Prolog KB: --format pl)" in text
+    assert not (tmp_path / "out" / "kb.pl").exists()
+    assert (tmp_path / "out" / "facts" / "holds.parquet").is_file()
