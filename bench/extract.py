@@ -22,8 +22,9 @@ Lines, in order:
   ``--full-max`` episodes).
 
 The checkpoint defaults to the shipped ``checkpoints/rgw2-predinet.pt``; without
-it an untrained default-size PrediNet is used (then the episodes are timeouts
-and the figures say ``"checkpoint": "untrained"``).
+it an untrained default-size PrediNet introspects while the actions follow the
+optimal route of Configuration-2 (``"policy": "route"``), so that the KBs hold
+the events the rules ask about (sword, teleport, enemy, terminal).
 
     python bench/extract.py                       # 1k, 10k, 100k episodes
     python bench/extract.py --sizes 1000 --episodes 64     # quick
@@ -79,6 +80,32 @@ def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
     return Agent(
         model=ActorCritic(cfg).eval(), config=cfg, env_name=env, env_kwargs={}, path=None
     ), "untrained"
+
+
+# The optimal route of Configuration-2 (thesis figure 9): sword, teleport, enemy, terminal.
+RGW2_ROUTE = [1] * 6 + [2] * 3 + [1] * 3 + [2] + [3] * 8
+
+
+class RouteAgent:
+    """Plays RGW2_ROUTE in every episode while the wrapped agent's model introspects.
+
+    For KBs whose episodes hold the events the rules ask about when no trained
+    checkpoint is at hand. Every episode of a wave ends at the same step, so
+    the batch never shrinks and step k of the wave is step k of every episode.
+    """
+
+    def __init__(self, inner: Any) -> None:
+        self.inner, self.step = inner, 0
+        self.config, self.env_name, self.env_kwargs = inner.config, inner.env_name, inner.env_kwargs
+        self.path = "optimal route"
+
+    def act(
+        self, obs: Any, greedy: bool = True, introspect: bool = False, generator: Any = None
+    ) -> Any:
+        _, intro = self.inner.act(obs, introspect=introspect)
+        k = self.step % len(RGW2_ROUTE)
+        self.step += 1
+        return np.full(len(obs), RGW2_ROUTE[k], dtype=np.int64), intro
 
 
 def model_rate(agent: Any, env: str, batch: int, repeats: int) -> tuple[float, float]:
@@ -187,6 +214,13 @@ def main() -> None:
     )
     ap.add_argument("--threads", type=int, default=None, help="torch threads (default: torch's)")
     ap.add_argument(
+        "--policy",
+        choices=["checkpoint", "route"],
+        default=None,
+        help="actions from the checkpoint, or rgw2's optimal route with the model introspecting "
+        "(default: checkpoint when there is one, else route)",
+    )
+    ap.add_argument(
         "--full-max", type=int, default=1000, help="largest KB with every predicate (default 1000)"
     )
     ap.add_argument(
@@ -210,6 +244,11 @@ def main() -> None:
         torch=torch.__version__,
     )
     agent, source = load_or_build_agent(args.checkpoint, args.env)
+    policy = args.policy or ("checkpoint" if source != "untrained" else "route")
+    if policy == "route":
+        if args.env != "rgw2":
+            raise SystemExit("--policy route plays Configuration-2's optimal route: use --env rgw2")
+        agent = RouteAgent(agent)
     batch = args.batch or DEFAULT_BATCH
     record(agent, args.env, episodes=min(8, args.episodes), seed=0, batch=batch)  # warm-up
     runs = []
@@ -219,10 +258,12 @@ def main() -> None:
         )
         runs.append(seconds)
     steps = rec.n_steps
-    model_best, model_median = model_rate(agent, args.env, min(batch, args.episodes), args.repeat)
+    model = getattr(agent, "inner", agent)  # the model alone, not the route counter
+    model_best, model_median = model_rate(model, args.env, min(batch, args.episodes), args.repeat)
     emit(
         bench="record",
         checkpoint=source,
+        policy=policy,
         env=args.env,
         module=agent.config.module,
         heads=agent.config.heads,
