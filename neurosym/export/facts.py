@@ -37,7 +37,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from neurosym.export.recording import META_KEYS, Recording, _atomic_write_bytes
+from neurosym.errors import ConfigError
+from neurosym.export.recording import META_KEYS, Recording, atomic_write
 from neurosym.export.thresholds import Threshold, parse_threshold
 
 # predicate -> argument columns, in argument order.
@@ -217,18 +218,14 @@ class FactSet:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         for name, df in self.tables.items():
-            if (
-                name == "kb_meta"
-            ):  # mixed values (atoms, numbers): Parquet needs one type per column
+            if name == "kb_meta":  # atoms and numbers: Parquet needs one type per column
                 df = df.assign(value=df["value"].map(str))
-            _atomic_write_bytes(
-                out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False)
-            )
+            atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         text = (
             json.dumps({"meta": self.meta, "threshold": str(self.threshold)}, indent=2, default=str)
             + "\n"
         )
-        _atomic_write_bytes(out / "meta.json", lambda p: Path(p).write_text(text))
+        atomic_write(out / "meta.json", lambda p: Path(p).write_text(text))
         return out
 
     def _header(self) -> str:
@@ -259,7 +256,7 @@ def _objects(positions: pd.DataFrame) -> pd.DataFrame:
     clash = objs["object"].duplicated(keep=False)
     if clash.any():
         bad = objs.loc[clash, "object"].iloc[0]
-        raise ValueError(f"object {bad!r} has more than one type in the recording")
+        raise ConfigError(f"object {bad!r} has more than one type in the recording's positions")
     objs = objs.sort_values("object", kind="stable")
     return _frame("object", {"id": objs["object"], "type": objs["type"]})
 

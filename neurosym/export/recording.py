@@ -119,7 +119,7 @@ def conform(name: str, df: pd.DataFrame | None) -> pd.DataFrame:
     return out.reset_index(drop=True)
 
 
-def _atomic_write_bytes(path: Path, write: Any) -> None:
+def atomic_write(path: Path, write: Any) -> None:
     """Call ``write(tmp_path)`` and move the result onto ``path`` in one rename."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
@@ -178,12 +178,10 @@ class Recording:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         for name, df in self.tables.items():
-            _atomic_write_bytes(
-                out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False)
-            )
+            atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         meta = {"format": _FORMAT, "format_version": _FORMAT_VERSION, "meta": self.meta}
         text = json.dumps(meta, indent=2, sort_keys=True, default=str) + "\n"
-        _atomic_write_bytes(out / "meta.json", lambda p: Path(p).write_text(text))
+        atomic_write(out / "meta.json", lambda p: Path(p).write_text(text))
         return out
 
     @classmethod
