@@ -55,7 +55,8 @@ def test_extract_writes_the_kb_and_prints_the_answers(
     for part in ("rgw2: 3 episodes (sampled, seed 5)", "facts: ", "thresholds (z:1)", "sword before enemy",
                  "sword-enemy link in the network", f"wrote {out / 'kb.pl'}"):  # fmt: skip
         assert part in text, part
-    assert re.search(r"visit orders \(most common\)\s+│ \[", text)  # Prolog lists survive rich markup
+    # Prolog lists such as [sword,enemy] survive rich markup
+    assert re.search(r"visit orders \(most common\)\s+│ \[", text)
     assert sorted(p.name for p in out.iterdir()) == [
         "facts",
         "kb.pl",

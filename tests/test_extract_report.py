@@ -29,7 +29,9 @@ def test_boxworld_report_answers_every_question(
         assert title in text
     assert "key(" in text and "lock(" in text  # key opens lock answers, as Prolog text
     taken = int((rec.episodes["outcome"] == "distractor").sum())
-    assert re.search(rf"distractor taken\s+│ [0-9, ]+\({taken} of {len(rec.episodes)} episodes\)", text)
+    assert re.search(
+        rf"distractor taken\s+│ [0-9, ]+\({taken} of {len(rec.episodes)} episodes\)", text
+    )
 
 
 def test_mhdpa_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
