@@ -42,6 +42,8 @@ def _meta(agent: Any, env_name: str, seed: int, greedy: bool) -> dict[str, Any]:
     return {
         "checkpoint": str(getattr(agent, "path", "") or ""),
         "env": env_name,
+        # Options the env was built with (a custom map, obs mode): plots redraw the grid from them.
+        "env_kwargs": dict(getattr(agent, "env_kwargs", {}) or {}),
         "module": config.module,
         "heads": int(config.heads),
         "relations": int(config.relations) if config.module == "predinet" else 0,
