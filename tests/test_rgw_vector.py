@@ -194,3 +194,12 @@ def test_final_info_of_an_undecoded_random_level_is_regenerated() -> None:
     _, _, _, _, info = vec.step([0, 0])  # autoreset; nothing of the old level was decoded
     assert vec.decode_info(info["final_info"], 0) == last
     assert vec.decode_info(info, 0) == first
+
+
+def test_partial_reset_is_refused_not_ignored() -> None:
+    from neurosym.envs import make_batched
+    from neurosym.errors import ConfigError
+
+    venv = make_batched("rgw2", 4, seed=0)
+    with pytest.raises(ConfigError, match="reset_mask is not supported"):
+        venv.reset(options={"reset_mask": np.array([True, False, False, False])})

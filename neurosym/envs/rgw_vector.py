@@ -135,6 +135,11 @@ class RGWVectorEnv(VectorEnv):
         seed: int | Sequence[int] | None = None,
         options: dict[str, Any] | None = None,
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        if options and options.get("reset_mask") is not None:
+            raise ConfigError(
+                "RGWVectorEnv resets all sub-envs at once; reset_mask is not supported "
+                "(each sub-env autoresets itself on the step after its episode ends)"
+            )
         if seed is None and self._seeds is None:
             seed = self._first_seed
         n = self.num_envs
