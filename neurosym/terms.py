@@ -91,8 +91,19 @@ class Term:
     def __str__(self) -> str:
         if not self.args:
             return atom_text(self.functor)
+        if len(self.args) == 2 and self.functor in _RESERVED_PAIRS:
+            raise FactError(_RESERVED_PAIRS[self.functor])
         inner = ",".join(format_value(a) for a in self.args)
         return f"{atom_text(self.functor)}({inner})"
+
+
+# Binary functors whose text SWI-Prolog 7+ reads as something else.
+_RESERVED_PAIRS = {
+    ".": "a '.'/2 compound cannot be written as Prolog text: SWI-Prolog reads '.'(A, B) "
+    "as dict access; use another functor",
+    "[|]": "a '[|]'/2 compound cannot be written as Prolog text: SWI-Prolog reads it as a "
+    "list cell; pass a Python list instead",
+}
 
 
 def _freeze(value: object) -> object:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 from hypothesis import given, settings
@@ -125,7 +126,11 @@ numbers = st.integers(min_value=-(2**100), max_value=2**100) | st.floats(
 terms = st.recursive(
     atoms | numbers,
     lambda children: (
-        st.builds(Term, atoms, st.lists(children, min_size=1, max_size=3).map(tuple))
+        st.builds(
+            Term,
+            atoms.filter(lambda a: a not in ("[|]", ".")),  # refused as '/2 (see below)
+            st.lists(children, min_size=1, max_size=3).map(tuple),
+        )
         | st.lists(children, max_size=3).map(tuple)
     ),
     max_leaves=12,
@@ -147,3 +152,10 @@ def _key(value: object) -> object:
 @given(terms)
 def test_parse_term_reads_back_what_format_value_writes(value: object) -> None:
     assert _key(parse_term(format_value(value))) == _key(value)
+
+
+@pytest.mark.parametrize("functor", [".", "[|]"])
+def test_pairs_that_prolog_reads_as_something_else_are_refused(functor: str) -> None:
+    with pytest.raises(FactError, match=f"'{re.escape(functor)}'/2 compound cannot be written"):
+        str(Term(functor, ("a", "b")))
+    assert str(Term(functor, ("a",))) == f"'{functor}'(a)"  # other arities are plain compounds
