@@ -11,22 +11,33 @@ from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Rollout, play_episodes, select_actions
+from neurosym.agent.sil import EpisodeMemory, SILBatch
 
 
-def rollout_of(
-    rewards, terminated, truncated, valid, next_values, values=None, logits=None, actions=None
-) -> Rollout:
+class Lookup(torch.nn.Module):
+    """A stand-in model: observation (1, 1, 1) holding an id -> that id's logits and value."""
+
+    def __init__(self, n: int = 10) -> None:
+        super().__init__()
+        self.logits = torch.nn.Parameter(torch.randn(n, 4))
+        self.values = torch.nn.Parameter(torch.randn(n))
+
+    def forward(self, obs: torch.Tensor):
+        ids = obs.reshape(obs.shape[0], -1)[:, 0].long()
+        return self.logits[ids], self.values[ids]
+
+
+def rollout_of(ids, rewards, terminated, truncated, valid, last_ids, actions=None) -> Rollout:
     r = torch.tensor(rewards, dtype=torch.float32)
     T, K = r.shape
     return Rollout(
-        logits=torch.zeros(T, K, 4, requires_grad=True) if logits is None else logits,
-        values=torch.zeros(T, K, requires_grad=True) if values is None else values,
+        obs=torch.tensor(ids, dtype=torch.uint8).view(T, K, 1, 1, 1),
+        last_obs=torch.tensor(last_ids, dtype=torch.uint8).view(K, 1, 1, 1),
         actions=torch.zeros(T, K, dtype=torch.int64) if actions is None else actions,
         rewards=r,
         terminated=torch.tensor(terminated),
         truncated=torch.tensor(truncated),
         valid=torch.tensor(valid),
-        next_values=torch.tensor(next_values, dtype=torch.float32),
     )
 
 
@@ -34,33 +45,77 @@ def test_n_step_returns_terminal_truncation_and_bootstrap() -> None:
     g = 0.5
     # env 0: steps 0,1 then terminated at 1; step 2 is the autoreset (invalid); step 3 bootstraps
     # env 1: truncated at step 1 -> bootstraps from V(o_2) = 4; later steps bootstrap from the end
-    ro = rollout_of(
-        rewards=[[1.0, 2.0], [3.0, 1.0], [0.0, 0.0], [5.0, 1.0]],
-        terminated=[[False, False], [True, False], [False, False], [False, False]],
-        truncated=[[False, False], [False, True], [False, False], [False, False]],
-        valid=[[True, True], [True, True], [False, False], [True, True]],
-        next_values=[[9.0, 9.0], [9.0, 4.0], [9.0, 9.0], [8.0, 2.0]],
+    G = n_step_returns(
+        rewards=torch.tensor([[1.0, 2.0], [3.0, 1.0], [0.0, 0.0], [5.0, 1.0]]),
+        terminated=torch.tensor([[False, False], [True, False], [False, False], [False, False]]),
+        truncated=torch.tensor([[False, False], [False, True], [False, False], [False, False]]),
+        next_values=torch.tensor([[9.0, 9.0], [9.0, 4.0], [9.0, 9.0], [8.0, 2.0]]),
+        gamma=g,
     )
-    G = n_step_returns(ro, g)
     assert G[3].tolist() == [5 + g * 8, 1 + g * 2]
     assert G[1].tolist() == [3.0, 1 + g * 4]
     assert G[0].tolist() == [1 + g * 3, 2 + g * (1 + g * 4)]
 
 
 def test_loss_ignores_invalid_steps() -> None:
+    torch.manual_seed(0)
     cfg = TrainConfig(entropy=0.1)
-    kw = dict(
+    # one env: step 0 terminates, step 1 is the autoreset (observation id 7), step 2 is a new episode
+    ro = rollout_of(
+        ids=[[1], [7], [2]],
         rewards=[[1.0], [0.0], [2.0]],
         terminated=[[True], [False], [False]],
         truncated=[[False], [False], [False]],
         valid=[[True], [False], [True]],
-        next_values=[[0.0], [0.0], [1.0]],
+        last_ids=[3],
     )
-    logits = torch.randn(3, 1, 4)
-    loss_a, _ = a3c_loss(rollout_of(**kw, logits=logits.clone().requires_grad_()), cfg)
-    logits[1] = torch.tensor([5.0, -3.0, 2.0, 0.0])  # the autoreset step's outputs do not matter
-    loss_b, _ = a3c_loss(rollout_of(**kw, logits=logits.clone().requires_grad_()), cfg)
+    model = Lookup()
+    loss_a, _ = a3c_loss(model, ro, cfg)
+    with torch.no_grad():
+        model.logits[7] = torch.tensor(
+            [5.0, -3.0, 2.0, 0.0]
+        )  # the autoreset step's outputs do not matter
+        model.values[7] = 100.0
+    loss_b, _ = a3c_loss(model, ro, cfg)
     assert torch.allclose(loss_a, loss_b)
+    with torch.no_grad():
+        model.values[3] = 50.0  # the bootstrap value does
+    loss_c, _ = a3c_loss(model, ro, cfg)
+    assert not torch.allclose(loss_a, loss_c)
+
+
+def test_self_imitation_only_learns_from_better_than_expected() -> None:
+    torch.manual_seed(0)
+    cfg = TrainConfig(entropy=0.0, sil=1.0)
+    ro = rollout_of(
+        ids=[[1]],
+        rewards=[[0.0]],
+        terminated=[[True]],
+        truncated=[[False]],
+        valid=[[True]],
+        last_ids=[1],
+    )
+    model = Lookup()
+    with torch.no_grad():
+        model.values[4], model.values[5] = 0.0, 9.0
+    base, _ = a3c_loss(model, ro, cfg)
+    worse = SILBatch(
+        torch.tensor([5], dtype=torch.uint8).view(1, 1, 1, 1),
+        torch.tensor([2]),
+        torch.tensor([3.0]),
+    )
+    assert torch.allclose(
+        a3c_loss(model, ro, cfg, worse)[0], base
+    )  # R = 3 < V = 9: nothing to imitate
+    better = SILBatch(
+        torch.tensor([4], dtype=torch.uint8).view(1, 1, 1, 1),
+        torch.tensor([2]),
+        torch.tensor([3.0]),
+    )
+    loss, _ = a3c_loss(model, ro, cfg, better)
+    model.zero_grad()
+    loss.backward()
+    assert model.logits.grad[4, 2] < 0 and model.values.grad[4] < 0  # raise pi(2|s4) and V(s4)
 
 
 def test_shared_rmsprop_matches_torch_rmsprop_and_shares_state() -> None:
@@ -94,25 +149,23 @@ def test_update_moves_policy_towards_advantaged_action() -> None:
     shared, local = ActorCritic(config), ActorCritic(config)
     shared.share_memory()
     opt = SharedRMSprop(shared.parameters(), lr=1e-3, alpha=0.99, eps=1e-5)
-    obs = torch.randint(0, 2, (2, 9, 10, 10), dtype=torch.uint8)
-    before = torch.softmax(shared(obs)[0], -1)[:, 2]
+    obs = torch.randint(0, 2, (1, 2, 9, 10, 10), dtype=torch.uint8)
+    before = torch.softmax(shared(obs[0])[0], -1)[:, 2]
+    ro = Rollout(
+        obs=obs,
+        last_obs=obs[0],
+        actions=torch.full((1, 2), 2),
+        rewards=torch.ones(1, 2),
+        terminated=torch.ones(1, 2, dtype=torch.bool),
+        truncated=torch.zeros(1, 2, dtype=torch.bool),
+        valid=torch.ones(1, 2, dtype=torch.bool),
+    )
     for _ in range(5):
         local.load_state_dict(shared.state_dict())
-        logits, values = local(obs)
-        ro = rollout_of(
-            rewards=[[1.0, 1.0]],
-            terminated=[[True, True]],
-            truncated=[[False, False]],
-            valid=[[True, True]],
-            next_values=[[0.0, 0.0]],
-            logits=logits.unsqueeze(0),
-            values=values.unsqueeze(0),
-            actions=torch.full((1, 2), 2),
-        )
-        loss, stats = a3c_loss(ro, TrainConfig(entropy=0.0))
+        loss, stats = a3c_loss(local, ro, TrainConfig(entropy=0.0))
         norm = apply_update(local, shared, opt, loss, clip=400.0)
         assert norm > 0 and stats.value_loss > 0
-    after = torch.softmax(shared(obs)[0], -1)[:, 2]
+    after = torch.softmax(shared(obs[0])[0], -1)[:, 2]
     assert bool((after > before + 0.01).all()), (before, after)
 
 
@@ -146,15 +199,70 @@ def test_episode_tracker_skips_autoreset_steps() -> None:
     assert tracker.ret.tolist() == [0.0, 5.0]
 
 
-def test_count_bonus() -> None:
-    bonus = CountBonus(0.5)
-    obs = np.zeros((3, 2, 3, 3), dtype=np.uint8)
-    obs[1, 0, 1, 1] = 1
-    got = bonus(obs, np.array([True, True, False]))
-    # rows 0 and 2 are the same observation, but row 2 is not a transition: not counted, no bonus
-    np.testing.assert_allclose(got, [0.5, 0.5, 0.0])
-    got = bonus(obs, np.array([True, True, True]))
-    np.testing.assert_allclose(got, [0.5 / np.sqrt(3), 0.5 / np.sqrt(2), 0.5 / np.sqrt(3)])
+def test_count_bonus_counts_and_episodic_gate() -> None:
+    a = np.zeros((1, 2, 3, 3), dtype=np.uint8)
+    b = a.copy()
+    b[0, 0, 1, 1] = 1
+    bonus = CountBonus(0.5, episodic=False)
+    yes, no = np.array([True]), np.array([False])
+    np.testing.assert_allclose(bonus(a, yes), [0.5])
+    np.testing.assert_allclose(bonus(a, yes), [0.5 / np.sqrt(2)])
+    np.testing.assert_allclose(bonus(b, yes), [0.5])
+    np.testing.assert_allclose(
+        bonus(a, no), [0.0]
+    )  # an autoreset step is not a transition: no bonus, no count
+    np.testing.assert_allclose(bonus(a, yes), [0.5 / np.sqrt(3)])
+    # episodic: a second visit within an episode pays nothing; a new episode (autoreset) starts afresh
+    ep = CountBonus(0.5)
+    np.testing.assert_allclose([ep(a, yes)[0], ep(b, yes)[0], ep(a, yes)[0]], [0.5, 0.5, 0.0])
+    ep(b, no)
+    np.testing.assert_allclose(ep(a, yes), [0.5 / np.sqrt(3)])
+    # decayed counts: after two half-lives without visits a count of 4 is back to 1
+    dec = CountBonus(1.0, episodic=False, half_life=1.0)
+    for _ in range(3):
+        dec(a, yes)
+    # counts of a: 1, 1.5, 1.75 at steps 1-3; b at steps 4, 5; at step 6 a's count is 1.75 / 8 + 1
+    assert dec(b, yes)[0] == 1.0 and dec(b, yes)[0] < 1.0
+    np.testing.assert_allclose(dec(a, yes), [1 / np.sqrt(1.75 / 8 + 1)])
+
+
+def test_episode_memory_keeps_best_positive_episodes() -> None:
+    mem = EpisodeMemory(2, gamma=0.5, capacity=2)
+    obs = np.arange(2, dtype=np.uint8).reshape(2, 1, 1, 1)
+    yes = np.array([True, True])
+    mem.step(
+        obs, np.array([0, 1]), np.array([0.0, -1.0]), yes, np.array([False, True])
+    )  # env 1: return -1
+    mem.step(
+        obs,
+        np.array([2, 3]),
+        np.array([4.0, 0.0]),
+        np.array([True, False]),
+        np.array([True, False]),
+    )
+    assert (
+        len(mem.best) == 1 and len(mem) == 2
+    )  # env 0: return 4 kept; env 1's negative episode not
+    batch = mem.sample(50, torch.Generator().manual_seed(0))
+    assert set(batch.returns.tolist()) == {2.0, 4.0}  # discounted returns-to-go 0 + 0.5 * 4 and 4
+    for r in (1.0, 9.0):
+        mem.step(
+            obs,
+            np.array([0, 0]),
+            np.array([r, 0.0]),
+            np.array([True, False]),
+            np.array([True, False]),
+        )
+    assert sorted(e[0][0] for e in mem.best) == [4.0, 9.0]
+    # equal returns: the shorter episode wins
+    mem = EpisodeMemory(1, gamma=0.5, capacity=1)
+    one, no, yes1 = obs[:1], np.array([False]), np.array([True])
+    mem.step(one, np.array([0]), np.array([0.0]), yes1, no)
+    mem.step(one, np.array([0]), np.array([2.0]), yes1, yes1)  # return 2 in 2 steps
+    mem.step(one, np.array([1]), np.array([2.0]), yes1, yes1)  # return 2 in 1 step
+    mem.step(one, np.array([0]), np.array([0.0]), yes1, no)
+    mem.step(one, np.array([0]), np.array([2.0]), yes1, yes1)  # 2 steps again: not better
+    assert len(mem) == 1 and mem.best[0][2].tolist() == [1]
 
 
 def test_play_episodes_on_rgw() -> None:
@@ -181,16 +289,18 @@ def test_collect_rollout_shapes(module: str) -> None:
     torch.manual_seed(0)
     model = ActorCritic(ModelConfig.for_family("rgw", module, (9, 10, 10)))
     state = RolloutState(make_batched("rgw2", 3, seed=0), seed=0)
+    memory = EpisodeMemory(3, 0.99)
     ro, finished = collect_rollout(
-        model, state, 5, torch.Generator().manual_seed(0), CountBonus(0.1)
+        model, state, 5, torch.Generator().manual_seed(0), CountBonus(0.1), memory
     )
     assert (
-        ro.logits.shape == (5, 3, 4)
-        and ro.values.shape == (5, 3)
-        and ro.next_values.shape == (5, 3)
+        ro.obs.shape == (5, 3, 9, 10, 10)
+        and ro.obs.dtype == torch.uint8
+        and ro.last_obs.shape == (3, 9, 10, 10)
     )
-    assert ro.logits.requires_grad and not ro.next_values.requires_grad
+    assert ro.actions.shape == ro.rewards.shape == ro.valid.shape == (5, 3)
     assert bool(ro.valid.all()) and len(finished) == 0
     assert float(ro.rewards.max()) > 0  # the exploration bonus is in the training rewards
-    loss, _ = a3c_loss(ro, TrainConfig())
+    assert [len(c) for c in memory.current] == [5, 5, 5]
+    loss, _ = a3c_loss(model, ro, TrainConfig())
     loss.backward()

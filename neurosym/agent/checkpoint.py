@@ -132,6 +132,16 @@ def _load_raw(path: Path) -> Any:
         raise CheckpointError(f"checkpoint not found: {path}")
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} is not a file")
+    with path.open("rb") as fh:
+        head = fh.read(4)
+    if not head:
+        raise CheckpointError(f"cannot read {path}: the file is empty")
+    if not (
+        head.startswith(b"PK\x03\x04") or head.startswith(b"\x80")
+    ):  # torch zip, or a bare pickle
+        raise CheckpointError(
+            f"cannot read {path}: not a torch checkpoint (neither a torch zip file nor a pickle)"
+        )
     try:
         return torch.load(path, map_location="cpu", weights_only=True)
     except pickle.UnpicklingError as exc:

@@ -95,6 +95,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--checkpoint-interval", type=float, default=60.0, help="seconds between checkpoints (60)"
     )
     watch.add_argument(
+        "--window",
+        type=int,
+        default=100,
+        help="recent episodes behind mean return and success (100)",
+    )
+    watch.add_argument(
         "--slim", action="store_true", help="leave the optimizer state out of checkpoints"
     )
     watch.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -138,6 +144,7 @@ def command_line(args: argparse.Namespace) -> str:
         ("--eval-interval", "eval_interval", 2.0),
         ("--eval-episodes", "eval_episodes", 8),
         ("--checkpoint-interval", "checkpoint_interval", 60.0),
+        ("--window", "window", 100),
     ):
         if getattr(args, dest) != default:
             parts += [flag, str(getattr(args, dest))]
@@ -161,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
         eval_interval=args.eval_interval,
         eval_episodes=args.eval_episodes,
         checkpoint_interval=args.checkpoint_interval,
+        window=args.window,
         slim=args.slim,
         progress=not args.quiet,
     )

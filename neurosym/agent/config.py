@@ -30,7 +30,7 @@ _MODEL_FAMILY: dict[str, dict[str, Any]] = {
     "boxworld": {"key_size": 64},
 }
 _TRAIN_FAMILY: dict[str, dict[str, Any]] = {
-    "rgw": {"lr": 2e-3, "entropy": 0.02},
+    "rgw": {"lr": 2e-3, "entropy": 0.02, "gamma": 0.95, "explore": 0.2, "sil": 1.0},
     "boxworld": {"lr": 2e-4, "entropy": 0.01},
 }
 
@@ -149,28 +149,34 @@ class TrainConfig:
     """weight of the value loss"""
     explore: float = 0.0
     """count-based exploration bonus beta (intrinsic reward beta / sqrt(visits)); 0 = none"""
-    rms_eps: float = 0.1
-    """RMSprop epsilon (Table 4: 0.1)"""
+    explore_half_life: float = 2000.0
+    """half-life of the visit counts, in worker steps (K frames each)"""
+    sil: float = 0.0
+    """weight of the self-imitation loss on the best episodes so far; 0 = none"""
+    sil_episodes: int = 32
+    """best episodes each worker keeps for self-imitation"""
+    rms_eps: float = 1e-5
+    """RMSprop epsilon (Table 4: 0.1, which stalls learning here; see the module docstring)"""
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""
     grad_clip: float = 400.0
     """global gradient-norm clip (Table 4: 400)"""
     workers: int = 2
     """worker processes W"""
-    envs: int = 32
+    envs: int = 8
     """environments per worker K (1 = classic A3C with one env)"""
     seed: int = 0
     """base seed; worker w uses seed + 1000 * w"""
 
     def __post_init__(self) -> None:
-        for name in ("lr", "gamma", "rms_eps", "rms_alpha", "grad_clip"):
+        for name in ("lr", "gamma", "rms_eps", "rms_alpha", "grad_clip", "explore_half_life"):
             if not float(getattr(self, name)) > 0:
                 raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
         if not 0 < self.gamma <= 1 or not 0 < self.rms_alpha < 1:
             raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
-        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0:
-            raise ConfigError("entropy, value_coef and explore must be >= 0")
-        for name in ("n_steps", "workers", "envs"):
+        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
+            raise ConfigError("entropy, value_coef, explore and sil must be >= 0")
+        for name in ("n_steps", "workers", "envs", "sil_episodes"):
             if int(getattr(self, name)) < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {getattr(self, name)}")
 

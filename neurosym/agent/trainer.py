@@ -73,7 +73,7 @@ class RunOptions:
     target_return: float | None = None
     """stop when the greedy policy's mean return reaches this"""
     eval_interval: float = 2.0
-    """seconds between greedy evaluations"""
+    """seconds between greedy evaluations (more when one takes over 5 % of that)"""
     eval_episodes: int = 8
     """episodes per greedy evaluation (played side by side)"""
     checkpoint_interval: float = 60.0
@@ -207,12 +207,37 @@ class _Stats:
     def success_rate(self) -> float | None:
         return float(np.mean(self.success)) if self.success else None
 
+    def row(
+        self, wall: float, fps: float, greedy: float | None, greedy_success: float | None
+    ) -> dict[str, Any]:
+        """One metrics.csv row (strings, blank where unknown); takes the losses since the last row."""
+        losses = self.take_losses() or (None, None, None, None)
+        return {
+            "wall_s": _fmt(wall, ".2f"),
+            "frames": self.frames,
+            "episodes": self.episodes,
+            "fps": _fmt(fps, ".1f"),
+            "mean_return": _fmt(self.mean_return(), ".4f"),
+            "success_rate": _fmt(self.success_rate(), ".4f"),
+            "mean_length": _fmt(float(np.mean(self.lengths)) if self.lengths else None, ".2f"),
+            "greedy_return": _fmt(greedy, ".4f"),
+            "greedy_success": _fmt(greedy_success, ".4f"),
+            "policy_loss": _fmt(losses[0], ".5g"),
+            "value_loss": _fmt(losses[1], ".5g"),
+            "entropy": _fmt(losses[2], ".5g"),
+            "grad_norm": _fmt(losses[3], ".5g"),
+        }
+
     def take_losses(self) -> tuple[float, ...] | None:
         if not self.losses:
             return None
         out = tuple(float(v) for v in np.mean(np.asarray(self.losses), axis=0))
         self.losses = []
         return out
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _env_seed(seed: int, rank: int, frames_before: int) -> int:
@@ -363,6 +388,8 @@ def train(
             procs.append(proc)
     finally:
         signal.signal(signal.SIGINT, previous)
+    # SIGTERM (kill, a batch scheduler) stops the run like Ctrl-C: workers stopped, checkpoint written
+    previous_term = signal.signal(signal.SIGTERM, _raise_interrupt)
 
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -384,6 +411,7 @@ def train(
 
     start = time.monotonic()
     last_log = last_eval = last_ckpt = start
+    eval_cost = 0.0
     last_frames = stats.frames
     greedy: float | None = None
     greedy_success: float | None = None
@@ -419,13 +447,15 @@ def train(
                     failure = "all workers exited unexpectedly"
                     stop_reason = "error"
                     break
-                if now - last_eval >= options.eval_interval:
+                # evaluations take at most ~5 % of the parent's time (they share the cores)
+                if now - last_eval >= max(options.eval_interval, 20 * eval_cost):
                     snapshot = {k: v.detach().clone() for k, v in shared.state_dict().items()}
                     eval_model.load_state_dict(snapshot)
                     done = evaluate()
                     greedy = float(np.mean(done.returns))
                     greedy_success = float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes]))
                     last_eval = time.monotonic()
+                    eval_cost = last_eval - now
                     if (
                         options.target_return is not None
                         and greedy >= options.target_return - TARGET_TOLERANCE
@@ -435,26 +465,7 @@ def train(
                 now = time.monotonic()
                 if now - last_log >= options.log_interval or stop_reason:
                     fps = (stats.frames - last_frames) / max(now - last_log, 1e-9)
-                    losses = stats.take_losses() or (None, None, None, None)
-                    rows.append(
-                        {
-                            "wall_s": _fmt(wall0 + now - start, ".2f"),
-                            "frames": stats.frames,
-                            "episodes": stats.episodes,
-                            "fps": _fmt(fps, ".1f"),
-                            "mean_return": _fmt(stats.mean_return(), ".4f"),
-                            "success_rate": _fmt(stats.success_rate(), ".4f"),
-                            "mean_length": _fmt(
-                                float(np.mean(stats.lengths)) if stats.lengths else None, ".2f"
-                            ),
-                            "greedy_return": _fmt(greedy, ".4f"),
-                            "greedy_success": _fmt(greedy_success, ".4f"),
-                            "policy_loss": _fmt(losses[0], ".5g"),
-                            "value_loss": _fmt(losses[1], ".5g"),
-                            "entropy": _fmt(losses[2], ".5g"),
-                            "grad_norm": _fmt(losses[3], ".5g"),
-                        }
-                    )
+                    rows.append(stats.row(wall0 + now - start, fps, greedy, greedy_success))
                     _write_rows(out / METRICS_NAME, rows)
                     last_log, last_frames = now, stats.frames
                     progress.update(
@@ -496,9 +507,16 @@ def train(
                 p.terminate()
                 p.join(timeout=5)
         drain(0.0)
+        signal.signal(signal.SIGTERM, previous_term)
     wall = wall0 + time.monotonic() - start
     if failure:
         raise RuntimeError(failure)
+    if (
+        not rows or int(rows[-1]["frames"]) != stats.frames
+    ):  # what arrived while the workers stopped
+        fps = (stats.frames - last_frames) / max(time.monotonic() - last_log, 1e-9)
+        rows.append(stats.row(wall, fps, greedy, greedy_success))
+        _write_rows(out / METRICS_NAME, rows)
     summary = {
         "wall_s": round(wall, 2),
         "stop_reason": stop_reason,

@@ -1,0 +1,313 @@
+"""Training benchmarks; prints one JSON object per line.
+
+Parts (``--only`` takes a comma-separated list; default: all):
+
+* ``fps``: training frames per second of ``neurosym train`` with W workers and
+  K envs per worker, K in {1, 8, 32}, for each module (steady state: the
+  first metrics row, which includes start-up, is left out).
+* ``solve``: wall time until the greedy policy reaches the optimal return on
+  rgw2 (10.7), per module and seed (default seeds 0 1 2).
+* ``boxworld``: bw1 success rate against frames for a fixed frame budget, per
+  module: the training success rate (last ``--window`` episodes) at each
+  metrics row, and the final checkpoint's sampled success over 1000 episodes.
+
+Every part runs the real command (``python -m neurosym train``) in a
+subprocess, in a temporary directory. Thesis figures for comparison (Box-World,
+success over the last 1000 training episodes): bw1 PrediNet 29.3 %, MHDPA
+36.5 %; bw2 22.5 %, 22.8 %; bw3 11.3 %, 8.8 %.
+
+    python bench/train.py --only fps,solve
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]  # the repository: `python -m neurosym` works from here
+MODULES = ("predinet", "mhdpa")
+THESIS_BW = {
+    "bw1": {"predinet": 0.293, "mhdpa": 0.365},
+    "bw2": {"predinet": 0.225, "mhdpa": 0.228},
+    "bw3": {"predinet": 0.113, "mhdpa": 0.088},
+}
+
+
+KEEP: Path | None = None  # --keep: run directories are kept here instead of deleted
+
+
+@contextlib.contextmanager
+def run_dir(name: str) -> Iterator[Path]:
+    """A fresh directory for one training run (under --keep, or temporary)."""
+    if KEEP is not None:
+        out = KEEP / name
+        shutil.rmtree(out, ignore_errors=True)
+        yield out
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        yield Path(tmp) / "run"
+
+
+def emit(record: dict) -> None:
+    print(json.dumps(record), flush=True)
+
+
+def neurosym(*args: str, timeout: float) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONHASHSEED": "0"}
+    return subprocess.run(
+        [sys.executable, "-m", "neurosym", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+        check=False,
+    )
+
+
+def rows(out: Path) -> list[dict[str, str]]:
+    with (out / "metrics.csv").open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def checkpoint_metrics(out: Path) -> dict:
+    import torch
+
+    return torch.load(out / "checkpoint.pt", weights_only=True)["metrics"]
+
+
+def bench_fps(workers: int, seconds: float, modules: tuple[str, ...], env: str) -> None:
+    for module in modules:
+        for k in (1, 8, 32):
+            with run_dir(f"fps-{module}-k{k}") as out:
+                proc = neurosym(
+                    "train",
+                    "--env",
+                    env,
+                    "--module",
+                    module,
+                    "--out",
+                    str(out),
+                    "--workers",
+                    str(workers),
+                    "--envs",
+                    str(k),
+                    "--minutes",
+                    str(seconds / 60),
+                    "--quiet",
+                    "--eval-interval",
+                    "1000000",
+                    timeout=seconds + 120,
+                )
+                if proc.returncode != 0:
+                    emit(
+                        {
+                            "bench": "train_fps",
+                            "module": module,
+                            "envs": k,
+                            "error": proc.stderr.strip()[-500:],
+                        }
+                    )
+                    continue
+                table = rows(out)[1:]  # the first row includes start-up
+                frames = int(table[-1]["frames"]) - int(rows(out)[0]["frames"])
+                wall = float(table[-1]["wall_s"]) - float(rows(out)[0]["wall_s"])
+                emit(
+                    {
+                        "bench": "train_fps",
+                        "env": env,
+                        "module": module,
+                        "workers": workers,
+                        "envs": k,
+                        "frames": frames,
+                        "seconds": round(wall, 2),
+                        "fps": round(frames / wall, 1),
+                        "cpus": os.cpu_count(),
+                    }
+                )
+
+
+def bench_solve(
+    seeds: list[int], modules: tuple[str, ...], workers: int, limit_minutes: float
+) -> None:
+    for module in modules:
+        for seed in seeds:
+            with run_dir(f"solve-{module}-s{seed}") as out:
+                start = time.monotonic()
+                proc = neurosym(
+                    "train",
+                    "--env",
+                    "rgw2",
+                    "--module",
+                    module,
+                    "--out",
+                    str(out),
+                    "--seed",
+                    str(seed),
+                    "--workers",
+                    str(workers),
+                    "--target-return",
+                    "10.7",
+                    "--minutes",
+                    str(limit_minutes),
+                    "--quiet",
+                    timeout=limit_minutes * 60 + 120,
+                )
+                elapsed = time.monotonic() - start
+                if proc.returncode != 0:
+                    emit(
+                        {
+                            "bench": "rgw2_solve",
+                            "module": module,
+                            "seed": seed,
+                            "error": proc.stderr.strip()[-500:],
+                        }
+                    )
+                    continue
+                m = checkpoint_metrics(out)
+                emit(
+                    {
+                        "bench": "rgw2_solve",
+                        "module": module,
+                        "seed": seed,
+                        "workers": workers,
+                        "solved": m.get("stop_reason") == "target",
+                        "wall_s": m.get("solved_wall_s"),
+                        "frames": m.get("solved_frames"),
+                        "greedy_return": m.get("greedy_return"),
+                        "process_s": round(elapsed, 1),
+                        "target_s": 300,
+                    }
+                )
+
+
+def bench_boxworld(
+    env: str, frames: int, modules: tuple[str, ...], workers: int, seed: int
+) -> None:
+    for module in modules:
+        with run_dir(f"{env}-{module}") as out:
+            proc = neurosym(
+                "train",
+                "--env",
+                env,
+                "--module",
+                module,
+                "--out",
+                str(out),
+                "--workers",
+                str(workers),
+                "--frames",
+                str(frames),
+                "--seed",
+                str(seed),
+                "--window",
+                "1000",
+                "--quiet",
+                "--eval-interval",
+                "30",
+                timeout=24 * 3600,
+            )
+            if proc.returncode != 0:
+                emit(
+                    {
+                        "bench": "boxworld",
+                        "env": env,
+                        "module": module,
+                        "error": proc.stderr.strip()[-500:],
+                    }
+                )
+                continue
+            table = rows(out)
+            step = max(1, len(table) // 10)
+            curve = [
+                {
+                    "frames": int(r["frames"]),
+                    "episodes": int(r["episodes"]),
+                    "success": float(r["success_rate"] or 0),
+                }
+                for r in table[step - 1 :: step]
+            ]
+            sampled = neurosym(
+                "eval",
+                "--checkpoint",
+                str(out / "checkpoint.pt"),
+                "--episodes",
+                "1000",
+                "--sample",
+                "--json",
+                timeout=3600,
+            )
+            final = (
+                json.loads(sampled.stdout)
+                if sampled.returncode == 0
+                else {"error": sampled.stderr.strip()}
+            )
+            emit(
+                {
+                    "bench": "boxworld",
+                    "env": env,
+                    "module": module,
+                    "frames": frames,
+                    "wall_s": float(table[-1]["wall_s"]),
+                    "train_success_last_1000": float(table[-1]["success_rate"] or 0),
+                    "sampled_success_1000": final.get("success_rate"),
+                    "thesis_success": THESIS_BW.get(env, {}).get(module),
+                    "curve": curve,
+                }
+            )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--only", default="fps,solve,boxworld", help="parts to run: fps, solve, boxworld"
+    )
+    parser.add_argument("--modules", default="predinet,mhdpa", help="modules (comma-separated)")
+    parser.add_argument("--workers", type=int, default=2, help="worker processes (2)")
+    parser.add_argument(
+        "--fps-seconds", type=float, default=40.0, help="seconds per fps measurement (40)"
+    )
+    parser.add_argument("--seeds", default="0,1,2", help="seeds for the rgw2 solve part (0,1,2)")
+    parser.add_argument(
+        "--solve-minutes", type=float, default=10.0, help="give up a solve run after this (10)"
+    )
+    parser.add_argument("--bw-env", default="bw1", help="Box-World configuration (bw1)")
+    parser.add_argument(
+        "--bw-frames", type=int, default=2_000_000, help="frame budget per Box-World run"
+    )
+    parser.add_argument(
+        "--keep", type=Path, help="keep the run directories (metrics.csv, checkpoint.pt) here"
+    )
+    args = parser.parse_args(argv)
+    global KEEP
+    KEEP = args.keep.resolve() if args.keep else None
+    parts = {p.strip() for p in args.only.split(",") if p.strip()}
+    unknown = parts - {"fps", "solve", "boxworld"}
+    if unknown:
+        parser.error(
+            f"unknown part(s) {', '.join(sorted(unknown))}; choose from fps, solve, boxworld"
+        )
+    modules = tuple(m.strip() for m in args.modules.split(",") if m.strip())
+    if "fps" in parts:
+        bench_fps(args.workers, args.fps_seconds, modules, "rgw2")
+    if "solve" in parts:
+        bench_solve(
+            [int(s) for s in args.seeds.split(",")], modules, args.workers, args.solve_minutes
+        )
+    if "boxworld" in parts:
+        bench_boxworld(args.bw_env, args.bw_frames, modules, args.workers, seed=0)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

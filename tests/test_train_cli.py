@@ -1,0 +1,181 @@
+"""`neurosym train` run for real in a subprocess on a tiny budget: outputs, resume, errors, Ctrl-C."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import torch
+
+from neurosym.agent.checkpoint import load_agent
+
+ROOT = Path(__file__).resolve().parents[1]
+ENV = {**os.environ, "PYTHONHASHSEED": "0"}
+
+
+def neurosym(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "neurosym", *args],
+        cwd=ROOT,
+        env=ENV,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def metrics(out: Path) -> list[dict[str, str]]:
+    with (out / "metrics.csv").open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+TINY = ("--envs", "4", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2")
+
+
+@pytest.mark.expensive
+def test_train_writes_checkpoint_and_metrics_then_resumes(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train",
+        "--env",
+        "rgw2",
+        "--module",
+        "predinet",
+        "--out",
+        str(out),
+        "--workers",
+        "2",
+        "--frames",
+        "3000",
+        *TINY,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "stopped (frames) after" in proc.stdout
+    agent = load_agent(out / "checkpoint.pt", env="rgw2")
+    assert agent.config.module == "predinet" and agent.meta["frames"] >= 3000
+    assert agent.meta["command"].startswith("neurosym train --env rgw2 --module predinet --out ")
+    assert agent.meta["train_config"]["workers"] == 2 and agent.meta["train_config"]["envs"] == 4
+    assert agent.meta["metrics"]["stop_reason"] == "frames"
+    raw = torch.load(out / "checkpoint.pt", weights_only=True)
+    assert raw["optimizer"] is not None  # resumable
+    first = metrics(out)
+    assert len(first) >= 1 and set(first[0]) >= {
+        "wall_s",
+        "frames",
+        "episodes",
+        "fps",
+        "mean_return",
+        "greedy_return",
+    }
+    assert int(first[-1]["frames"]) == agent.meta["frames"]
+
+    again = neurosym(
+        "train",
+        "--env",
+        "rgw2",
+        "--module",
+        "predinet",
+        "--out",
+        str(out),
+        "--frames",
+        "3000",
+        *TINY,
+    )
+    assert again.returncode == 1 and "already exists; pass --resume" in again.stderr
+    assert len(again.stderr.strip().splitlines()) == 1
+
+    proc = neurosym(
+        "train", "--out", str(out), "--resume", "--workers", "1", "--frames", "6000", *TINY
+    )
+    assert proc.returncode == 0, proc.stderr
+    resumed = load_agent(out / "checkpoint.pt")
+    assert resumed.meta["frames"] >= 6000 and resumed.meta["frames"] > agent.meta["frames"]
+    assert resumed.meta["episodes"] >= agent.meta["episodes"]
+    assert resumed.meta["train_config"]["workers"] == 1  # an override on resume
+    assert "--resume" in resumed.meta["command"]
+    rows = metrics(out)
+    assert rows[: len(first)] == first and len(rows) > len(first)
+    walls = [float(r["wall_s"]) for r in rows]
+    assert walls == sorted(walls)
+
+    other = neurosym(
+        "train", "--out", str(out), "--resume", "--module", "mhdpa", "--frames", "9000", *TINY
+    )
+    assert other.returncode == 1
+    assert "has a different model config: module 'predinet' (asked for 'mhdpa')" in other.stderr
+    assert len(other.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.expensive
+def test_train_mhdpa_single_worker_classic_k1(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "rgw1", "--module", "mhdpa", "--out", str(out), "--workers", "1", "--envs", "1",
+        "--frames", "600", "--quiet", "--slim", "--heads", "2",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.config.module == "mhdpa" and agent.config.heads == 2 and agent.env_name == "rgw1"
+    assert torch.load(out / "checkpoint.pt", weights_only=True)["optimizer"] is None
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("--env", "rgw9", "--module", "predinet"), "rgw9"),
+        (("--module", "predinet"), "--env and --module are needed unless --resume"),
+        (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--frames", "0"),
+            "--frames must be a positive integer",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),
+            "--env-option wants KEY=VALUE",
+        ),
+    ],
+)
+def test_train_bad_input_is_one_line(tmp_path: Path, args: tuple[str, ...], message: str) -> None:
+    proc = neurosym("train", "--out", str(tmp_path / "run"), "--quiet", *args)
+    assert proc.returncode == 1, proc.stderr
+    assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert not (tmp_path / "run" / "checkpoint.pt").exists()
+
+
+def test_resume_without_checkpoint(tmp_path: Path) -> None:
+    proc = neurosym("train", "--out", str(tmp_path / "nothing"), "--resume", "--quiet")
+    assert proc.returncode == 1
+    assert (
+        proc.stderr.strip()
+        == f"neurosym train: error: checkpoint not found: {tmp_path / 'nothing' / 'checkpoint.pt'}"
+    )
+
+
+@pytest.mark.expensive
+def test_ctrl_c_stops_cleanly_with_a_checkpoint(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "neurosym", "train", "--env", "rgw2", "--module", "predinet", "--out", str(out),
+         "--workers", "2", "--minutes", "5", *TINY],
+        cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (out / "metrics.csv").exists():
+            time.sleep(0.2)
+        assert (out / "metrics.csv").exists(), "training never started"
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, stderr
+    assert "stopped (interrupted)" in stdout
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.meta["metrics"]["stop_reason"] == "interrupted" and agent.meta["frames"] > 0
