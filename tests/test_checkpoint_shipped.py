@@ -36,15 +36,13 @@ def play(path: Path, route: list[str]) -> tuple[float, list[str], int]:
     raise AssertionError("episode did not end")
 
 
-# The agents the project ships (checkpoints/README.md). rgw1-mhdpa is not trained yet:
-# its runs reach a sampled success of 1.0 but the greedy policy bumps the border.
+# The agents the project ships (checkpoints/README.md).
 EXPECTED = {"rgw1-predinet", "rgw1-mhdpa", "rgw2-predinet", "rgw2-mhdpa"}
 SHIPPED = sorted(p.stem for p in CHECKPOINTS.glob("*.pt"))
 
 
-def test_only_known_agents_are_shipped_and_the_demo_one_is_there() -> None:
-    assert set(SHIPPED) <= EXPECTED, SHIPPED
-    assert {"rgw2-predinet", "rgw2-mhdpa", "rgw1-predinet"} <= set(SHIPPED), SHIPPED
+def test_all_four_agents_are_shipped() -> None:
+    assert set(SHIPPED) == EXPECTED, SHIPPED
 
 
 @pytest.mark.parametrize("name", SHIPPED)
