@@ -304,3 +304,18 @@ def test_collect_rollout_shapes(module: str) -> None:
     assert [len(c) for c in memory.current] == [5, 5, 5]
     loss, _ = a3c_loss(model, ro, TrainConfig())
     loss.backward()
+
+
+def test_kept_graph_gives_the_recomputed_loss() -> None:
+    from neurosym.agent.rollout import RolloutState, collect_rollout
+    from neurosym.envs import make_batched
+
+    torch.manual_seed(0)
+    model = ActorCritic(ModelConfig.for_family("rgw", "mhdpa", (9, 10, 10)))
+    state = RolloutState(make_batched("rgw2", 2, seed=0), seed=0)
+    ro, _ = collect_rollout(model, state, 4, torch.Generator().manual_seed(0), keep_graph=True)
+    assert ro.logits.shape == (4, 2, 4) and ro.logits.requires_grad and ro.values.shape == (4, 2)
+    kept, _ = a3c_loss(model, ro, TrainConfig())
+    recomputed, _ = a3c_loss(model, ro._replace(logits=None, values=None), TrainConfig())
+    torch.testing.assert_close(kept, recomputed, rtol=1e-5, atol=1e-5)
+    kept.backward()

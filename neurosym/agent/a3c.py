@@ -111,19 +111,24 @@ def a3c_loss(
 ) -> tuple[torch.Tensor, LossStats]:
     """The scalar loss of one rollout (plus self-imitation on ``sil_batch``) and its parts.
 
-    The model runs once over the rollout's T * K observations, the last
-    observation of each env and the self-imitation batch.
+    The model runs once over what it has not seen with a graph: the rollout's
+    T * K observations (unless acting kept their graph), the last observation
+    of each env and the self-imitation batch.
     """
     T, K = rollout.actions.shape
-    parts = [rollout.obs.flatten(0, 1), rollout.last_obs]
+    kept = rollout.logits is not None and rollout.values is not None
+    parts = [] if kept else [rollout.obs.flatten(0, 1)]
+    parts.append(rollout.last_obs)
     if sil_batch is not None:
         parts.append(sil_batch.obs)
-    logits_all, values_all = model(torch.cat(parts))  # (T*K + K [+ M], A), (T*K + K [+ M],)
-    logits = logits_all[: T * K].view(T, K, -1)  # (T, K, A)
-    values = values_all[: T * K].view(T, K)  # (T, K)
-    next_values = torch.cat(
-        [values[1:], values_all[T * K : T * K + K].unsqueeze(0)]
-    ).detach()  # (T, K)
+    logits_all, values_all = model(torch.cat(parts))  # ([T*K +] K [+ M], A), ([T*K +] K [+ M],)
+    n = 0 if kept else T * K  # rows of the rollout itself in this pass
+    if kept:
+        logits, values = rollout.logits, rollout.values  # (T, K, A), (T, K)
+    else:
+        logits = logits_all[:n].view(T, K, -1)  # (T, K, A)
+        values = values_all[:n].view(T, K)  # (T, K)
+    next_values = torch.cat([values[1:], values_all[n : n + K].unsqueeze(0)]).detach()  # (T, K)
     returns = n_step_returns(
         rollout.rewards, rollout.terminated, rollout.truncated, next_values, config.gamma
     )
@@ -138,9 +143,7 @@ def a3c_loss(
     loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
     if sil_batch is not None:
         M = sil_batch.actions.shape[0]
-        sil = sil_loss(
-            logits_all[T * K + K :], values_all[T * K + K :], sil_batch, config.value_coef
-        )
+        sil = sil_loss(logits_all[n + K :], values_all[n + K :], sil_batch, config.value_coef)
         loss = loss + config.sil * sil * (T / M)
     numbers = torch.stack([policy_loss, value_loss, entropy_sum]).tolist()
     return loss, LossStats(numbers[0], numbers[1], numbers[2], 0.0)
@@ -197,11 +200,12 @@ def worker(
         memory = None
         if train_config.sil > 0:
             memory = EpisodeMemory(train_config.envs, train_config.gamma, train_config.sil_episodes)
+        keep_graph = model_config.module == "mhdpa"  # see collect_rollout
         parent = os.getppid()
         while not stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
             rollout, finished = collect_rollout(
-                local, state, train_config.n_steps, generator, bonus, memory
+                local, state, train_config.n_steps, generator, bonus, memory, keep_graph
             )
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
             loss, stats = a3c_loss(local, rollout, train_config, batch)
