@@ -24,6 +24,18 @@ Choices made here (DESIGN.md leaves them open):
   projects them to Table 4's output size (26). It is linear so that the
   output is a plain read-out of R and the R vectors stay the only relational
   features.
+
+How it is computed (same function, same parameters, cheaper on a CPU):
+
+* Q K^T = Q (L W_K)^T = (Q W_K) L^T: the (B, 2H, D) queries are moved into
+  entity space once instead of projecting all N entities to keys (the keys'
+  projection and its backward were a tenth of an update).
+* Both queries of all heads come from one product with the two weight
+  matrices side by side, and both attentions share one softmax and one
+  batched product with L (small batched products are slow per call).
+Together these made a PrediNet forward and backward over a 1352-observation
+update batch 25 % faster on one core (bench/train.py's fps part shows the
+effect on training).
 """
 
 from __future__ import annotations
@@ -63,14 +75,12 @@ class PrediNet(nn.Module):
     def forward(self, L: torch.Tensor, introspect: bool = False):
         B, N, F = L.shape
         H, D = self.heads, self.key_size
-        keys = self.key(L)  # (B, N, D)
         flat = L.reshape(B, N * F)  # (B, N * F)
-        q1 = self.query1(flat).view(B, H, D)  # (B, H, D)
-        q2 = self.query2(flat).view(B, H, D)
-        a1 = torch.softmax(q1 @ keys.transpose(1, 2) * self.scale, dim=-1)  # (B, H, N)
-        a2 = torch.softmax(q2 @ keys.transpose(1, 2) * self.scale, dim=-1)  # (B, H, N)
-        e1 = a1 @ L  # (B, H, F)
-        e2 = a2 @ L  # (B, H, F)
+        q = torch.cat([self.query1(flat), self.query2(flat)], dim=1).view(B, 2 * H, D)  # Q1, Q2
+        q_in_l = (q @ self.key.weight) * self.scale  # (B, 2H, F)  Q W_K: Q K^T = (Q W_K) L^T
+        a = torch.softmax(q_in_l @ L.transpose(1, 2), dim=-1)  # (B, 2H, N)
+        e = a @ L  # (B, 2H, F)
+        a1, a2, e1, e2 = a[:, :H], a[:, H:], e[:, :H], e[:, H:]  # (B, H, N), (B, H, F)
         rel = self.embed(e1[..., :-2] - e2[..., :-2])  # (B, H, J)  D^h
         pos1, pos2 = e1[..., -2:], e2[..., -2:]  # (B, H, 2)
         r = torch.cat([rel, pos1, pos2], dim=-1)  # (B, H, J + 4)
