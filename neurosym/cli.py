@@ -25,10 +25,22 @@ from neurosym.errors import NeurosymError
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "train": ("neurosym.agent.cli_train", "Train a PrediNet or MHDPA agent with A3C."),
-    "eval": ("neurosym.agent.cli_eval", "Evaluate a checkpoint: mean return, success rate, outcomes."),
-    "extract": ("neurosym.export.cli_extract", "Record episodes and write the R-vector facts as a Prolog KB."),
-    "query": ("neurosym.prolog.cli_query", "Run a Prolog goal against a knowledge base and print the answers."),
-    "plot": ("neurosym.viz.cli_plot", "Draw attention maps, R-vector heat maps and episode renderings."),
+    "eval": (
+        "neurosym.agent.cli_eval",
+        "Evaluate a checkpoint: mean return, success rate, outcomes.",
+    ),
+    "extract": (
+        "neurosym.export.cli_extract",
+        "Record episodes and write the R-vector facts as a Prolog KB.",
+    ),
+    "query": (
+        "neurosym.prolog.cli_query",
+        "Run a Prolog goal against a knowledge base and print the answers.",
+    ),
+    "plot": (
+        "neurosym.viz.cli_plot",
+        "Draw attention maps, R-vector heat maps and episode renderings.",
+    ),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
 }
 
