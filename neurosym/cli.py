@@ -22,6 +22,22 @@ from collections.abc import Sequence
 from neurosym import __version__
 from neurosym.errors import NeurosymError
 
+
+def add_action_mode(parser: argparse.ArgumentParser) -> None:
+    """``--greedy`` (default) | ``--sample``, stored as ``args.greedy``; eval and extract share it."""
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument(
+        "--greedy",
+        dest="greedy",
+        action="store_true",
+        default=True,
+        help="most likely action (default)",
+    )
+    mode.add_argument(
+        "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
+    )
+
+
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "train": ("neurosym.agent.cli_train", "Train a PrediNet or MHDPA agent with A3C."),

@@ -136,6 +136,14 @@ def test_out_that_is_a_file_is_refused(run_neurosym, checkpoint: Path, tmp_path:
     assert out.read_text() == "% someone's file\n"
 
 
+def test_env_defaults_to_the_checkpoints(run_neurosym, checkpoint: Path, tmp_path: Path) -> None:
+    out = tmp_path / "kb"
+    proc = run_neurosym("extract", "--checkpoint", checkpoint, "--episodes", 1, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "rgw2: 1 episodes (greedy, seed 0)" in proc.stdout
+    assert (out / "kb.pl").is_file()
+
+
 def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
     """examples/extract_and_query.py goes from a checkpoint to rule answers."""
     import os

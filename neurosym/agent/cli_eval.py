@@ -13,6 +13,7 @@ import json
 from collections import Counter
 from typing import Any
 
+from neurosym.cli import add_action_mode
 from neurosym.errors import ConfigError
 
 
@@ -25,17 +26,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--episodes", type=int, default=100, help="episodes to play (100)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode (0)")
-    mode = parser.add_mutually_exclusive_group()
-    mode.add_argument(
-        "--greedy",
-        dest="greedy",
-        action="store_true",
-        default=True,
-        help="most likely action (default)",
-    )
-    mode.add_argument(
-        "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
-    )
+    add_action_mode(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
 
 

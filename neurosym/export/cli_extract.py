@@ -1,6 +1,6 @@
 """``neurosym extract``: record episodes, extract the R-vector facts, write the KB, print answers.
 
-    neurosym extract --checkpoint ckpt.pt --env rgw2 [--episodes 20] [--seed 0]
+    neurosym extract --checkpoint ckpt.pt [--env rgw2] [--episodes 20] [--seed 0]
         [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
         [--format pl,parquet] [--qlf]
 
@@ -25,6 +25,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from neurosym.cli import add_action_mode
 from neurosym.errors import ConfigError
 
 FORMATS = ("pl", "parquet")
@@ -35,9 +36,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
     parser.add_argument(
         "--env",
-        required=True,
         metavar="NAME",
-        help="environment the checkpoint was trained on, e.g. rgw2",
+        help="environment to record, e.g. rgw2; must be the checkpoint's (default: it)",
     )
     parser.add_argument(
         "--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)"
@@ -49,17 +49,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="episode k is played from seed S + k (default: 0)",
     )
-    mode = parser.add_mutually_exclusive_group()
-    mode.add_argument(
-        "--greedy",
-        dest="greedy",
-        action="store_true",
-        default=True,
-        help="most likely action (default)",
-    )
-    mode.add_argument(
-        "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
-    )
+    add_action_mode(parser)
     parser.add_argument(
         "--threshold",
         default="quantile:0.9",
@@ -112,16 +102,19 @@ def run(args: argparse.Namespace) -> int:
 
     from neurosym.envs import canonical_name
 
-    env = canonical_name(args.env)
-    out = Path(args.out) if args.out else Path("kb_out") / env
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out} exists and is not a folder")
+    env = canonical_name(args.env) if args.env else None
+    if args.out and Path(args.out).exists() and not Path(args.out).is_dir():
+        raise ConfigError(f"--out {args.out} exists and is not a folder")
 
     from neurosym.agent.checkpoint import load_agent
     from neurosym.export.facts import extract_facts
     from neurosym.export.recorder import record
 
     agent = load_agent(args.checkpoint, env=env)
+    env = env or canonical_name(agent.env_name)
+    out = Path(args.out) if args.out else Path("kb_out") / env
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out} exists and is not a folder")
     show = not args.quiet
     rec = record(
         agent,
