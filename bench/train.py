@@ -9,7 +9,8 @@ Parts (``--only`` takes a comma-separated list; default: all):
   rgw2 (10.7), per module and seed (default seeds 0 1 2).
 * ``boxworld``: bw1 success rate against frames for a fixed frame budget, per
   module: the training success rate (last ``--window`` episodes) at each
-  metrics row, and the final checkpoint's sampled success over 1000 episodes.
+  metrics row, and the final checkpoint's sampled success over 1000 episodes;
+  first, the success of uniformly random actions over 1000 episodes.
 
 Every part runs the real command (``python -m neurosym train``) in a
 subprocess, in a temporary directory. Thesis figures for comparison (Box-World,
@@ -35,6 +36,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]  # the repository: `python -m neurosym` works from here
+sys.path.insert(0, str(ROOT))  # the in-process parts import neurosym from here too
 MODULES = ("predinet", "mhdpa")
 THESIS_BW = {
     "bw1": {"predinet": 0.293, "mhdpa": 0.365},
@@ -191,9 +193,28 @@ def bench_solve(
                 )
 
 
+def random_success(env: str, episodes: int = 1000, seed: int = 0) -> float:
+    """Success rate of uniformly random actions: the floor a learned policy must clear."""
+    import numpy as np
+
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES, play_episodes
+    from neurosym.envs import make_batched
+
+    rng = np.random.default_rng(seed)
+    done = play_episodes(
+        lambda obs: rng.integers(0, 4, size=len(obs)),
+        lambda n: make_batched(env, n),
+        episodes,
+        seed,
+        batch=250,
+    )
+    return sum(o in SUCCESS_OUTCOMES for o in done.outcomes) / episodes
+
+
 def bench_boxworld(
     env: str, frames: int, modules: tuple[str, ...], workers: int, seed: int
 ) -> None:
+    emit({"bench": "boxworld_random", "env": env, "episodes": 1000, "success": random_success(env)})
     for module in modules:
         with run_dir(f"{env}-{module}") as out:
             proc = neurosym(
@@ -283,7 +304,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--bw-env", default="bw1", help="Box-World configuration (bw1)")
     parser.add_argument(
-        "--bw-frames", type=int, default=2_000_000, help="frame budget per Box-World run"
+        "--bw-frames", type=int, default=1_500_000, help="frame budget per Box-World run"
     )
     parser.add_argument(
         "--keep", type=Path, help="keep the run directories (metrics.csv, checkpoint.pt) here"
