@@ -117,10 +117,12 @@ def test_train_mhdpa_single_worker_classic_k1(tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train", "--env", "rgw1", "--module", "mhdpa", "--out", str(out), "--workers", "1", "--envs", "1",
-        "--frames", "600", "--quiet", "--slim", "--heads", "2",
+        "--frames", "600", "--quiet", "--slim", "--heads", "2", "--sil", "0",
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     agent = load_agent(out / "checkpoint.pt")
+    assert agent.meta["train_config"]["sil"] == 0.0  # the RGW default is 1.0
+    assert "--sil 0" in agent.meta["command"]
     assert agent.config.module == "mhdpa" and agent.config.heads == 2 and agent.env_name == "rgw1"
     assert torch.load(out / "checkpoint.pt", weights_only=True)["optimizer"] is None
 
@@ -131,6 +133,7 @@ def test_train_mhdpa_single_worker_classic_k1(tmp_path: Path) -> None:
         (("--env", "rgw9", "--module", "predinet"), "rgw9"),
         (("--module", "predinet"), "--env and --module are needed unless --resume"),
         (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
+        (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
         (
             ("--env", "rgw2", "--module", "predinet", "--frames", "0"),
             "--frames must be a positive integer",

@@ -28,6 +28,8 @@ _OVERRIDES = (
     ("--value-coef", "value_coef", "train"),
     ("--rms-eps", "rms_eps", "train"),
     ("--explore", "explore", "train"),
+    ("--sil", "sil", "train"),
+    ("--sil-episodes", "sil_episodes", "train"),
     ("--heads", "heads", "model"),
     ("--key-size", "key_size", "model"),
     ("--relations", "relations", "model"),
@@ -72,6 +74,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     a3c.add_argument("--value-coef", type=float, help="value loss weight")
     a3c.add_argument("--rms-eps", type=float, help="RMSprop epsilon")
     a3c.add_argument("--explore", type=float, help="count-based exploration bonus beta (0: none)")
+    a3c.add_argument("--sil", type=float, help="self-imitation loss weight (0: none)")
+    a3c.add_argument(
+        "--sil-episodes", type=int, help="best episodes each worker keeps for self-imitation"
+    )
     model = parser.add_argument_group("model (defaults: Table 4)")
     model.add_argument("--heads", type=int, help="attention heads (4)")
     model.add_argument("--key-size", type=int, help="query/key size (32 RGW, 64 Box-World)")
