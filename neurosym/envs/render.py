@@ -13,6 +13,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from neurosym.envs.rgw_rules import ENTITY_NAMES
+
 RGB = tuple[int, int, int]
 
 
@@ -177,18 +179,7 @@ _RGW_GLYPHS: dict[str, tuple[tuple[str, ...], dict[str, RGB]]] = {
         {".": _FLOOR, "#": (40, 90, 200), "+": (230, 180, 20)},
     ),
 }
-RGW_TILE_ORDER = (
-    "agent",
-    "sword",
-    "enemy",
-    "terminal",
-    "teleport",
-    "wall",
-    "mountain",
-    "pit",
-    "empty",
-    "agent+sword",
-)
+RGW_TILE_ORDER = (*ENTITY_NAMES, "agent+sword")
 """tile index = entity code (agent .. empty), then 9 = agent holding the sword"""
 
 RGW_CHARS = ("A", "S", "E", "T", "O", "W", "M", "P", ".", "A")

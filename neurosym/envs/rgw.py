@@ -17,7 +17,7 @@ from gymnasium import spaces
 from neurosym.envs import render as draw
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.actions import Action
-from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource
+from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, batch_for
 from neurosym.envs.rgw_maps import load_map
 from neurosym.errors import ConfigError
 
@@ -147,18 +147,9 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         # Action: 0 up, 1 right, 2 down, 3 left.
         self.action_space = spaces.Discrete(len(Action))
         self.obs_scale = 1.0 if obs_mode == "onehot" else 1 / 255
-        self._batch = rules.RGWBatch(
-            1,
-            self.height,
-            self.width,
-            classic=self.classic,
-            obs_mode=obs_mode,
-            max_steps=max_steps,
-            per_env_levels=source.per_episode,
+        self._batch = batch_for(
+            source, 1, classic=self.classic, obs_mode=obs_mode, max_steps=max_steps
         )
-        if not source.per_episode:
-            cells, starts = source.levels(np.zeros(1, np.uint64), np.zeros(1, np.int64))
-            self._batch.set_levels(np.zeros(1, np.intp), cells, starts)
         self.level_seed: int | None = None
         """seed of the current level key (see rgw_levels)"""
         self.episode_index = -1

@@ -94,6 +94,25 @@ class LevelSource(Protocol):
     # ``take(rows, seeds, episodes) -> (cells, starts)`` that generates ahead.
 
 
+def batch_for(
+    source: LevelSource, n: int, *, classic: bool, obs_mode: str, max_steps: int | None
+) -> rules.RGWBatch:
+    """The rules' state for n envs playing ``source``'s levels; a fixed level is set once here."""
+    batch = rules.RGWBatch(
+        n,
+        source.height,
+        source.width,
+        classic=classic,
+        obs_mode=obs_mode,
+        max_steps=max_steps,
+        per_env_levels=source.per_episode,
+    )
+    if not source.per_episode:
+        cells, starts = source.levels(np.zeros(1, np.uint64), np.zeros(1, np.int64))
+        batch.set_levels(np.zeros(1, np.intp), cells, starts)
+    return batch
+
+
 class FixedLevel:
     """One map for every episode (rgw1, rgw2 or a user's map)."""
 

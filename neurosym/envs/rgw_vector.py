@@ -35,7 +35,7 @@ from gymnasium.vector.utils import batch_space
 from neurosym.envs import render as draw
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.rgw import check_options, observation_space
-from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, ObjectsCache
+from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, ObjectsCache, batch_for
 from neurosym.envs.rgw_maps import load_map
 from neurosym.envs.rgw_random import RandomLevels, config_from_kwargs
 from neurosym.errors import ConfigError
@@ -106,18 +106,9 @@ class RGWVectorEnv(VectorEnv):
         self.single_action_space = spaces.Discrete(4)
         self.action_space = spaces.MultiDiscrete(np.full(self.num_envs, 4))
         self.obs_scale = 1.0 if obs_mode == "onehot" else 1 / 255
-        self._batch = rules.RGWBatch(
-            self.num_envs,
-            self.height,
-            self.width,
-            classic=self.classic,
-            obs_mode=obs_mode,
-            max_steps=max_steps,
-            per_env_levels=source.per_episode,
+        self._batch = batch_for(
+            source, self.num_envs, classic=self.classic, obs_mode=obs_mode, max_steps=max_steps
         )
-        if not source.per_episode:
-            cells, starts = source.levels(np.zeros(1, np.uint64), np.zeros(1, np.int64))
-            self._batch.set_levels(np.zeros(1, np.intp), cells, starts)
         self._first_seed = seed
         self._seeds: np.ndarray | None = None
         self._episodes = np.zeros(self.num_envs, dtype=np.int64)
