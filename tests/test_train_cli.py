@@ -161,7 +161,8 @@ def test_resume_without_checkpoint(tmp_path: Path) -> None:
 
 
 @pytest.mark.expensive
-def test_ctrl_c_stops_cleanly_with_a_checkpoint(tmp_path: Path) -> None:
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_ctrl_c_stops_cleanly_with_a_checkpoint(tmp_path: Path, sig: signal.Signals) -> None:
     out = tmp_path / "run"
     proc = subprocess.Popen(
         [sys.executable, "-m", "neurosym", "train", "--env", "rgw2", "--module", "predinet", "--out", str(out),
@@ -173,7 +174,7 @@ def test_ctrl_c_stops_cleanly_with_a_checkpoint(tmp_path: Path) -> None:
         while time.monotonic() < deadline and not (out / "metrics.csv").exists():
             time.sleep(0.2)
         assert (out / "metrics.csv").exists(), "training never started"
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
         stdout, stderr = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:

@@ -236,8 +236,31 @@ class _Stats:
         return out
 
 
-def _raise_interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
+class _StopSignal:
+    """Ctrl-C and SIGTERM as a flag the watch loop polls, not an exception.
+
+    A KeyboardInterrupt raised in the middle of reading a worker's message
+    from the queue leaves the rest of that message in the pipe; the next read
+    then takes its bytes for a length header and can wait forever (seen once
+    under heavy load: Ctrl-C, and the run never stopped). A handler that only
+    sets a flag lets every read finish.
+    """
+
+    def __init__(self) -> None:
+        self.received = False
+        self._previous: dict[int, Any] = {}
+
+    def _handle(self, signum: int, frame: object) -> None:
+        self.received = True
+
+    def __enter__(self) -> _StopSignal:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._previous[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
 
 
 def _env_seed(seed: int, rank: int, frames_before: int) -> int:
@@ -388,8 +411,8 @@ def train(
             procs.append(proc)
     finally:
         signal.signal(signal.SIGINT, previous)
-    # SIGTERM (kill, a batch scheduler) stops the run like Ctrl-C: workers stopped, checkpoint written
-    previous_term = signal.signal(signal.SIGTERM, _raise_interrupt)
+    # Ctrl-C and SIGTERM (kill, a batch scheduler) stop the run: workers stopped, checkpoint written
+    stop_signal = _StopSignal().__enter__()
 
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -440,6 +463,9 @@ def train(
             while True:
                 drain(0.1)
                 now = time.monotonic()
+                if stop_signal.received:
+                    stop_reason = "interrupted"
+                    break
                 if failure:
                     stop_reason = "error"
                     break
@@ -490,24 +516,24 @@ def train(
                 elif now - last_ckpt >= options.checkpoint_interval:
                     checkpoint(None, {"wall_s": wall0 + now - start, "stop_reason": "running"})
                     last_ckpt = now
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # a Ctrl-C that came before the handler was in place
         stop_reason = "interrupted"
     finally:
         stop.set()
         deadline = time.monotonic() + 30
         while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
-            try:
-                drain(0.05)
-            except KeyboardInterrupt:
-                continue
+            drain(0.05)
             for p in procs:
                 p.join(timeout=0.01)
+        cut = False
         for p in procs:
             if p.is_alive():
                 p.terminate()
                 p.join(timeout=5)
-        drain(0.0)
-        signal.signal(signal.SIGTERM, previous_term)
+                cut = True
+        if not cut:  # a terminated worker may have left half a message in the pipe
+            drain(0.0)
+        stop_signal.__exit__()
     wall = wall0 + time.monotonic() - start
     if failure:
         raise RuntimeError(failure)
