@@ -104,6 +104,7 @@ def test_extract_writes_the_kb_and_prints_the_answers(
         (["--env", "rgw2", "--threshold", "top:5"], ["bad threshold 'top:5'", "quantile:0.9"]),
         (["--env", "rgw2", "--format", "pl,csv"], ["bad --format 'pl,csv'", "pl, parquet"]),
         (["--env", "rgw2", "--episodes", "0"], ["--episodes must be at least 1"]),
+        (["--env", "rgw2", "--top-keys", "0"], ["--top-keys must be at least 1"]),
     ],
 )
 def test_bad_input_is_refused_and_nothing_is_written(
@@ -162,3 +163,25 @@ def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
     assert "sword before enemy in episodes: [" in proc.stdout
     assert "how the network links sword and enemy:" in proc.stdout
     assert (tmp_path / "kb" / "kb.pl").is_file()
+
+
+def test_top_keys_keeps_more_mhdpa_keys(run_neurosym, tmp_path: Path) -> None:
+    env = make("rgw2")
+    torch.manual_seed(0)
+    cfg = ModelConfig.for_family(
+        "rgw", "mhdpa", env.observation_space.shape, env.unwrapped.obs_scale,
+        heads=2, key_size=8, value_size=8, conv_channels=(4, 8), hidden_sizes=(16,),
+    )  # fmt: skip
+    ckpt = save_checkpoint(
+        tmp_path / "mhdpa.pt", model=ActorCritic(cfg), config=cfg, env_name="rgw2",
+        env_kwargs={"max_steps": 5},
+    )  # fmt: skip
+    counts = {}
+    for n in (1, 3):
+        out = tmp_path / f"kb{n}"
+        proc = run_neurosym("extract", "--checkpoint", ckpt, "--episodes", 1, "--out", out,
+                            "--format", "pl,parquet", "--top-keys", n, "--quiet")  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        table = pd.read_parquet(out / "facts" / "attention.parquet")
+        counts[n] = table.groupby(["t", "head", "query"]).size()  # query: the cell's entity name
+    assert counts[1].index.equals(counts[3].index) and (counts[3] == 3 * counts[1]).all()

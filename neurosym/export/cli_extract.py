@@ -73,6 +73,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="B",
         help="environments stepped together (default: 64)",
     )
+    parser.add_argument(
+        "--top-keys",
+        type=int,
+        default=1,
+        metavar="N",
+        help="MHDPA: keep each query cell's N strongest keys as attention/6 facts (default: 1)",
+    )
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -99,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
     if args.batch is not None and args.batch < 1:
         raise ConfigError(f"--batch must be at least 1, got {args.batch}")
+    if args.top_keys < 1:
+        raise ConfigError(f"--top-keys must be at least 1, got {args.top_keys}")
 
     from neurosym.envs import canonical_name
 
@@ -124,6 +133,7 @@ def run(args: argparse.Namespace) -> int:
         greedy=args.greedy,
         batch=args.batch,
         progress=show and _tty(),
+        top_keys=args.top_keys,
     )
     facts = extract_facts(rec, threshold=threshold)
     written = write_outputs(out, rec, facts, formats, qlf=args.qlf)
