@@ -77,6 +77,24 @@ def neurosym(*args: str, timeout: float) -> subprocess.CompletedProcess[str]:
     )
 
 
+def train(
+    env: str, module: str, out: Path, *options: str, timeout: float
+) -> subprocess.CompletedProcess[str]:
+    """``neurosym train --env ENV --module MODULE --out OUT --quiet OPTIONS...``."""
+    return neurosym(
+        "train", "--env", env, "--module", module, "--out", str(out), "--quiet", *options,
+        timeout=timeout,
+    )  # fmt: skip
+
+
+def failed(proc: subprocess.CompletedProcess[str], **record: object) -> bool:
+    """True when the run failed, after printing ``record`` with the end of its stderr."""
+    if proc.returncode == 0:
+        return False
+    emit({**record, "error": proc.stderr.strip()[-500:]})
+    return True
+
+
 def rows(out: Path) -> list[dict[str, str]]:
     with (out / "metrics.csv").open(newline="") as fh:
         return list(csv.DictReader(fh))
@@ -92,38 +110,18 @@ def bench_fps(workers: int, seconds: float, modules: tuple[str, ...], env: str) 
     for module in modules:
         for k in (1, 8, 32):
             with run_dir(f"fps-{module}-k{k}") as out:
-                proc = neurosym(
-                    "train",
-                    "--env",
-                    env,
-                    "--module",
-                    module,
-                    "--out",
-                    str(out),
-                    "--workers",
-                    str(workers),
-                    "--envs",
-                    str(k),
-                    "--minutes",
-                    str(seconds / 60),
-                    "--quiet",
-                    "--eval-interval",
-                    "1000000",
+                proc = train(
+                    env, module, out,
+                    "--workers", str(workers), "--envs", str(k), "--minutes", str(seconds / 60),
+                    "--eval-interval", "1000000",
                     timeout=seconds + 120,
-                )
-                if proc.returncode != 0:
-                    emit(
-                        {
-                            "bench": "train_fps",
-                            "module": module,
-                            "envs": k,
-                            "error": proc.stderr.strip()[-500:],
-                        }
-                    )
+                )  # fmt: skip
+                if failed(proc, bench="train_fps", module=module, envs=k):
                     continue
-                table = rows(out)[1:]  # the first row includes start-up
-                frames = int(table[-1]["frames"]) - int(rows(out)[0]["frames"])
-                wall = float(table[-1]["wall_s"]) - float(rows(out)[0]["wall_s"])
+                table = rows(out)
+                first, last = table[0], table[-1]  # the first row includes start-up: left out
+                frames = int(last["frames"]) - int(first["frames"])
+                wall = float(last["wall_s"]) - float(first["wall_s"])
                 emit(
                     {
                         "bench": "train_fps",
@@ -146,35 +144,14 @@ def bench_solve(
         for seed in seeds:
             with run_dir(f"solve-{module}-s{seed}") as out:
                 start = time.monotonic()
-                proc = neurosym(
-                    "train",
-                    "--env",
-                    "rgw2",
-                    "--module",
-                    module,
-                    "--out",
-                    str(out),
-                    "--seed",
-                    str(seed),
-                    "--workers",
-                    str(workers),
-                    "--target-return",
-                    "10.7",
-                    "--minutes",
-                    str(limit_minutes),
-                    "--quiet",
+                proc = train(
+                    "rgw2", module, out,
+                    "--seed", str(seed), "--workers", str(workers), "--target-return", "10.7",
+                    "--minutes", str(limit_minutes),
                     timeout=limit_minutes * 60 + 120,
-                )
+                )  # fmt: skip
                 elapsed = time.monotonic() - start
-                if proc.returncode != 0:
-                    emit(
-                        {
-                            "bench": "rgw2_solve",
-                            "module": module,
-                            "seed": seed,
-                            "error": proc.stderr.strip()[-500:],
-                        }
-                    )
+                if failed(proc, bench="rgw2_solve", module=module, seed=seed):
                     continue
                 m = checkpoint_metrics(out)
                 emit(
@@ -217,36 +194,13 @@ def bench_boxworld(
     emit({"bench": "boxworld_random", "env": env, "episodes": 1000, "success": random_success(env)})
     for module in modules:
         with run_dir(f"{env}-{module}") as out:
-            proc = neurosym(
-                "train",
-                "--env",
-                env,
-                "--module",
-                module,
-                "--out",
-                str(out),
-                "--workers",
-                str(workers),
-                "--frames",
-                str(frames),
-                "--seed",
-                str(seed),
-                "--window",
-                "1000",
-                "--quiet",
-                "--eval-interval",
-                "30",
+            proc = train(
+                env, module, out,
+                "--workers", str(workers), "--frames", str(frames), "--seed", str(seed),
+                "--window", "1000", "--eval-interval", "30",
                 timeout=24 * 3600,
-            )
-            if proc.returncode != 0:
-                emit(
-                    {
-                        "bench": "boxworld",
-                        "env": env,
-                        "module": module,
-                        "error": proc.stderr.strip()[-500:],
-                    }
-                )
+            )  # fmt: skip
+            if failed(proc, bench="boxworld", env=env, module=module):
                 continue
             table = rows(out)
             step = max(1, len(table) // 10)
