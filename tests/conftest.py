@@ -27,7 +27,7 @@ def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
 
     def run(*args: object, timeout: float = 300) -> subprocess.CompletedProcess[str]:
         path = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH")) if p)
-        env = {**os.environ, "PYTHONPATH": path}
+        env = {**os.environ, "PYTHONPATH": path, "PYTHONHASHSEED": "0"}
         return subprocess.run(
             [sys.executable, "-m", "neurosym", *map(str, args)],
             capture_output=True, text=True, cwd=REPO, env=env, timeout=timeout,

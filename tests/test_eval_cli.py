@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+import functools
 import json
-import os
 import subprocess
-import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -16,19 +16,13 @@ from neurosym.agent.cli_eval import evaluate
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.model import ActorCritic
 
-ROOT = Path(__file__).resolve().parents[1]
-ENV = {**os.environ, "PYTHONHASHSEED": "0"}
 
-
-def neurosym(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "neurosym", *args],
-        cwd=ROOT,
-        env=ENV,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+@pytest.fixture
+def neurosym(
+    run_neurosym: Callable[..., subprocess.CompletedProcess[str]],
+) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """The CLI in a subprocess (conftest's run_neurosym) with these tests' 120 s limit."""
+    return functools.partial(run_neurosym, timeout=120)
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +34,7 @@ def untrained(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def test_eval_json(untrained: Path) -> None:
+def test_eval_json(neurosym, untrained: Path) -> None:
     proc = neurosym("eval", "--checkpoint", str(untrained), "--episodes", "6", "--json")
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.strip().splitlines()
@@ -55,7 +49,7 @@ def test_eval_json(untrained: Path) -> None:
     assert again["mean_return"] == report["mean_return"] and again["outcomes"] == report["outcomes"]
 
 
-def test_eval_text_and_sample(untrained: Path) -> None:
+def test_eval_text_and_sample(neurosym, untrained: Path) -> None:
     proc = neurosym(
         "eval", "--checkpoint", str(untrained), "--episodes", "4", "--sample", "--seed", "3"
     )
@@ -77,14 +71,16 @@ def test_eval_text_and_sample(untrained: Path) -> None:
         (("--env", "rgw1"), "was trained on rgw2, not rgw1"),
     ],
 )
-def test_eval_errors_are_one_line(untrained: Path, args: tuple[str, ...], message: str) -> None:
+def test_eval_errors_are_one_line(
+    neurosym, untrained: Path, args: tuple[str, ...], message: str
+) -> None:
     full = ("--checkpoint", str(untrained), *args) if args[0] != "--checkpoint" else args
     proc = neurosym("eval", *full)
     assert proc.returncode == 1
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
 
 
-def test_eval_refuses_a_text_file(tmp_path: Path) -> None:
+def test_eval_refuses_a_text_file(neurosym, tmp_path: Path) -> None:
     path = tmp_path / "notes.pt"
     path.write_text("not a checkpoint\n")
     proc = neurosym("eval", "--checkpoint", str(path))

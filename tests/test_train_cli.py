@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import csv
+import functools
 import os
 import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -19,15 +21,12 @@ ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONHASHSEED": "0"}
 
 
-def neurosym(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "neurosym", *args],
-        cwd=ROOT,
-        env=ENV,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
+@pytest.fixture
+def neurosym(
+    run_neurosym: Callable[..., subprocess.CompletedProcess[str]],
+) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """The CLI in a subprocess (conftest's run_neurosym) with these tests' 120 s limit."""
+    return functools.partial(run_neurosym, timeout=120)
 
 
 def metrics(out: Path) -> list[dict[str, str]]:
@@ -39,7 +38,7 @@ TINY = ("--envs", "4", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "
 
 
 @pytest.mark.expensive
-def test_train_writes_checkpoint_and_metrics_then_resumes(tmp_path: Path) -> None:
+def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train",
@@ -113,7 +112,7 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(tmp_path: Path) -> Non
 
 
 @pytest.mark.expensive
-def test_train_mhdpa_single_worker_classic_k1(tmp_path: Path) -> None:
+def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train", "--env", "rgw1", "--module", "mhdpa", "--out", str(out), "--workers", "1", "--envs", "1",
@@ -144,14 +143,16 @@ def test_train_mhdpa_single_worker_classic_k1(tmp_path: Path) -> None:
         ),
     ],
 )
-def test_train_bad_input_is_one_line(tmp_path: Path, args: tuple[str, ...], message: str) -> None:
+def test_train_bad_input_is_one_line(
+    neurosym, tmp_path: Path, args: tuple[str, ...], message: str
+) -> None:
     proc = neurosym("train", "--out", str(tmp_path / "run"), "--quiet", *args)
     assert proc.returncode == 1, proc.stderr
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert not (tmp_path / "run" / "checkpoint.pt").exists()
 
 
-def test_resume_without_checkpoint(tmp_path: Path) -> None:
+def test_resume_without_checkpoint(neurosym, tmp_path: Path) -> None:
     proc = neurosym("train", "--out", str(tmp_path / "nothing"), "--resume", "--quiet")
     assert proc.returncode == 1
     assert (
