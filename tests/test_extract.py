@@ -17,19 +17,25 @@ from neurosym.envs import make
 from neurosym.export.recording import Recording
 
 
-@pytest.fixture(scope="module")
-def checkpoint(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A small untrained rgw2 PrediNet checkpoint whose episodes stop after 15 steps."""
+def small_checkpoint(path: Path, module: str, max_steps: int, **sizes: object) -> Path:
+    """A small untrained rgw2 checkpoint (seed 0) whose episodes stop after ``max_steps``."""
     env = make("rgw2")
     torch.manual_seed(0)
     cfg = ModelConfig.for_family(
-        "rgw", "predinet", env.observation_space.shape, env.unwrapped.obs_scale,
-        heads=2, relations=3, key_size=8, conv_channels=(4, 8), hidden_sizes=(16,),
+        "rgw", module, env.observation_space.shape, env.unwrapped.obs_scale,
+        heads=2, key_size=8, conv_channels=(4, 8), hidden_sizes=(16,), **sizes,
     )  # fmt: skip
-    path = tmp_path_factory.mktemp("ckpt") / "rgw2-small.pt"
     return save_checkpoint(
-        path, model=ActorCritic(cfg), config=cfg, env_name="rgw2", env_kwargs={"max_steps": 15}
-    )
+        path, model=ActorCritic(cfg), config=cfg, env_name="rgw2",
+        env_kwargs={"max_steps": max_steps},
+    )  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def checkpoint(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A small untrained rgw2 PrediNet checkpoint whose episodes stop after 15 steps."""
+    path = tmp_path_factory.mktemp("ckpt") / "rgw2-small.pt"
+    return small_checkpoint(path, "predinet", 15, relations=3)
 
 
 def one_line_error(proc: subprocess.CompletedProcess[str], *parts: str) -> None:
@@ -166,16 +172,7 @@ def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
 
 
 def test_top_keys_keeps_more_mhdpa_keys(run_neurosym, tmp_path: Path) -> None:
-    env = make("rgw2")
-    torch.manual_seed(0)
-    cfg = ModelConfig.for_family(
-        "rgw", "mhdpa", env.observation_space.shape, env.unwrapped.obs_scale,
-        heads=2, key_size=8, value_size=8, conv_channels=(4, 8), hidden_sizes=(16,),
-    )  # fmt: skip
-    ckpt = save_checkpoint(
-        tmp_path / "mhdpa.pt", model=ActorCritic(cfg), config=cfg, env_name="rgw2",
-        env_kwargs={"max_steps": 5},
-    )  # fmt: skip
+    ckpt = small_checkpoint(tmp_path / "mhdpa.pt", "mhdpa", 5, value_size=8)
     counts = {}
     for n in (1, 3):
         out = tmp_path / f"kb{n}"
