@@ -241,9 +241,9 @@ class _StopSignal:
 
     A KeyboardInterrupt raised in the middle of reading a worker's message
     from the queue leaves the rest of that message in the pipe; the next read
-    then takes its bytes for a length header and can wait forever (seen once
-    under heavy load: Ctrl-C, and the run never stopped). A handler that only
-    sets a flag lets every read finish.
+    then takes its bytes for a length header and can wait forever (the likely
+    cause of a Ctrl-C that once never stopped a run under heavy load). A
+    handler that only sets a flag lets every read finish.
     """
 
     def __init__(self) -> None:
@@ -253,12 +253,11 @@ class _StopSignal:
     def _handle(self, signum: int, frame: object) -> None:
         self.received = True
 
-    def __enter__(self) -> _StopSignal:
+    def install(self) -> None:
         for sig in (signal.SIGINT, signal.SIGTERM):
             self._previous[sig] = signal.signal(sig, self._handle)
-        return self
 
-    def __exit__(self, *exc: object) -> None:
+    def restore(self) -> None:
         for sig, handler in self._previous.items():
             signal.signal(sig, handler)
 
@@ -411,8 +410,6 @@ def train(
             procs.append(proc)
     finally:
         signal.signal(signal.SIGINT, previous)
-    # Ctrl-C and SIGTERM (kill, a batch scheduler) stop the run: workers stopped, checkpoint written
-    stop_signal = _StopSignal().__enter__()
 
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -458,6 +455,9 @@ def train(
             elif msg[0] == "error" and failure is None:
                 failure = f"worker {msg[1]} failed:\n{msg[2]}"
 
+    # Ctrl-C and SIGTERM (kill, a batch scheduler) stop the run: workers stopped, checkpoint written
+    stop_signal = _StopSignal()
+    stop_signal.install()
     try:
         with progress:
             while True:
@@ -533,7 +533,7 @@ def train(
                 cut = True
         if not cut:  # a terminated worker may have left half a message in the pipe
             drain(0.0)
-        stop_signal.__exit__()
+        stop_signal.restore()
     wall = wall0 + time.monotonic() - start
     if failure:
         raise RuntimeError(failure)
