@@ -112,8 +112,6 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.envs import canonical_name
 
     env = canonical_name(args.env) if args.env else None
-    if args.out and Path(args.out).exists() and not Path(args.out).is_dir():
-        raise ConfigError(f"--out {args.out} exists and is not a folder")
 
     from neurosym.agent.checkpoint import load_agent
     from neurosym.export.facts import extract_facts
@@ -121,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
 
     agent = load_agent(args.checkpoint, env=env)
     env = env or canonical_name(agent.env_name)
-    out = Path(args.out) if args.out else Path("kb_out") / env
+    out = Path(args.out) if args.out else Path("kb_out") / env  # default: needs the checkpoint's env
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out} exists and is not a folder")
     show = not args.quiet
