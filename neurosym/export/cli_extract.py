@@ -119,7 +119,8 @@ def run(args: argparse.Namespace) -> int:
 
     agent = load_agent(args.checkpoint, env=env)
     env = env or canonical_name(agent.env_name)
-    out = Path(args.out) if args.out else Path("kb_out") / env  # default: needs the checkpoint's env
+    # checked here, once: the default folder needs the checkpoint's env
+    out = Path(args.out) if args.out else Path("kb_out") / env
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out} exists and is not a folder")
     show = not args.quiet
