@@ -17,7 +17,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from neurosym.envs.actions import ACTION_NAMES, Action
-from neurosym.envs.boxworld_entities import ENTITY_NAMES
+from neurosym.envs.boxworld_entities import ENTITY_NAMES, NUM_PLANES
 from neurosym.envs.boxworld_gen import (
     GRID,
     Box,
@@ -29,7 +29,7 @@ from neurosym.envs.boxworld_gen import (
     seed_keys,
 )
 from neurosym.envs.boxworld_render import DEFAULT_TILE, ansi_text, rgb_frame
-from neurosym.envs.boxworld_rules import BoxWorldState, decode_info
+from neurosym.envs.boxworld_rules import OBS_MODES, BoxWorldState, decode_info
 from neurosym.errors import ConfigError
 
 __all__ = [
@@ -55,9 +55,17 @@ BOXWORLD_CONFIGS: dict[str, dict[str, int]] = {
 _METADATA = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
 
 
-def _observation_space() -> spaces.Box:
+def _observation_space(obs_mode: str) -> spaces.Box:
+    if obs_mode not in OBS_MODES:
+        raise ConfigError(f"obs_mode {obs_mode!r} is not one of {', '.join(OBS_MODES)}")
+    if obs_mode == "onehot":  # 0/1 planes: 6 object types, then 20 colours
+        return spaces.Box(0, 1, (NUM_PLANES, GRID, GRID), np.uint8)
     # RGB, channels first, 0..255 (obs_scale 1/255): the 12 x 12 interior and its border
     return spaces.Box(0, 255, (3, GRID, GRID), np.uint8)
+
+
+def _obs_scale(obs_mode: str) -> float:
+    return 1.0 if obs_mode == "onehot" else 1.0 / 255.0
 
 
 def _check_render_mode(render_mode: str | None, tile_size: int) -> None:
@@ -90,9 +98,15 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
     (:class:`neurosym.envs.actions.Action`).
 
     ## Observation
-    ``uint8`` RGB ``(3, 14, 14)``, channels first (``obs_scale`` 1/255): wall
-    black, empty light grey, agent dark grey, gem white, keys and locks in one
-    of 20 named colours (:data:`~neurosym.envs.boxworld_entities.COLOURS`).
+    ``obs_mode="rgb"`` (default): ``uint8`` RGB ``(3, 14, 14)``, channels first
+    (``obs_scale`` 1/255): wall black, empty light grey, agent dark grey, gem
+    white, keys and locks in one of 20 named colours
+    (:data:`~neurosym.envs.boxworld_entities.COLOURS`).
+    ``obs_mode="onehot"`` (what ``neurosym train`` uses by default): ``uint8``
+    0/1 planes ``(26, 14, 14)``: six object types (wall, agent, gem, key,
+    lock, held key) then one plane per colour, so a key and its lock share a
+    plane (:data:`~neurosym.envs.boxworld_entities.ONEHOT`); empty cells
+    set none. The held key is the top-left border cell in both modes.
     ``entity_grid()`` names each cell: ``agent, gem, key(C), lock(C),
     held(C), wall, empty`` (a box's content shows as ``key(C)`` or ``gem``).
 
@@ -130,7 +144,6 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
 
     metadata = _METADATA
     entity_names: tuple[str, ...] = ENTITY_NAMES
-    obs_scale: float = 1.0 / 255.0
 
     def __init__(
         self,
@@ -140,14 +153,17 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
         max_steps: int = 300,
         render_mode: str | None = None,
         tile_size: int = DEFAULT_TILE,
+        obs_mode: str = "rgb",
     ) -> None:
         self.config = BoxWorldConfig(solution_length, num_distractors, distractor_length, max_steps)
         _check_render_mode(render_mode, tile_size)
         self.render_mode = render_mode
         self.tile_size = tile_size
-        self.observation_space = _observation_space()
+        self.observation_space = _observation_space(obs_mode)
+        self.obs_mode = obs_mode
+        self.obs_scale = _obs_scale(obs_mode)
         self.action_space = spaces.Discrete(4)  # 0 up, 1 right, 2 down, 3 left
-        self._state = BoxWorldState(1, self.config.num_slots, max_steps)
+        self._state = BoxWorldState(1, self.config.num_slots, max_steps, obs_mode)
         self._key: np.ndarray | None = None  # (1,) uint64 level stream
         self._episode = 0
         self._action = np.zeros(1, np.int64)
@@ -168,7 +184,9 @@ class BoxWorldEnv(gym.Env[np.ndarray, np.int64]):
         elif isinstance(level, Level):
             levels = level.to_arrays()
             if levels.cells.shape[1] > self._state.slots:
-                self._state = BoxWorldState(1, levels.cells.shape[1], self.config.max_steps)
+                self._state = BoxWorldState(
+                    1, levels.cells.shape[1], self.config.max_steps, self.obs_mode
+                )
         else:
             raise ConfigError(
                 f"options['level'] must be a neurosym.envs.boxworld.Level, got {type(level).__name__}"
@@ -232,7 +250,6 @@ class BoxWorldVectorEnv(VectorEnv):
 
     metadata = {**_METADATA, "autoreset_mode": AutoresetMode.NEXT_STEP}
     entity_names: tuple[str, ...] = ENTITY_NAMES
-    obs_scale: float = 1.0 / 255.0
 
     def __init__(
         self,
@@ -245,6 +262,7 @@ class BoxWorldVectorEnv(VectorEnv):
         render_mode: str | None = None,
         tile_size: int = DEFAULT_TILE,
         copy: bool = True,
+        obs_mode: str = "rgb",
     ) -> None:
         if not isinstance(num_envs, int | np.integer) or isinstance(num_envs, bool) or num_envs < 1:
             raise ConfigError(f"num_envs must be a positive integer, got {num_envs!r}")
@@ -254,11 +272,13 @@ class BoxWorldVectorEnv(VectorEnv):
         self.render_mode = render_mode
         self.tile_size = tile_size
         self.copy = bool(copy)
-        self.single_observation_space = _observation_space()
+        self.single_observation_space = _observation_space(obs_mode)
+        self.obs_mode = obs_mode
+        self.obs_scale = _obs_scale(obs_mode)
         self.single_action_space = spaces.Discrete(4)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self._state = BoxWorldState(self.num_envs, self.config.num_slots, max_steps)
+        self._state = BoxWorldState(self.num_envs, self.config.num_slots, max_steps, obs_mode)
         if seed is not None:
             seed_keys(seed, 1)  # refuse a bad seed now rather than at the first reset
         self._seed = seed
@@ -338,7 +358,7 @@ class BoxWorldVectorEnv(VectorEnv):
     def _observation(self) -> np.ndarray:
         if self.copy:
             return self._state.observation()
-        return self._state.obs.reshape(self.num_envs, 3, GRID, GRID)  # the live buffer
+        return self._state.obs.reshape(self.num_envs, self._state.planes, GRID, GRID)  # live buffer
 
     def decode_info(self, info: dict[str, Any], i: int) -> dict[str, Any]:
         """The dict :class:`BoxWorldEnv` would give for sub-environment ``i``."""

@@ -80,6 +80,27 @@ PALETTE: np.ndarray = _palette()
 """(NUM_CODES, 3) uint8: the RGB value of each code in the observation."""
 PALETTE.setflags(write=False)
 
+TYPE_PLANES: tuple[str, ...] = ("wall", "agent", "gem", "key", "lock", "held")
+"""The object-type planes of the one-hot observation, then one plane per colour."""
+NUM_PLANES = len(TYPE_PLANES) + NUM_COLOURS
+
+
+def _onehot_table() -> np.ndarray:
+    table = np.zeros((NUM_CODES, NUM_PLANES), np.uint8)
+    table[WALL, 0] = table[AGENT, 1] = table[GEM, 2] = 1
+    for c in range(NUM_COLOURS):
+        for plane, base in ((3, KEY), (4, LOCK), (5, HELD)):
+            table[base + c, plane] = 1
+            table[base + c, len(TYPE_PLANES) + c] = 1
+    return table
+
+
+ONEHOT: np.ndarray = _onehot_table()
+"""(NUM_CODES, NUM_PLANES) uint8: the planes set for each code (empty sets none). A key and its
+lock share their colour plane and differ in their type plane, so "same colour" is one
+channel for the network instead of a match of three RGB values."""
+ONEHOT.setflags(write=False)
+
 # Prolog text used in info dicts, built once (decoding runs every step).
 KEY_TEXT: tuple[str, ...] = ENTITY_NAMES[KEY:LOCK]
 LOCK_TEXT: tuple[str, ...] = ENTITY_NAMES[LOCK:HELD]

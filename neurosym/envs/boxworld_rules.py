@@ -42,6 +42,8 @@ from neurosym.envs.boxworld_entities import (
     KEY,
     KEY_TEXT,
     LOCK,
+    NUM_PLANES,
+    ONEHOT,
     OPENED_TEXT,
     OUTCOME_DISTRACTOR,
     OUTCOME_GEM,
@@ -60,15 +62,26 @@ _BASE_GRID = base_grid()
 _RED, _GREEN, _BLUE = (np.ascontiguousarray(PALETTE[:, ch]) for ch in range(3))
 
 
+OBS_MODES = ("rgb", "onehot")
+
+
+def _table(obs_mode: str) -> np.ndarray:
+    """(NUM_CODES, P) uint8 observation values of each entity code."""
+    return PALETTE if obs_mode == "rgb" else ONEHOT
+
+
 class BoxWorldState:
     """n Box-World environments as arrays (flat cells index the 14 x 14 grid row-major)."""
 
-    def __init__(self, n: int, slots: int, max_steps: int) -> None:
+    def __init__(self, n: int, slots: int, max_steps: int, obs_mode: str = "rgb") -> None:
         self.n, self.slots, self.max_steps = n, slots, max_steps
+        self.obs_mode = obs_mode
+        self.planes = 3 if obs_mode == "rgb" else NUM_PLANES
+        self._lut = _table(obs_mode)
         rows = np.arange(n)
         self.grid = np.tile(_BASE_GRID, (n, 1))  # (n, CELLS) uint8 entity codes
-        # (n, 3, CELLS) uint8 RGB, kept up to date cell by cell
-        self.obs = np.ascontiguousarray(PALETTE[self.grid].transpose(0, 2, 1))
+        # (n, P, CELLS) uint8 RGB or one-hot planes, kept up to date cell by cell
+        self.obs = np.ascontiguousarray(self._lut[self.grid].transpose(0, 2, 1))
         self.distractor = np.zeros((n, CELLS), bool)  # lock cells of distractor boxes
         # object slot of each cell; `slots` where there is none
         self.slot_of_cell = np.full((n, CELLS), slots, np.int64)
@@ -84,6 +97,7 @@ class BoxWorldState:
         self._alive_flat = self.object_alive.reshape(-1)
         self._base = rows * CELLS
         self._base3 = np.tile(self._base, 3)
+        self._rows3 = np.tile(rows, 3)
         self._obs_base3 = np.tile(rows * 3 * CELLS, 3)
         self._alive_base = rows * slots
         self.agent = np.zeros(n, np.int64)  # flat cell of the agent
@@ -112,7 +126,7 @@ class BoxWorldState:
         )
         grid.reshape(-1)[np.arange(m) * CELLS + levels.agent] = AGENT
         self.grid[rows] = grid
-        self.obs[rows] = PALETTE[grid].transpose(0, 2, 1)
+        self.obs[rows] = self._lut[grid].transpose(0, 2, 1)
         at = (rows * CELLS)[:, None] + cells
         self.distractor[rows] = False
         self._distractor_flat[at] = levels.distractor & real
@@ -189,12 +203,15 @@ class BoxWorldState:
         self.grid[:, 0] = held_code  # strided write
         changed = np.concatenate([old, emptied, new])  # (3n,) cells to repaint
         codes = grid[self._base3 + changed]
-        paint = self._obs_base3 + changed
-        obs = self._obs_flat
-        obs[paint] = _RED[codes]
-        obs[paint + CELLS] = _GREEN[codes]
-        obs[paint + 2 * CELLS] = _BLUE[codes]
-        self.obs[:, :, 0] = PALETTE[held_code]  # the held key's cell, a strided write
+        if self.obs_mode == "rgb":
+            paint = self._obs_base3 + changed
+            obs = self._obs_flat
+            obs[paint] = _RED[codes]
+            obs[paint + CELLS] = _GREEN[codes]
+            obs[paint + 2 * CELLS] = _BLUE[codes]
+        else:  # (3n, P) rows of planes; the later writes of a cell win, as above
+            self.obs[self._rows3, :, changed] = ONEHOT[codes]
+        self.obs[:, :, 0] = self._lut[held_code]  # the held key's cell, a strided write
         self.agent = new
         return reward, terminated, truncated
 
@@ -205,8 +222,8 @@ class BoxWorldState:
         return self.grid.reshape(self.n, GRID, GRID).copy()
 
     def observation(self) -> np.ndarray:
-        """(n, 3, 14, 14) uint8 RGB (a copy)."""
-        return self.obs.reshape(self.n, 3, GRID, GRID).copy()
+        """(n, P, 14, 14) uint8 RGB or one-hot planes (a copy)."""
+        return self.obs.reshape(self.n, self.planes, GRID, GRID).copy()
 
     def info(self) -> dict[str, np.ndarray]:
         """The batched info: arrays (copies) that ``decode_info`` turns into the single env's dict."""
