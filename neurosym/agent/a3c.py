@@ -1,4 +1,4 @@
-"""A3C: the n-step actor-critic update, a shared RMSprop, and the worker process.
+"""A3C: the actor-critic update, shared optimisers (Adam, RMSprop), and the worker process.
 
 Each of W worker processes steps K environments (K = 1 is the classic
 algorithm with one env per worker; the same batched env code runs it) for
@@ -14,11 +14,17 @@ transitions of the rollout (the autoreset steps of the batched env are masked
 out), summed over time and averaged over the K envs so that the gradient
 scale does not grow with K::
 
-    G_t = r_t + gamma * (0 if terminated_t else V(o_{t+1}) if truncated_t else G_{t+1})
-    loss = -sum log pi(a_t|o_t) (G_t - V(o_t)) + value_coef * sum 0.5 (G_t - V(o_t))^2
+    delta_t = s r_t + gamma * (0 if terminated_t else V(o_{t+1})) - V(o_t)
+    A_t = delta_t + gamma * lambda * (0 if the episode ended at t else A_{t+1})
+    loss = -sum log pi(a_t|o_t) A_t / rms(A) + value_coef * sum 0.5 (A_t)^2
            - entropy * sum H(pi(.|o_t))
 
-with G at the rollout's end bootstrapped from V of the last observation.
+with s = ``reward_scale``, the value regressed on A_t + V(o_t) (so the
+value loss is 0.5 A_t^2 with V(o_t) kept in the graph), V after the
+rollout's last step bootstrapping the tail, and rms(A) the worker's running
+root-mean-square of the advantages when ``normalize_advantages`` is on
+(:class:`AdvantageScale` says why not the usual per-batch normalisation). With lambda = 1, s = 1 and no normalisation this is Table 4's n-step
+A3C: A_t = G_t - V(o_t) with G_t the bootstrapped n-step return.
 Truncated episodes (time limit) bootstrap from V of their final observation.
 With ``config.sil > 0`` the self-imitation loss (:mod:`neurosym.agent.sil`)
 on a batch of M remembered transitions is added, scaled to T transitions.
@@ -40,6 +46,40 @@ from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
 from neurosym.agent.sil import EpisodeMemory, SILBatch, sil_loss
+
+
+class SharedAdam(torch.optim.Adam):
+    """Adam whose moment estimates are created eagerly and can live in shared memory.
+
+    The usual optimiser of A3C implementations (e.g. ikostrikov's pytorch-a3c):
+    its per-weight step is about ``lr`` whatever the gradient's size, so the
+    encoder and attention layers, whose gradients start 1e-8..1e-6, move as
+    fast as the policy head (bench/diagnose.py measured the sizes).
+    """
+
+    def __init__(self, params: Iterable[torch.nn.Parameter], lr: float, eps: float) -> None:
+        super().__init__(params, lr=lr, eps=eps, foreach=False)
+        self._init_state()
+
+    def _init_state(self) -> None:
+        for group in self.param_groups:
+            for p in group["params"]:
+                state = self.state[p]
+                if not state:
+                    state["step"] = torch.zeros(())
+                    state["exp_avg"] = torch.zeros_like(p, memory_format=torch.preserve_format)
+                    state["exp_avg_sq"] = torch.zeros_like(p, memory_format=torch.preserve_format)
+
+    def share_memory(self) -> SharedAdam:
+        """Move the statistics to shared memory (call again after load_state_dict)."""
+        for state in self.state.values():
+            for value in state.values():
+                value.share_memory_()
+        return self
+
+    def set_hyperparameters(self, lr: float, eps: float) -> None:
+        for group in self.param_groups:
+            group.update(lr=lr, eps=eps)
 
 
 class SharedRMSprop(torch.optim.RMSprop):
@@ -79,6 +119,24 @@ class SharedRMSprop(torch.optim.RMSprop):
             group.update(lr=lr, alpha=alpha, eps=eps)
 
 
+SharedOptimizer = SharedAdam | SharedRMSprop
+
+
+def shared_optimizer(params: Iterable[torch.nn.Parameter], config: TrainConfig) -> SharedOptimizer:
+    """The optimiser ``config.optimizer`` names, with its statistics created up front."""
+    if config.optimizer == "adam":
+        return SharedAdam(params, config.lr, config.adam_eps)
+    return SharedRMSprop(params, config.lr, config.rms_alpha, config.rms_eps)
+
+
+def set_optimizer_hyperparameters(optimizer: SharedOptimizer, config: TrainConfig) -> None:
+    """Apply ``config``'s settings after loading a state dict (which carries the old ones)."""
+    if isinstance(optimizer, SharedAdam):
+        optimizer.set_hyperparameters(config.lr, config.adam_eps)
+    else:
+        optimizer.set_hyperparameters(config.lr, config.rms_alpha, config.rms_eps)
+
+
 class LossStats(NamedTuple):
     """Per-update diagnostics (per env, summed over time)."""
 
@@ -106,17 +164,79 @@ def n_step_returns(
     return returns
 
 
+def gae_advantages(
+    rewards: torch.Tensor,
+    values: torch.Tensor,
+    terminated: torch.Tensor,
+    truncated: torch.Tensor,
+    next_values: torch.Tensor,
+    gamma: float,
+    lam: float,
+) -> torch.Tensor:
+    """(T, K) generalised advantage estimates; next_values[t] = V(o_{t+1}) (module docstring).
+
+    With ``lam = 1`` this is ``n_step_returns(...) - values``.
+    """
+    T = rewards.shape[0]
+    advantages = torch.empty_like(rewards)
+    A = torch.zeros_like(rewards[0])  # (K,) advantage after the rollout's last step
+    for t in range(T - 1, -1, -1):
+        bootstrap = torch.where(terminated[t], 0.0, next_values[t])
+        delta = rewards[t] + gamma * bootstrap - values[t]
+        ended = terminated[t] | truncated[t]
+        A = delta + gamma * lam * torch.where(ended, 0.0, A)
+        advantages[t] = A
+    return advantages
+
+
+class AdvantageScale:
+    """Divides advantages by a running root-mean-square of the advantages seen so far.
+
+    Why not the usual per-batch normalisation (subtract the mean, divide by the
+    std)? An A3C update sees one small rollout (K envs x 40 steps), and on
+    sparse-reward levels most rollouts hold no reward at all: their advantages
+    are the critic's small errors, and centring and scaling them per rollout
+    turns that noise into full-sized policy steps with a random sign (measured
+    on bw1: the policy drifted to a deterministic one whose success fell from
+    the random 20 % to 0.4 % within 500 k frames). A running RMS keeps each
+    advantage's sign and the rollouts' relative sizes, and still keeps the
+    actor's gradient independent of the rewards' scale.
+    """
+
+    def __init__(self, decay: float = 0.99) -> None:
+        self.decay = decay
+        self.mean_square: float | None = None
+
+    def __call__(self, advantages: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        n = float(mask.sum())
+        if n > 0:
+            batch = float((advantages.detach().pow(2) * mask).sum()) / n
+            if self.mean_square is None:
+                self.mean_square = batch
+            else:
+                self.mean_square = self.decay * self.mean_square + (1 - self.decay) * batch
+        rms = (self.mean_square or 0.0) ** 0.5
+        return advantages / (rms + 1e-8)
+
+
 def a3c_loss(
-    model: torch.nn.Module, rollout: Rollout, config: TrainConfig, sil_batch: SILBatch | None = None
+    model: torch.nn.Module,
+    rollout: Rollout,
+    config: TrainConfig,
+    sil_batch: SILBatch | None = None,
+    scale: AdvantageScale | None = None,
 ) -> tuple[torch.Tensor, LossStats]:
     """The scalar loss of one rollout (plus self-imitation on ``sil_batch``) and its parts.
+
+    With ``config.normalize_advantages`` the advantages are divided by
+    ``scale``'s running RMS (a worker keeps one; without it, this rollout's RMS).
 
     The model runs once over what it has not seen with a graph: the rollout's
     T * K observations (unless acting kept their graph), the last observation
     of each env and the self-imitation batch.
     """
     T, K = rollout.actions.shape
-    kept = rollout.logits is not None and rollout.values is not None
+    kept = rollout.logits is not None and rollout.logits.requires_grad
     parts = [] if kept else [rollout.obs.flatten(0, 1)]
     parts.append(rollout.last_obs)
     if sil_batch is not None:
@@ -129,16 +249,24 @@ def a3c_loss(
         logits = logits_all[:n].view(T, K, -1)  # (T, K, A)
         values = values_all[:n].view(T, K)  # (T, K)
     next_values = torch.cat([values[1:], values_all[n : n + K].unsqueeze(0)]).detach()  # (T, K)
-    returns = n_step_returns(
-        rollout.rewards, rollout.terminated, rollout.truncated, next_values, config.gamma
-    )
+    advantages = gae_advantages(
+        rollout.rewards * config.reward_scale,
+        values.detach(),
+        rollout.terminated,
+        rollout.truncated,
+        next_values,
+        config.gamma,
+        config.gae_lambda,
+    )  # (T, K)
+    returns = advantages + values.detach()  # (T, K) the value's targets
     mask = rollout.valid.to(torch.float32)  # (T, K)
     logp = F.log_softmax(logits, dim=-1)  # (T, K, A)
     logp_a = logp.gather(-1, rollout.actions.unsqueeze(-1)).squeeze(-1)  # (T, K)
     entropy = -(logp.exp() * logp).sum(-1)  # (T, K)
-    delta = returns - values  # (T, K)
-    policy_loss = -(logp_a * delta.detach() * mask).sum() / K
-    value_loss = 0.5 * (delta.pow(2) * mask).sum() / K
+    if config.normalize_advantages:
+        advantages = (scale or AdvantageScale())(advantages, mask)
+    policy_loss = -(logp_a * advantages * mask).sum() / K
+    value_loss = 0.5 * ((returns - values).pow(2) * mask).sum() / K
     entropy_sum = (entropy * mask).sum() / K
     loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
     if sil_batch is not None:
@@ -169,7 +297,7 @@ def apply_update(
 def worker(
     rank: int,
     shared: ActorCritic,
-    optimizer: SharedRMSprop,
+    optimizer: SharedOptimizer,
     model_config: ModelConfig,
     train_config: TrainConfig,
     env_name: str,
@@ -205,6 +333,7 @@ def worker(
         # rollout by 45 % (one worker), at K = 8 it was 4 % ahead (W = 2), at
         # K <= 4 it lost (K = 1: 456 against 676 frames/s, one worker)
         keep_graph = model_config.module == "mhdpa" and train_config.envs >= 8
+        scale = AdvantageScale()
         parent = os.getppid()
         while not stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
@@ -212,7 +341,7 @@ def worker(
                 local, state, train_config.n_steps, generator, bonus, memory, keep_graph
             )
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
-            loss, stats = a3c_loss(local, rollout, train_config, batch)
+            loss, stats = a3c_loss(local, rollout, train_config, batch, scale)
             norm = apply_update(local, shared, optimizer, loss, train_config.grad_clip)
             frames = int(rollout.valid.sum())
             queue.put(

@@ -1,8 +1,9 @@
-"""``neurosym train``: train a PrediNet or MHDPA agent with A3C.
+"""``neurosym train``: train a PrediNet or MHDPA agent with A3C (or PPO).
 
 A thin wrapper over :func:`neurosym.agent.trainer.train`. Unset options take
-the env family's defaults (``neurosym.agent.config``); with ``--resume`` they
-take the checkpoint's settings. The command line is stored in the checkpoint.
+the preset's defaults for the env family (``neurosym.agent.config``;
+``--preset thesis`` is Table 4 exactly); with ``--resume`` they take the
+checkpoint's settings. The command line is stored in the checkpoint.
 """
 
 from __future__ import annotations
@@ -30,6 +31,17 @@ _OVERRIDES = (
     ("--explore", "explore", "train"),
     ("--sil", "sil", "train"),
     ("--sil-episodes", "sil_episodes", "train"),
+    ("--optimizer", "optimizer", "train"),
+    ("--adam-eps", "adam_eps", "train"),
+    ("--reward-scale", "reward_scale", "train"),
+    ("--gae-lambda", "gae_lambda", "train"),
+    ("--normalize-advantages", "normalize_advantages", "train"),
+    ("--ppo-epochs", "ppo_epochs", "train"),
+    ("--ppo-minibatches", "ppo_minibatches", "train"),
+    ("--clip-range", "clip_range", "train"),
+    ("--attention-gain", "attention_gain", "model"),
+    ("--entity-norm", "entity_norm", "model"),
+    ("--init", "init", "model"),
     ("--heads", "heads", "model"),
     ("--key-size", "key_size", "model"),
     ("--relations", "relations", "model"),
@@ -52,6 +64,22 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--resume", action="store_true", help="continue the run in --out from its checkpoint"
     )
+    parser.add_argument(
+        "--algo",
+        choices=("a3c", "ppo"),
+        help="learner: a3c (asynchronous workers, default) or ppo (one synchronous learner)",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=("default", "thesis"),
+        default="default",
+        help="settings to start from: default (what learns best here) or thesis (Table 4 exactly)",
+    )
+    parser.add_argument(
+        "--tensorboard",
+        action="store_true",
+        help="also write TensorBoard event files to OUT/tensorboard",
+    )
     stop = parser.add_argument_group("stopping (any that is reached; none: run until Ctrl-C)")
     stop.add_argument(
         "--frames", type=int, help="total training frames (env steps), counting resumed ones"
@@ -61,12 +89,24 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--target-return", type=float, help="stop when the greedy policy's mean return reaches this"
     )
     a3c = parser.add_argument_group(
-        "A3C (defaults: the env family's, see neurosym/agent/config.py)"
+        "learner (defaults: the preset's for the env family, see neurosym/agent/config.py)"
     )
     a3c.add_argument("--workers", type=int, help="worker processes W (default: CPU cores)")
     a3c.add_argument("--envs", type=int, help="environments per worker K (1 = classic A3C)")
     a3c.add_argument("--seed", type=int, help="base seed (default 0)")
-    a3c.add_argument("--lr", type=float, help="RMSprop learning rate")
+    a3c.add_argument("--lr", type=float, help="learning rate")
+    a3c.add_argument("--optimizer", choices=("adam", "rmsprop"), help="shared optimiser")
+    a3c.add_argument("--adam-eps", type=float, help="Adam epsilon")
+    a3c.add_argument("--reward-scale", type=float, help="factor on rewards in the training signal")
+    a3c.add_argument("--gae-lambda", type=float, help="GAE lambda (1: n-step returns)")
+    a3c.add_argument(
+        "--normalize-advantages",
+        action=argparse.BooleanOptionalAction,
+        help="normalise each update's advantages",
+    )
+    a3c.add_argument("--ppo-epochs", type=int, help="PPO passes over each rollout")
+    a3c.add_argument("--ppo-minibatches", type=int, help="PPO minibatches per pass")
+    a3c.add_argument("--clip-range", type=float, help="PPO probability-ratio clip")
     a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
     a3c.add_argument("--gamma", type=float, help="discount")
     a3c.add_argument("--n-steps", type=int, help="rollout length per update (Table 4: 40)")
@@ -83,6 +123,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
     model.add_argument("--key-size", type=int, help="query/key size (32 RGW, 64 Box-World)")
     model.add_argument("--relations", type=int, help="PrediNet relations per head (8)")
     model.add_argument("--value-size", type=int, help="MHDPA value size (64)")
+    model.add_argument(
+        "--attention-gain", type=float, help="factor on the attention logits (default 8; thesis 1)"
+    )
+    model.add_argument(
+        "--entity-norm",
+        action=argparse.BooleanOptionalAction,
+        help="LayerNorm on the entities (default on; thesis off)",
+    )
+    model.add_argument(
+        "--init",
+        choices=("orthogonal", "torch"),
+        help="weight init of the MLP and heads (default orthogonal; thesis torch)",
+    )
     watch = parser.add_argument_group("watching")
     watch.add_argument(
         "--env-option",
@@ -134,6 +187,10 @@ def command_line(args: argparse.Namespace) -> str:
             parts += [flag, str(getattr(args, dest))]
     if args.resume:
         parts.append("--resume")
+    if args.algo is not None:
+        parts += ["--algo", args.algo]
+    if args.preset != "default":
+        parts += ["--preset", args.preset]
     for flag, dest in (
         ("--frames", "frames"),
         ("--minutes", "minutes"),
@@ -142,8 +199,11 @@ def command_line(args: argparse.Namespace) -> str:
         if getattr(args, dest) is not None:
             parts += [flag, str(getattr(args, dest))]
     for flag, dest, _ in _OVERRIDES:
-        if getattr(args, dest) is not None:
-            parts += [flag, str(getattr(args, dest))]
+        value = getattr(args, dest)
+        if isinstance(value, bool):
+            parts.append(flag if value else "--no-" + flag[2:])
+        elif value is not None:
+            parts += [flag, str(value)]
     for item in args.env_option:
         parts += ["--env-option", item]
     for flag, dest, default in (
@@ -156,6 +216,8 @@ def command_line(args: argparse.Namespace) -> str:
             parts += [flag, str(getattr(args, dest))]
     if args.slim:
         parts.append("--slim")
+    if args.tensorboard:
+        parts.append("--tensorboard")
     return shlex.join(parts)
 
 
@@ -165,7 +227,7 @@ def run(args: argparse.Namespace) -> int:
     overrides: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
     for _, dest, kind in _OVERRIDES:
         overrides[kind][dest] = getattr(args, dest)
-    if overrides["train"]["workers"] is None and not args.resume:
+    if overrides["train"]["workers"] is None and not args.resume and args.algo != "ppo":
         overrides["train"]["workers"] = os.cpu_count() or 1
     options = RunOptions(
         frames=args.frames,
@@ -177,6 +239,7 @@ def run(args: argparse.Namespace) -> int:
         window=args.window,
         slim=args.slim,
         progress=not args.quiet,
+        tensorboard=args.tensorboard,
     )
     result = train(
         args.env,
@@ -189,5 +252,7 @@ def run(args: argparse.Namespace) -> int:
         resume=args.resume,
         command=command_line(args),
         print_fn=print,
+        preset=args.preset,
+        algo=args.algo,
     )
     return 130 if result.stop_reason == "interrupted" else 0

@@ -9,9 +9,24 @@ entropy 0.01 BW / 0.02 RGW. Two notes on the table:
   we follow the table (``relations=8``), ``--relations 4`` gives the text's value.
 * The discount gamma is not in the thesis; we use 0.99.
 
+Presets. ``preset="thesis"`` (``neurosym train --preset thesis``) is Table 4
+exactly: RMSprop (lr as above, epsilon 0.1, decay 0.99), gradient clip 400,
+classic A3C (one env per worker), the network as first built (no entity
+normalisation), raw rewards, unnormalised advantages, n-step returns, and the
+RGB Box-World observation. ``preset="default"`` is what learns best here,
+measured with ``bench/diagnose.py`` (the fresh network's input signal and
+gradient split) and ``bench/train.py``; each departure from Table 4 says why
+at its field. In short: the thesis network is blind at initialisation (policy
+logits varied by 6e-9 across bw1 observations, PrediNet attention exactly
+uniform), its per-weight gradients (1e-8 to 4e-7) sit far below RMSprop's
+epsilon, and the critic's gradient on the shared layers was 100-200x the
+actor's; the default preset fixes each of these.
+
 Both configs are plain frozen dataclasses that round-trip through
 ``to_dict``/``from_dict`` (plain ints, floats, strings and lists only), which is
-how checkpoints store them.
+how checkpoints store them. A key missing from a stored config predates that
+setting: ``from_dict`` fills it with the value the code had before the setting
+existed (``_LEGACY``), so older checkpoints load and replay as they were made.
 """
 
 from __future__ import annotations
@@ -23,21 +38,74 @@ from neurosym.errors import ConfigError
 
 MODULES = ("predinet", "mhdpa")
 FAMILIES = ("rgw", "boxworld")
+PRESETS = ("default", "thesis")
+ALGOS = ("a3c", "ppo")
+OPTIMIZERS = ("adam", "rmsprop")
+INITS = ("orthogonal", "torch")
 
 # Table 4 values that differ by env family.
 _MODEL_FAMILY: dict[str, dict[str, Any]] = {
     "rgw": {"key_size": 32},
     "boxworld": {"key_size": 64},
 }
-_TRAIN_FAMILY: dict[str, dict[str, Any]] = {
-    "rgw": {"lr": 2e-3, "entropy": 0.02, "gamma": 0.95, "explore": 0.2, "sil": 1.0},
+# Table 4 exactly (preset "thesis"): classic A3C, RMSprop with epsilon 0.1.
+_THESIS_TRAIN: dict[str, dict[str, Any]] = {
+    "rgw": {"lr": 2e-3, "entropy": 0.02},
     "boxworld": {"lr": 2e-4, "entropy": 0.01},
+}
+_THESIS_COMMON: dict[str, Any] = {
+    "optimizer": "rmsprop",
+    "rms_eps": 0.1,
+    "grad_clip": 400.0,
+    "envs": 1,
+    "gamma": 0.99,
+    "reward_scale": 1.0,
+    "normalize_advantages": False,
+    "gae_lambda": 1.0,
+}
+# What learns best here (preset "default"); each value's reason is at its field.
+_DEFAULT_TRAIN: dict[str, dict[str, Any]] = {
+    # RGW keeps its measured exploration aids: the +10 terminal sits behind a
+    # teleport reached across a mountain (random actions reach it in ~0.2 %).
+    "rgw": {"lr": 1e-3, "entropy": 0.02, "gamma": 0.95, "explore": 0.2, "sil": 1.0},
+    # rewards x 0.1: the +11 gem otherwise makes the critic's loss (and its pull on the
+    # shared layers) a hundred times the actor's
+    "boxworld": {"lr": 1e-3, "entropy": 0.01, "reward_scale": 0.1},
+}
+_PPO_TRAIN: dict[str, Any] = {"envs": 64, "n_steps": 128, "workers": 1, "lr": 5e-4}
+_DEFAULT_MODEL: dict[str, Any] = {"entity_norm": True, "attention_gain": 8.0, "init": "orthogonal"}
+_THESIS_MODEL: dict[str, Any] = {"entity_norm": False, "attention_gain": 1.0, "init": "torch"}
+_LEGACY: dict[str, dict[str, Any]] = {
+    # what the code did before each setting existed (checkpoints without the key)
+    "ModelConfig": {"entity_norm": False, "attention_gain": 1.0, "init": "torch"},
+    "TrainConfig": {
+        "algo": "a3c",
+        "optimizer": "rmsprop",
+        "reward_scale": 1.0,
+        "normalize_advantages": False,
+        "gae_lambda": 1.0,
+        "preset": "legacy",
+    },
 }
 
 
 def _check_family(family: str) -> None:
     if family not in FAMILIES:
         raise ConfigError(f"unknown env family {family!r}; expected one of {', '.join(FAMILIES)}")
+
+
+def _check_preset(preset: str) -> None:
+    if preset not in PRESETS:
+        raise ConfigError(f"unknown preset {preset!r}; expected one of {', '.join(PRESETS)}")
+
+
+def preset_env_kwargs(family: str, preset: str = "default") -> dict[str, Any]:
+    """Env options a preset trains with: Box-World's one-hot observation by default, RGB for the thesis."""
+    _check_family(family)
+    _check_preset(preset)
+    if family == "boxworld":
+        return {"obs_mode": "rgb" if preset == "thesis" else "onehot"}
+    return {}
 
 
 @dataclass(frozen=True)
@@ -68,6 +136,24 @@ class ModelConfig:
     """actor-critic MLP widths (Table 4: 256, 128, 64)"""
     n_actions: int = 4
     """policy outputs (up, right, down, left)"""
+    entity_norm: bool = True
+    """LayerNorm over each entity's conv features (not its coordinates) before the relational
+    module. Without it (Table 4's network) the entities are small and alike at initialisation:
+    PrediNet's attention is exactly uniform and the logits barely vary across observations
+    (bench/diagnose.py)."""
+    attention_gain: float = 8.0
+    """factor on the attention logits (softmax(gain * Q K^T / sqrt(d))). At 1 (Table 4's network)
+    the fresh attention is uniform to within 1.3x on bw1 (max weight 0.0063 against 1/196), so
+    every head attends to the mean entity and PrediNet's D is 0; at 8 the largest weight is
+    5x uniform (entropy 96 % of uniform's), so heads start out looking at something"""
+    init: str = "orthogonal"
+    """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
+    (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
+    (PyTorch's default, Table 4's network). torch's default shrinks a signal's spread by about
+    0.4 per layer, so after the five layers behind the relational module the value varied by
+    2.5e-7 across bw1 observations; orthogonal init with the entity norm and attention gain
+    gives 3.7e-3 (bench/diagnose.py). The policy head starts at gain 0.01 either way (a near
+    uniform first policy)."""
 
     def __post_init__(self) -> None:
         if self.module not in MODULES:
@@ -98,6 +184,10 @@ class ModelConfig:
             raise ConfigError("conv_channels and hidden_sizes must be positive")
         if not self.obs_scale > 0:
             raise ConfigError(f"obs_scale must be positive, got {self.obs_scale}")
+        if self.init not in INITS:
+            raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
+        if not self.attention_gain > 0:
+            raise ConfigError(f"attention_gain must be positive, got {self.attention_gain}")
 
     @property
     def n_entities(self) -> int:
@@ -116,11 +206,18 @@ class ModelConfig:
         module: str,
         obs_shape: tuple[int, int, int],
         obs_scale: float = 1.0,
+        preset: str = "default",
         **overrides: Any,
     ) -> ModelConfig:
-        """Table 4 defaults for an env family ("rgw" or "boxworld"), then ``overrides``."""
+        """Table 4 sizes for an env family ("rgw" or "boxworld"), the preset's switches, then ``overrides``."""
         _check_family(family)
-        values = {**_MODEL_FAMILY[family], **{k: v for k, v in overrides.items() if v is not None}}
+        _check_preset(preset)
+        switches = _THESIS_MODEL if preset == "thesis" else _DEFAULT_MODEL
+        values = {
+            **_MODEL_FAMILY[family],
+            **switches,
+            **{k: v for k, v in overrides.items() if v is not None},
+        }
         return cls(module=module, obs_shape=obs_shape, obs_scale=obs_scale, **values)
 
     def to_dict(self) -> dict[str, Any]:
@@ -135,10 +232,18 @@ class ModelConfig:
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """A3C settings. Defaults are Table 4's where it has them; see ``for_family``."""
+    """Learner settings (A3C or PPO). ``for_family`` gives a preset's values per env family."""
 
-    lr: float = 2e-3
-    """RMSprop learning rate (Table 4: 2e-3 RGW, 2e-4 BW)"""
+    algo: str = "a3c"
+    """learner: "a3c" (asynchronous workers, the mission's algorithm) or "ppo" (synchronous)"""
+    preset: str = "default"
+    """the preset these settings started from ("default", "thesis"), recorded for the reader"""
+    optimizer: str = "adam"
+    """"adam" (shared statistics) or "rmsprop" (Table 4). Adam's per-weight step is about lr
+    whatever the gradient's size; RMSprop with Table 4's epsilon 0.1 divided gradients of
+    1e-8..4e-7 (encoder, queries, keys at initialisation) by ~0.3 and left those layers still"""
+    lr: float = 1e-3
+    """learning rate (Table 4, RMSprop: 2e-3 RGW, 2e-4 BW)"""
     entropy: float = 0.02
     """entropy bonus weight (Table 4: 0.02 RGW, 0.01 BW)"""
     gamma: float = 0.99
@@ -157,10 +262,27 @@ class TrainConfig:
     """best episodes each worker keeps for self-imitation"""
     rms_eps: float = 1e-5
     """RMSprop epsilon (Table 4: 0.1, which stalls learning here; see the module docstring)"""
+    adam_eps: float = 1e-5
+    """Adam epsilon"""
+    reward_scale: float = 1.0
+    """factor on the env's rewards in the training signal (reported returns stay the env's)"""
+    normalize_advantages: bool = True
+    """scale each update's advantages to zero mean and unit variance: the actor's gradient then
+    no longer grows with the rewards' size, and the critic stops drowning it on the shared
+    layers (measured 100-200x on a bw1 rollout with one +11 gem)"""
+    gae_lambda: float = 0.95
+    """GAE lambda for the advantages (1.0 = the n-step returns of Table 4's A3C)"""
+    ppo_epochs: int = 4
+    """PPO: passes over each rollout"""
+    ppo_minibatches: int = 4
+    """PPO: minibatches per pass"""
+    clip_range: float = 0.2
+    """PPO: probability-ratio clip"""
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""
-    grad_clip: float = 400.0
-    """global gradient-norm clip (Table 4: 400)"""
+    grad_clip: float = 0.5
+    """global gradient-norm clip (Table 4: 400, which never bites; 0.5 as in common A2C/PPO code
+    keeps one rollout with a rare large reward from throwing the shared weights far)"""
     workers: int = 2
     """worker processes W"""
     envs: int = 8
@@ -169,22 +291,55 @@ class TrainConfig:
     """base seed; worker w uses seed + 1000 * w"""
 
     def __post_init__(self) -> None:
-        for name in ("lr", "gamma", "rms_eps", "rms_alpha", "grad_clip", "explore_half_life"):
+        for name, allowed in (("algo", ALGOS), ("optimizer", OPTIMIZERS)):
+            if getattr(self, name) not in allowed:
+                raise ConfigError(
+                    f"unknown {name} {getattr(self, name)!r}; expected one of {', '.join(allowed)}"
+                )
+        for name in (
+            "lr",
+            "gamma",
+            "rms_eps",
+            "adam_eps",
+            "rms_alpha",
+            "grad_clip",
+            "explore_half_life",
+            "reward_scale",
+            "clip_range",
+        ):
             if not float(getattr(self, name)) > 0:
                 raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
         if not 0 < self.gamma <= 1 or not 0 < self.rms_alpha < 1:
             raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
+        if not 0 <= self.gae_lambda <= 1:
+            raise ConfigError(f"gae_lambda must be in [0, 1], got {self.gae_lambda}")
         if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
             raise ConfigError("entropy, value_coef, explore and sil must be >= 0")
-        for name in ("n_steps", "workers", "envs", "sil_episodes"):
+        for name in ("n_steps", "workers", "envs", "sil_episodes", "ppo_epochs", "ppo_minibatches"):
             if int(getattr(self, name)) < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {getattr(self, name)}")
 
     @classmethod
-    def for_family(cls, family: str, **overrides: Any) -> TrainConfig:
-        """Table 4 defaults for an env family, then the overrides that are not None."""
+    def for_family(
+        cls, family: str, preset: str = "default", algo: str = "a3c", **overrides: Any
+    ) -> TrainConfig:
+        """A preset's settings for an env family and learner, then the overrides that are not None."""
         _check_family(family)
-        values = {**_TRAIN_FAMILY[family], **{k: v for k, v in overrides.items() if v is not None}}
+        _check_preset(preset)
+        if preset == "thesis":
+            if algo != "a3c":
+                raise ConfigError("--preset thesis is A3C (Table 4); it has no PPO settings")
+            base = {**_THESIS_COMMON, **_THESIS_TRAIN[family]}
+        else:
+            base = dict(_DEFAULT_TRAIN[family])
+            if algo == "ppo":  # no exploration aids: PPO is the plain comparison point
+                base = {**base, "explore": 0.0, "sil": 0.0, **_PPO_TRAIN}
+        values = {
+            **base,
+            "preset": preset,
+            "algo": algo,
+            **{k: v for k, v in overrides.items() if v is not None},
+        }
         return cls(**values)
 
     def replace(self, **changes: Any) -> TrainConfig:
@@ -206,7 +361,8 @@ def _from_dict(cls: Any, data: dict[str, Any]) -> Any:
     unknown = sorted(set(data) - names)
     if unknown:
         raise ConfigError(f"unknown {cls.__name__} keys: {', '.join(unknown)}")
+    legacy = {k: v for k, v in _LEGACY.get(cls.__name__, {}).items() if k not in data}
     try:
-        return cls(**data)
+        return cls(**legacy, **data)
     except TypeError as exc:
         raise ConfigError(f"bad {cls.__name__}: {exc}") from None

@@ -6,6 +6,12 @@ bottom and the second pads left and top: the map keeps the grid's shape and
 entity k (cell k, row-major) sees the 3 x 3 neighbourhood centred on its own
 cell (for kernel 2). Two coordinate channels (row, col scaled to [0, 1]) are
 appended last, so an entity has ``channels[-1] + 2`` features (26 by default).
+
+``norm=True`` (ModelConfig.entity_norm) puts a LayerNorm over each entity's
+conv features (not its coordinates). Table 4's network has none, and on
+Box-World's RGB input its entities start small and alike, so that the
+relational module's attention starts uniform and the policy blind
+(bench/diagnose.py measures both).
 """
 
 from __future__ import annotations
@@ -36,7 +42,13 @@ class Encoder(nn.Module):
     """(B, C, H, W) float -> (B, H * W, channels[-1] + 2) entities."""
 
     def __init__(
-        self, in_channels: int, height: int, width: int, channels: tuple[int, ...], kernel: int
+        self,
+        in_channels: int,
+        height: int,
+        width: int,
+        channels: tuple[int, ...],
+        kernel: int,
+        norm: bool = False,
     ) -> None:
         super().__init__()
         sizes = (in_channels, *channels)
@@ -45,6 +57,7 @@ class Encoder(nn.Module):
         )
         self.pads = [_pads(kernel, i) for i in range(len(channels))]
         self.register_buffer("coords", coordinates(height, width), persistent=False)
+        self.norm = nn.LayerNorm(channels[-1]) if norm else None
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         # channels-last: oneDNN's convolutions run a third faster forward and
@@ -54,5 +67,7 @@ class Encoder(nn.Module):
             x = F.relu(conv(F.pad(x, pad)))  # (B, c, H, W)
         B, C, H, W = x.shape
         entities = x.permute(0, 2, 3, 1).reshape(B, H * W, C)  # (B, N, C), cell k row-major
+        if self.norm is not None:
+            entities = self.norm(entities)  # (B, N, C) zero mean, unit variance per entity
         coords = self.coords.expand(B, H * W, 2)  # (B, N, 2)
         return torch.cat([entities, coords], dim=-1)  # (B, N, C + 2)

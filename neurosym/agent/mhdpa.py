@@ -38,7 +38,13 @@ class MHDPA(nn.Module):
     """(B, N, F) entities -> (B, output_size), optionally with the attention weights."""
 
     def __init__(
-        self, entity_size: int, heads: int, key_size: int, value_size: int, output_size: int
+        self,
+        entity_size: int,
+        heads: int,
+        key_size: int,
+        value_size: int,
+        output_size: int,
+        attention_gain: float = 1.0,
     ) -> None:
         super().__init__()
         self.heads, self.key_size, self.value_size = heads, key_size, value_size
@@ -54,7 +60,7 @@ class MHDPA(nn.Module):
         self.out = (
             nn.Identity() if output_size == entity_size else nn.Linear(entity_size, output_size)
         )
-        self.scale = 1.0 / math.sqrt(key_size)
+        self.scale = attention_gain / math.sqrt(key_size)
 
     def folded_weights(self) -> tuple[torch.Tensor, torch.Tensor]:
         """(F, H * F) W_Q^h W_K^h^T * scale and (F, H * F) W_V^h W_O^h, heads side by side."""

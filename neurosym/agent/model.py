@@ -3,10 +3,15 @@
 Table 4: the relational module's 26-wide output goes through 26 -> 256 -> 128
 -> 64 (ReLU) and then two linear heads, 4 policy logits and 1 value. The
 policy head starts with small weights (std 0.01 orthogonal) so the initial
-policy is close to uniform, which is what exploration on RGW needs.
+policy is close to uniform, which is what exploration on RGW needs. With
+``config.init == "orthogonal"`` the MLP (gain sqrt 2), the value head and
+PrediNet's read-out (gain 1) start orthogonal too, so that the value and the
+policy's hidden features vary with the observation from the first update.
 """
 
 from __future__ import annotations
+
+import math
 
 import torch
 from torch import nn
@@ -29,9 +34,15 @@ def build_relational(config: ModelConfig) -> nn.Module:
             config.key_size,
             config.relations,
             config.output_size,
+            config.attention_gain,
         )
     return MHDPA(
-        config.entity_size, config.heads, config.key_size, config.value_size, config.output_size
+        config.entity_size,
+        config.heads,
+        config.key_size,
+        config.value_size,
+        config.output_size,
+        config.attention_gain,
     )
 
 
@@ -42,7 +53,9 @@ class ActorCritic(nn.Module):
         super().__init__()
         self.config = config
         C, H, W = config.obs_shape
-        self.encoder = Encoder(C, H, W, config.conv_channels, config.kernel_size)
+        self.encoder = Encoder(
+            C, H, W, config.conv_channels, config.kernel_size, norm=config.entity_norm
+        )
         self.relational = build_relational(config)
         layers: list[nn.Module] = []
         width = config.output_size
@@ -54,6 +67,20 @@ class ActorCritic(nn.Module):
         self.value = nn.Linear(width, 1)
         nn.init.orthogonal_(self.policy.weight, gain=0.01)
         nn.init.zeros_(self.policy.bias)
+        if config.init == "orthogonal":
+            self._orthogonal_init()
+
+    def _orthogonal_init(self) -> None:
+        """CleanRL/SB3's layer init: keeps a signal's spread through the ReLU layers."""
+        for layer in self.body:
+            if isinstance(layer, nn.Linear):
+                nn.init.orthogonal_(layer.weight, gain=math.sqrt(2))
+                nn.init.zeros_(layer.bias)
+        readout = getattr(self.relational, "out", None)
+        for layer in (self.value, readout):
+            if isinstance(layer, nn.Linear):
+                nn.init.orthogonal_(layer.weight, gain=1.0)
+                nn.init.zeros_(layer.bias)
 
     def forward(
         self, obs: torch.Tensor, introspect: bool = False

@@ -12,9 +12,10 @@ With L the (B, N, F) entities (F = features + 2 coordinates):
 
 Choices made here (DESIGN.md leaves them open):
 
-* The 1/sqrt(d) in the softmax is the usual attention temperature. It is the
-  same function class as DESIGN's softmax(Q K^T) (W_Q absorbs the factor) and
-  only makes the initial attention softer.
+* The 1/sqrt(d) in the softmax is the usual attention temperature, times
+  ``attention_gain`` (ModelConfig; 1 in Table 4's network). It is the same
+  function class as DESIGN's softmax(Q K^T) (W_Q absorbs the factor); it only
+  sets how peaked the attention is at initialisation (uniform at gain 1).
 * W_S reads the feature channels of E1 and E2, not their two coordinate
   channels: as in the thesis (section 3.2.4), D carries no position
   information; the positions are in R as pos(E1), pos(E2). D is computed as
@@ -60,6 +61,7 @@ class PrediNet(nn.Module):
         key_size: int,
         relations: int,
         output_size: int,
+        attention_gain: float = 1.0,
     ) -> None:
         super().__init__()
         assert entity_size > 2, "entities need features besides the 2 coordinates"
@@ -71,7 +73,7 @@ class PrediNet(nn.Module):
         self.query2 = nn.Linear(n_entities * entity_size, heads * key_size, bias=False)  # W_Q2^h
         self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
         self.out = nn.Linear(heads * (relations + 4), output_size)
-        self.scale = 1.0 / math.sqrt(key_size)
+        self.scale = attention_gain / math.sqrt(key_size)
 
     def forward(self, L: torch.Tensor, introspect: bool = False):
         B, N, F = L.shape

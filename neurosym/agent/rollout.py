@@ -111,9 +111,10 @@ class Rollout(NamedTuple):
     valid: torch.Tensor
     """False for the autoreset steps that are not transitions"""
     logits: torch.Tensor | None = None
-    """(T, K, A) with the model's graph, when acting kept it (else the update recomputes)"""
+    """(T, K, A) the acting logits: with the model's graph when acting kept it (A3C), without
+    when only recorded (PPO's behaviour policy); None when neither (the update recomputes)"""
     values: torch.Tensor | None = None
-    """(T, K) with the model's graph, likewise"""
+    """(T, K) the acting values, likewise"""
 
 
 class RolloutState:
@@ -134,6 +135,7 @@ def collect_rollout(
     bonus: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
     memory: Any | None = None,
     keep_graph: bool = False,
+    record: bool = False,
 ) -> tuple[Rollout, Finished]:
     """Act ``n_steps`` steps in every sub-env with sampled actions.
 
@@ -146,7 +148,8 @@ def collect_rollout(
     ``bonus(next_obs, valid) -> (K,)`` adds an intrinsic reward to the
     rollout's rewards (the training signal); the finished episodes' returns
     are the environment's own. ``memory`` (an ``sil.EpisodeMemory``) is fed
-    every transition, with the environment's rewards.
+    every transition, with the environment's rewards. ``record`` keeps the
+    acting logits and values without a graph (PPO's behaviour policy).
     """
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
@@ -155,7 +158,7 @@ def collect_rollout(
     for _ in range(n_steps):
         with torch.set_grad_enabled(keep_graph):
             logits, value = model(torch.from_numpy(state.obs))  # (K, A), (K,)
-        if keep_graph:
+        if keep_graph or record:
             logits_t.append(logits)
             values_t.append(value)
         actions = select_actions(logits, greedy=False, generator=generator).numpy()
@@ -181,8 +184,8 @@ def collect_rollout(
         terminated=torch.from_numpy(np.stack(terms)),
         truncated=torch.from_numpy(np.stack(truncs)),
         valid=torch.from_numpy(np.stack(valids)),
-        logits=torch.stack(logits_t) if keep_graph else None,
-        values=torch.stack(values_t) if keep_graph else None,
+        logits=torch.stack(logits_t) if logits_t else None,
+        values=torch.stack(values_t) if values_t else None,
     )
     return rollout, finished
 

@@ -1,4 +1,9 @@
-"""The training run: start the A3C workers, watch them, evaluate, checkpoint, stop.
+"""The training run: start the learner processes, watch them, evaluate, checkpoint, stop.
+
+The learners are the A3C workers (:func:`neurosym.agent.a3c.worker`, W of
+them) or one PPO learner (:func:`neurosym.agent.ppo.ppo_learner`); both write
+into one shared model and report through one queue, so everything below is
+the same for both.
 
 :func:`train` is the plain function behind ``neurosym train``. The parent
 process owns everything the user sees: the progress bar, ``metrics.csv``,
@@ -34,9 +39,9 @@ import numpy as np
 import torch
 import torch.multiprocessing as mp
 
-from neurosym.agent.a3c import SharedRMSprop, worker
+from neurosym.agent.a3c import set_optimizer_hyperparameters, shared_optimizer, worker
 from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpoint
-from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, play_episodes, select_actions
 from neurosym.errors import CheckpointError, ConfigError
@@ -86,6 +91,8 @@ class RunOptions:
     """leave the optimizer state out of checkpoints"""
     progress: bool = True
     """show a rich progress bar on stderr"""
+    tensorboard: bool = False
+    """also write the metrics as TensorBoard event files under ``out/tensorboard``"""
 
     def __post_init__(self) -> None:
         if self.frames is not None and self.frames < 1:
@@ -166,6 +173,45 @@ def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
     with os.fdopen(fd, "w") as fh:
         fh.write(buf.getvalue())
     os.replace(tmp, path)
+
+
+class _TensorBoard:
+    """The metrics rows as TensorBoard scalars against frames, namespaced as SB3/CleanRL do.
+
+    torch's own ``SummaryWriter`` (the ``tensorboard`` package writes the files).
+    Tags: ``charts/*`` for returns, success and speed, ``losses/*`` for the
+    learner's loss parts.
+    """
+
+    TAGS = {
+        "mean_return": "charts/episodic_return",
+        "success_rate": "charts/success_rate",
+        "mean_length": "charts/episodic_length",
+        "greedy_return": "charts/greedy_return",
+        "greedy_success": "charts/greedy_success",
+        "fps": "charts/fps",
+        "episodes": "charts/episodes",
+        "policy_loss": "losses/policy_loss",
+        "value_loss": "losses/value_loss",
+        "entropy": "losses/entropy",
+        "grad_norm": "losses/grad_norm",
+    }
+
+    def __init__(self, directory: Path) -> None:
+        from torch.utils.tensorboard import SummaryWriter
+
+        self.writer = SummaryWriter(log_dir=str(directory))
+
+    def add(self, row: dict[str, Any]) -> None:
+        step = int(row["frames"])
+        for column, tag in self.TAGS.items():
+            text = str(row.get(column, ""))
+            if text:
+                self.writer.add_scalar(tag, float(text), step)
+        self.writer.flush()
+
+    def close(self) -> None:
+        self.writer.close()
 
 
 def _fmt(value: float | None, spec: str = ".3f") -> str:
@@ -279,11 +325,15 @@ def train(
     resume: bool = False,
     command: str = "",
     print_fn: Callable[[str], None] | None = None,
+    preset: str = "default",
+    algo: str | None = None,
 ) -> TrainResult:
-    """Train an agent with A3C into ``out`` (``checkpoint.pt``, ``metrics.csv``).
+    """Train an agent with A3C or PPO into ``out`` (``checkpoint.pt``, ``metrics.csv``).
 
     ``train_overrides`` / ``model_overrides``: TrainConfig / ModelConfig fields
-    to change from the family defaults (None values are ignored). With
+    to change from the preset's family defaults (None values are ignored);
+    ``env_kwargs`` are added to the preset's env options (Box-World: one-hot
+    observation by default). ``algo``: "a3c" (default) or "ppo". With
     ``resume`` the run continues ``out/checkpoint.pt``: its model and settings,
     unless overridden (a model override that differs is an error), its frame
     and episode counts, its metrics rows.
@@ -316,6 +366,10 @@ def train(
             )
         base = payload.get("train_config") or TrainConfig.for_family(family).to_dict()
         train_config = TrainConfig.from_dict(base).replace(**train_overrides)
+        if algo is not None and algo != train_config.algo:
+            raise CheckpointError(
+                f"{ckpt_path} was trained with --algo {train_config.algo}; resume it with that"
+            )
         frames0, episodes0 = int(payload["frames"]), int(payload["episodes"])
         wall0 = float(payload["metrics"].get("wall_s", 0.0))
     else:
@@ -325,10 +379,18 @@ def train(
             raise ConfigError(
                 f"{ckpt_path} already exists; pass --resume to continue it or choose another --out"
             )
-        kwargs = dict(env_kwargs or {})
+        from neurosym.envs import env_family
+
+        kwargs = {**preset_env_kwargs(env_family(env), preset), **(env_kwargs or {})}
         name, family, shape, scale = probe_env(env, kwargs)
-        model_config = ModelConfig.for_family(family, module, shape, scale, **model_overrides)
-        train_config = TrainConfig.for_family(family, **train_overrides)
+        model_config = ModelConfig.for_family(
+            family, module, shape, scale, preset=preset, **model_overrides
+        )
+        train_config = TrainConfig.for_family(
+            family, preset=preset, algo=algo or "a3c", **train_overrides
+        )
+        if train_config.algo == "ppo" and train_config.sil > 0:
+            raise ConfigError("--sil is A3C's self-imitation; PPO has none (use --sil 0)")
         frames0 = episodes0 = 0
         wall0 = 0.0
     if options.frames is not None and options.frames <= frames0:
@@ -340,9 +402,8 @@ def train(
     torch.manual_seed(train_config.seed)
     shared = ActorCritic(model_config) if payload is None else build_model(payload, ckpt_path)
     shared.share_memory()
-    optimizer = SharedRMSprop(
-        shared.parameters(), train_config.lr, train_config.rms_alpha, train_config.rms_eps
-    )
+    optimizer = shared_optimizer(shared.parameters(), train_config)
+    learners = 1 if train_config.algo == "ppo" else train_config.workers
     if payload is not None and payload.get("optimizer"):
         try:
             optimizer.load_state_dict(payload["optimizer"])
@@ -351,10 +412,18 @@ def train(
                 f"{ckpt_path}: its optimizer state does not fit the model ({exc})"
             ) from None
         optimizer._init_state()
-        optimizer.set_hyperparameters(train_config.lr, train_config.rms_alpha, train_config.rms_eps)
+        set_optimizer_hyperparameters(optimizer, train_config)
     optimizer.share_memory()
 
     rows: list[dict[str, Any]] = _read_rows(out / METRICS_NAME) if resume else []
+    board = _TensorBoard(out / "tensorboard") if options.tensorboard else None
+
+    def log_row(row: dict[str, Any]) -> None:
+        rows.append(row)
+        _write_rows(out / METRICS_NAME, rows)
+        if board is not None:
+            board.add(row)
+
     stats = _Stats(frames0, episodes0, options.window)
     eval_model = ActorCritic(model_config)
     eval_model.eval()
@@ -390,8 +459,12 @@ def train(
     messages = ctx.Queue()
     procs = []
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # children start with Ctrl-C ignored
+    if train_config.algo == "ppo":
+        from neurosym.agent.ppo import ppo_learner as learner
+    else:
+        learner = worker
     try:
-        for rank in range(train_config.workers):
+        for rank in range(learners):
             seed = _env_seed(train_config.seed, rank, frames0)
             args = (
                 rank,
@@ -405,7 +478,9 @@ def train(
                 stop,
                 messages,
             )
-            proc = ctx.Process(target=worker, args=args, daemon=True, name=f"neurosym-a3c-{rank}")
+            proc = ctx.Process(
+                target=learner, args=args, daemon=True, name=f"neurosym-{train_config.algo}-{rank}"
+            )
             proc.start()
             procs.append(proc)
     finally:
@@ -491,8 +566,7 @@ def train(
                 now = time.monotonic()
                 if now - last_log >= options.log_interval or stop_reason:
                     fps = (stats.frames - last_frames) / max(now - last_log, 1e-9)
-                    rows.append(stats.row(wall0 + now - start, fps, greedy, greedy_success))
-                    _write_rows(out / METRICS_NAME, rows)
+                    log_row(stats.row(wall0 + now - start, fps, greedy, greedy_success))
                     last_log, last_frames = now, stats.frames
                     progress.update(
                         task,
@@ -541,8 +615,9 @@ def train(
         not rows or int(rows[-1]["frames"]) != stats.frames
     ):  # what arrived while the workers stopped
         fps = (stats.frames - last_frames) / max(time.monotonic() - last_log, 1e-9)
-        rows.append(stats.row(wall, fps, greedy, greedy_success))
-        _write_rows(out / METRICS_NAME, rows)
+        log_row(stats.row(wall, fps, greedy, greedy_success))
+    if board is not None:
+        board.close()
     summary = {
         "wall_s": round(wall, 2),
         "stop_reason": stop_reason,
