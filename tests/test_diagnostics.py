@@ -25,7 +25,11 @@ def test_default_model_sees_bw1_and_thesis_model_is_blind(bw1_obs, module: str) 
     for preset, obs in bw1_obs.items():
         torch.manual_seed(0)
         config = ModelConfig.for_family(
-            "boxworld", module, obs.shape[1:], 1.0 if preset == "default" else 1 / 255, preset=preset
+            "boxworld",
+            module,
+            obs.shape[1:],
+            1.0 if preset == "default" else 1 / 255,
+            preset=preset,
         )
         figures[preset] = input_signal(ActorCritic(config), obs)
     default, thesis = figures["default"], figures["thesis"]

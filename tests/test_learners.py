@@ -6,12 +6,12 @@ import pytest
 import torch
 
 from neurosym.agent.a3c import (
+    AdvantageScale,
     SharedAdam,
     SharedRMSprop,
     a3c_loss,
     gae_advantages,
     n_step_returns,
-    AdvantageScale,
     shared_optimizer,
 )
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
@@ -63,7 +63,14 @@ def test_configs_without_the_new_keys_load_as_the_code_was() -> None:
     old = ModelConfig.from_dict(model)
     assert (old.entity_norm, old.attention_gain) == (False, 1.0)
     train = TrainConfig.for_family("rgw").to_dict()
-    for key in ("algo", "optimizer", "reward_scale", "normalize_advantages", "gae_lambda", "preset"):
+    for key in (
+        "algo",
+        "optimizer",
+        "reward_scale",
+        "normalize_advantages",
+        "gae_lambda",
+        "preset",
+    ):
         del train[key]
     old_train = TrainConfig.from_dict(train)
     assert (old_train.optimizer, old_train.normalize_advantages, old_train.gae_lambda) == (
