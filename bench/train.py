@@ -189,57 +189,74 @@ def random_success(env: str, episodes: int = 1000, seed: int = 0) -> float:
 
 
 def bench_boxworld(
-    env: str, frames: int, modules: tuple[str, ...], workers: int, seed: int
+    env: str,
+    frames: int,
+    modules: tuple[str, ...],
+    workers: int,
+    seed: int,
+    algos: tuple[str, ...] = ("a3c",),
+    preset: str = "default",
 ) -> None:
     emit({"bench": "boxworld_random", "env": env, "episodes": 1000, "success": random_success(env)})
-    for module in modules:
-        with run_dir(f"{env}-{module}") as out:
-            proc = train(
-                env, module, out,
-                "--workers", str(workers), "--frames", str(frames), "--seed", str(seed),
-                "--window", "1000", "--eval-interval", "30",
-                timeout=24 * 3600,
-            )  # fmt: skip
-            if failed(proc, bench="boxworld", env=env, module=module):
-                continue
-            table = rows(out)
-            step = max(1, len(table) // 10)
-            curve = [
-                {
-                    "frames": int(r["frames"]),
-                    "episodes": int(r["episodes"]),
-                    "success": float(r["success_rate"] or 0),
-                }
-                for r in table[step - 1 :: step]
-            ]
-            sampled = neurosym(
-                "eval",
-                "--checkpoint",
-                str(out / "checkpoint.pt"),
-                "--episodes",
-                "1000",
-                "--sample",
-                "--json",
-                timeout=3600,
-            )
-            final = (
-                json.loads(sampled.stdout)
-                if sampled.returncode == 0
-                else {"error": sampled.stderr.strip()}
-            )
-            emit(
-                {
-                    "bench": "boxworld",
-                    "env": env,
-                    "module": module,
-                    "frames": frames,
-                    "wall_s": float(table[-1]["wall_s"]),
-                    "train_success_last_1000": float(table[-1]["success_rate"] or 0),
-                    "sampled_success_1000": final.get("success_rate"),
-                    "thesis_success": THESIS_BW.get(env, {}).get(module),
-                    "curve": curve,
-                }
-            )
+    for algo in algos:
+        for module in modules:
+            bench_boxworld_run(env, frames, module, workers, seed, algo, preset)
+
+
+def bench_boxworld_run(
+    env: str, frames: int, module: str, workers: int, seed: int, algo: str, preset: str
+) -> None:
+    """One training run on Box-World: its success curve and the final agent's sampled success."""
+    with run_dir(f"{env}-{module}-{algo}") as out:
+        learner = ["--algo", algo] + (["--workers", str(workers)] if algo == "a3c" else [])
+        proc = train(
+            env, module, out, *learner, "--preset", preset,
+            "--frames", str(frames), "--seed", str(seed),
+            "--window", "1000", "--eval-interval", "30",
+            timeout=24 * 3600,
+        )  # fmt: skip
+        if failed(proc, bench="boxworld", env=env, module=module, algo=algo):
+            return
+        table = rows(out)
+        step = max(1, len(table) // 10)
+        curve = [
+            {
+                "frames": int(r["frames"]),
+                "episodes": int(r["episodes"]),
+                "success": float(r["success_rate"] or 0),
+            }
+            for r in table[step - 1 :: step]
+        ]
+        sampled = neurosym(
+            "eval",
+            "--checkpoint",
+            str(out / "checkpoint.pt"),
+            "--episodes",
+            "1000",
+            "--sample",
+            "--json",
+            timeout=3600,
+        )
+        final = (
+            json.loads(sampled.stdout)
+            if sampled.returncode == 0
+            else {"error": sampled.stderr.strip()}
+        )
+        emit(
+            {
+                "bench": "boxworld",
+                "env": env,
+                "module": module,
+                "algo": algo,
+                "preset": preset,
+                "frames": frames,
+                "wall_s": float(table[-1]["wall_s"]),
+                "train_success_last_1000": float(table[-1]["success_rate"] or 0),
+                "sampled_success_1000": final.get("success_rate"),
+                "thesis_success": THESIS_BW.get(env, {}).get(module),
+                "curve": curve,
+            }
+        )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -261,6 +278,12 @@ def main(argv: list[str] | None = None) -> int:
         "--bw-frames", type=int, default=1_500_000, help="frame budget per Box-World run"
     )
     parser.add_argument(
+        "--bw-algos", default="a3c", help="learners for the Box-World part: a3c, ppo (a3c)"
+    )
+    parser.add_argument(
+        "--bw-preset", default="default", help="settings for the Box-World part (default)"
+    )
+    parser.add_argument(
         "--keep", type=Path, help="keep the run directories (metrics.csv, checkpoint.pt) here"
     )
     args = parser.parse_args(argv)
@@ -280,7 +303,15 @@ def main(argv: list[str] | None = None) -> int:
             [int(s) for s in args.seeds.split(",")], modules, args.workers, args.solve_minutes
         )
     if "boxworld" in parts:
-        bench_boxworld(args.bw_env, args.bw_frames, modules, args.workers, seed=0)
+        bench_boxworld(
+            args.bw_env,
+            args.bw_frames,
+            modules,
+            args.workers,
+            seed=0,
+            algos=tuple(a.strip() for a in args.bw_algos.split(",") if a.strip()),
+            preset=args.bw_preset,
+        )
     return 0
 
 

@@ -54,7 +54,7 @@ def test_forward_shapes(module: str, env, batch: int) -> None:
 
 def test_table4_defaults_per_family() -> None:
     rgw = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
-    bw = ModelConfig.for_family("boxworld", "mhdpa", (3, 14, 14), 1 / 255)
+    bw = ModelConfig.for_family("boxworld", "mhdpa", (3, 14, 14), 1 / 255, preset="thesis")
     assert (rgw.heads, rgw.key_size, rgw.relations, rgw.output_size) == (4, 32, 8, 26)
     assert (bw.key_size, bw.value_size, bw.conv_channels, bw.hidden_sizes) == (
         64,
@@ -64,10 +64,9 @@ def test_table4_defaults_per_family() -> None:
     )
     assert rgw.entity_size == 26
     assert (TrainConfig.for_family("rgw").lr, TrainConfig.for_family("rgw").entropy) == (2e-3, 0.02)
-    assert (TrainConfig.for_family("boxworld").lr, TrainConfig.for_family("boxworld").entropy) == (
-        2e-4,
-        0.01,
-    )
+    thesis = TrainConfig.for_family("boxworld", preset="thesis")
+    assert (thesis.lr, thesis.entropy) == (2e-4, 0.01)
+    assert ModelConfig.for_family("boxworld", "mhdpa", (26, 14, 14)).key_size == 32  # default
     assert ModelConfig.for_family("rgw", "predinet", (9, 10, 10), relations=4).relations == 4
 
 

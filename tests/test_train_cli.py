@@ -126,6 +126,67 @@ def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     assert torch.load(out / "checkpoint.pt", weights_only=True)["optimizer"] is None
 
 
+@pytest.mark.expensive
+def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path: Path) -> None:
+    """The synchronous learner: one-hot Box-World by default, event files, resume keeps the algo."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw1", "--module", "predinet", "--algo", "ppo", "--out", str(out),
+        "--envs", "8", "--n-steps", "16", "--ppo-minibatches", "2", "--frames", "256",
+        "--tensorboard", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.meta["train_config"]["algo"] == "ppo"
+    assert agent.meta["train_config"]["optimizer"] == "adam"
+    assert agent.env_kwargs == {"obs_mode": "onehot"} and agent.config.obs_shape == (26, 14, 14)
+    assert "--algo ppo" in agent.meta["command"] and "--tensorboard" in agent.meta["command"]
+    assert agent.meta["frames"] >= 256
+    events = EventAccumulator(str(out / "tensorboard"))
+    events.Reload()
+    tags = set(events.Tags()["scalars"])
+    assert {"charts/episodic_return", "charts/fps", "losses/policy_loss"} <= tags
+    steps = [e.step for e in events.Scalars("losses/policy_loss")]
+    assert steps and steps == sorted(steps) and steps[-1] <= agent.meta["frames"]
+
+    wrong = neurosym("train", "--out", str(out), "--resume", "--algo", "a3c", "--quiet")
+    assert wrong.returncode == 1 and "trained with --algo ppo" in wrong.stderr
+    again = neurosym(
+        "train", "--out", str(out), "--resume", "--frames", "512", "--quiet",
+        "--eval-interval", "0.5", "--eval-episodes", "2",
+    )  # fmt: skip
+    assert again.returncode == 0, again.stderr
+    assert load_agent(out / "checkpoint.pt").meta["frames"] >= 512
+
+
+@pytest.mark.expensive
+def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw1", "--module", "mhdpa", "--preset", "thesis", "--out", str(out),
+        "--workers", "1", "--frames", "200", "--quiet", "--heads", "1",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    train = agent.meta["train_config"]
+    assert (train["preset"], train["optimizer"], train["rms_eps"], train["lr"]) == (
+        "thesis",
+        "rmsprop",
+        0.1,
+        2e-4,
+    )
+    assert (train["envs"], train["grad_clip"], train["normalize_advantages"]) == (1, 400.0, False)
+    assert agent.env_kwargs == {"obs_mode": "rgb"} and agent.config.obs_shape == (3, 14, 14)
+    assert (agent.config.entity_norm, agent.config.attention_gain, agent.config.init) == (
+        False,
+        1.0,
+        "torch",
+    )
+    assert "--preset thesis" in agent.meta["command"]
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -133,6 +194,11 @@ def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
         (("--module", "predinet"), "--env and --module are needed unless --resume"),
         (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
         (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
+        (("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"), "PPO has none"),
+        (
+            ("--env", "bw1", "--module", "mhdpa", "--preset", "thesis", "--algo", "ppo"),
+            "--preset thesis is A3C",
+        ),
         (
             ("--env", "rgw2", "--module", "predinet", "--frames", "0"),
             "--frames must be a positive integer",

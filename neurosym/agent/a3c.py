@@ -271,7 +271,8 @@ def a3c_loss(
     loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
     if sil_batch is not None:
         M = sil_batch.actions.shape[0]
-        sil = sil_loss(logits_all[n + K :], values_all[n + K :], sil_batch, config.value_coef)
+        scaled = sil_batch._replace(returns=sil_batch.returns * config.reward_scale)
+        sil = sil_loss(logits_all[n + K :], values_all[n + K :], scaled, config.value_coef)
         loss = loss + config.sil * sil * (T / M)
     numbers = torch.stack([policy_loss, value_loss, entropy_sum]).tolist()
     return loss, LossStats(numbers[0], numbers[1], numbers[2], 0.0)
