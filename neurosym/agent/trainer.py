@@ -23,7 +23,6 @@ import os
 import queue as _queue
 import signal
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -39,6 +38,7 @@ from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpo
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, play_episodes, select_actions
+from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 
 CHECKPOINT_NAME = "checkpoint.pt"
@@ -162,10 +162,7 @@ def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
     )
     writer.writeheader()
     writer.writerows(rows)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(buf.getvalue())
-    os.replace(tmp, path)
+    write_bytes_atomic(path, buf.getvalue().encode())
 
 
 def _fmt(value: float | None, spec: str = ".3f") -> str:
