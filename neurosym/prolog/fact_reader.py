@@ -28,11 +28,19 @@ from __future__ import annotations
 MODULE = "neurosym_facts"
 
 SOURCE = r"""
-:- module(neurosym_facts, [load_facts/6]).
+:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1]).
 :- use_module(library(lists), [member/2, append/3]).
 :- use_module(library(apply), [exclude/3]).
 
 :- thread_local touched_/3.   % touched_(Name, Arity, ClausesBefore | new)
+:- dynamic chunk_bytes_/1.    % files this large are read in parallel chunks
+chunk_bytes_(8388608).
+
+%!  set_chunk_bytes(+Bytes) is det.
+%   Tests read small files in chunks with this.
+set_chunk_bytes(Bytes) :-
+    retractall(chunk_bytes_(_)),
+    assertz(chunk_bytes_(Bytes)).
 
 %!  load_facts(+Module, +File, +Mode, +RuleFiles, -Count, -Status) is det.
 %   Mode: assert or check. RuleFiles: the source ids of the KB's rule files.
@@ -40,11 +48,7 @@ SOURCE = r"""
 load_facts(M, File, Mode, RuleFiles, Count, Status) :-
     retractall(touched_(_, _, _)),
     b_setval(neurosym_rule_files, RuleFiles),
-    catch(setup_call_cleanup(
-              open(File, read, S, [encoding(utf8)]),
-              read_loop_(S, M, Mode, -, -1, 0, Count),
-              close(S)),
-          E, true),
+    catch(load_(M, File, Mode, RuleFiles, Count), E, true),
     (   var(E)
     ->  Status = ok
     ;   Count = 0,
@@ -53,6 +57,187 @@ load_facts(M, File, Mode, RuleFiles, Count, Status) :-
         Status = error-Text
     ),
     retractall(touched_(_, _, _)).
+
+% A large file is cut at line starts into one chunk per core; helper threads
+% read and check chunks 1.. into lists while this thread reads chunk 0 and
+% adds it, then adds each helper's list in order. A cut is used only once the
+% chunk before it is known to end exactly there (so a cut inside a quoted
+% atom or comment is detected); otherwise, and on any helper trouble, this
+% thread simply reads on, so results, order and error lines never depend on
+% the cuts.
+load_(M, File, Mode, RuleFiles, Count) :-
+    cuts_(File, Cuts),
+    setup_call_cleanup(
+        ( open(File, read, S, [encoding(utf8)]),
+          start_helpers_(Cuts, File, M, RuleFiles, Helpers) ),
+        read_chunks_(Helpers, S, M, Mode, Count),
+        ( close(S), stop_helpers_(Helpers) )).
+
+cuts_(File, Cuts) :-
+    size_file(File, Size),
+    current_prolog_flag(cpu_count, Cores0),
+    Cores is min(Cores0, 4),
+    chunk_bytes_(Min),
+    (   Size >= Min, Cores >= 2, current_prolog_flag(threads, true)
+    ->  setup_call_cleanup(open(File, read, S, [type(binary)]),
+                           findall(Cut, ( between(1, Cores, I), I < Cores,
+                                          Guess is I * Size // Cores,
+                                          line_start_(S, Guess, Cut) ), Cuts0),
+                           close(S)),
+        sort(Cuts0, Cuts)
+    ;   Cuts = []
+    ).
+
+line_start_(S, Guess, Cut) :-
+    seek(S, Guess, bof, _),
+    skip(S, 0'\n),
+    \+ at_end_of_stream(S),
+    byte_count(S, Cut).
+
+% helper(Thread, Queue, From, To): the chunk [From, To), To = eof for the last one.
+start_helpers_(Cuts, File, M, RuleFiles, Helpers) :-
+    append(Cuts, [eof], Ends),
+    start_helpers_(Cuts, Ends, File, M, RuleFiles, Helpers).
+
+start_helpers_([], _, _, _, _, []).
+start_helpers_([From|Fs], [_, To|Ts], File, M, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
+    message_queue_create(Q, [max_size(64)]),
+    thread_create(read_chunk_(File, M, RuleFiles, Q, From, To), Id, []),
+    start_helpers_(Fs, [To|Ts], File, M, RuleFiles, Hs).
+
+% A helper blocked on its full queue is woken by the queue's destruction.
+stop_helpers_(Helpers) :-
+    forall(member(helper(Id, Q, _, _), Helpers),
+           (   catch(thread_signal(Id, throw(neurosym_stop)), _, true),
+               catch(message_queue_destroy(Q), _, true),
+               catch(thread_join(Id, _), _, true)
+           )).
+
+% In a helper thread: sends batch(Terms, Pos) messages, then done(End), End
+% the byte after the last term (eof at the end of the file); it stops at
+% anything but plain facts, so the main thread reads that part itself.
+% Small batches keep the helper's stacks (and its garbage collections) small.
+read_chunk_(File, M, RuleFiles, Q, From, To) :-
+    b_setval(neurosym_rule_files, RuleFiles),
+    catch(setup_call_cleanup(
+              ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
+              chunk_batches_(S, M, Q, To, -, -1),
+              close(S)),
+          _, true),
+    catch(thread_send_message(Q, stop), _, true).
+
+% batch(Terms, Pos): whole, checked terms, Pos the byte after them. The main
+% thread reads on by itself from the last Pos when no done(End) comes.
+chunk_batches_(S, M, Q, To, PName, PArity) :-
+    catch(chunk_terms_(S, M, To, PName, PArity, 2000, Terms, Name, Arity, End), _, fail),
+    byte_count(S, Pos),
+    thread_send_message(Q, batch(Terms, Pos)),
+    (   End == more
+    ->  chunk_batches_(S, M, Q, To, Name, Arity)
+    ;   thread_send_message(Q, done(End))
+    ).
+
+% Up to K terms; End0 is more, eof, or the byte position past To.
+chunk_terms_(_, _, _, PName, PArity, 0, [], PName, PArity, more) :- !.
+chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    (   T == end_of_file
+    ->  Terms = [], LName = PName, LArity = PArity, End = eof
+    ;   QQ == [],
+        (   nonvar(T), functor(T, PName, PArity)
+        ->  Name = PName, Arity = PArity
+        ;   T \= (:- _),
+            check_(T, S, M, check, 0, Name, Arity)
+        ),
+        Terms = [T|Terms1],
+        byte_count(S, B),
+        (   To \== eof, B >= To
+        ->  Terms1 = [], LName = Name, LArity = Arity, End = B
+        ;   K1 is K - 1,
+            chunk_terms_(S, M, To, Name, Arity, K1, Terms1, LName, LArity, End)
+        )
+    ).
+
+% Chunk 0 from the stream, then each helper's chunk while the cuts hold.
+read_chunks_([], S, M, Mode, N) :- !,
+    read_loop_(S, M, Mode, -, -1, 0, N).
+read_chunks_(Helpers, S, M, Mode, N) :-
+    Helpers = [helper(_, _, Cut, _)|_],
+    read_until_(S, M, Mode, Cut, -, -1, 0, N0, PName, PArity, End),
+    (   End == Cut
+    ->  take_chunks_(Helpers, S, M, Mode, PName, PArity, N0, N)
+    ;   End == eof
+    ->  N = N0
+    ;   read_loop_(S, M, Mode, PName, PArity, N0, N)
+    ).
+
+take_chunks_([], _, _, _, _, _, N, N).
+take_chunks_([helper(_, Q, From, To)|Hs], S, M, Mode, PName, PArity, N0, N) :-
+    take_batches_(Q, S, M, Mode, From, PName, PArity, N0, N1, Name, Arity, End),
+    (   End == To
+    ->  take_chunks_(Hs, S, M, Mode, Name, Arity, N1, N)
+    ;   End == eof
+    ->  N = N1
+    ;   End = failed(Pos)
+    ->  seek(S, Pos, bof, _),     % the batches before Pos were added
+        read_loop_(S, M, Mode, Name, Arity, N1, N)
+    ;   seek(S, End, bof, _),
+        read_loop_(S, M, Mode, Name, Arity, N1, N)
+    ).
+
+% Batches are added as they come: each is whole and checked. Anything but
+% done(End) (a helper that stopped, or one that is too slow) means: read on
+% from the byte after the last batch.
+take_batches_(Q, S, M, Mode, Pos, PName, PArity, N0, N, Name, Arity, End) :-
+    (   thread_get_message(Q, Msg, [timeout(60)]) -> true ; Msg = timeout ),
+    (   Msg = batch(Terms, Pos1)
+    ->  add_terms_(Terms, S, M, Mode, PName, PArity, N0, N1, Name1, Arity1),
+        take_batches_(Q, S, M, Mode, Pos1, Name1, Arity1, N1, N, Name, Arity, End)
+    ;   N = N0, Name = PName, Arity = PArity,
+        (   Msg = done(End)
+        ->  true
+        ;   End = failed(Pos)
+        )
+    ).
+
+add_terms_([], _, _, _, PName, PArity, N, N, PName, PArity).
+add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
+    N1 is N0 + 1,
+    (   functor(T, PName, PArity)
+    ->  Name1 = PName, Arity1 = PArity
+    ;   check_(T, S, M, Mode, N1, Name1, Arity1)
+    ),
+    ( Mode == assert -> assertz(M:T) ; true ),
+    add_terms_(Ts, S, M, Mode, Name1, Arity1, N1, N, Name, Arity).
+
+% Like read_loop_, stopping after the term that reaches byte Stop: End is
+% that byte position, or eof.
+read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    (   T == end_of_file
+    ->  N = N0, LName = PName, LArity = PArity, End = eof
+    ;   N1 is N0 + 1,
+        (   QQ \== []
+        ->  refuse_(N1, 'a quasi-quotation', T)
+        ;   nonvar(T), functor(T, PName, PArity)
+        ->  Name = PName, Arity = PArity
+        ;   check_(T, S, M, Mode, N1, Name, Arity),
+            (   T = (:- encoding(Enc)), Enc \== utf8
+            ->  Stop1 = never   % the helpers decoded the rest as UTF-8
+            ;   true
+            )
+        ),
+        (   Name == (:-)
+        ->  Name2 = PName, Arity2 = PArity
+        ;   ( Mode == assert -> assertz(M:T) ; true ),
+            Name2 = Name, Arity2 = Arity
+        ),
+        ( var(Stop1) -> Stop1 = Stop ; true ),
+        (   Stop1 \== never, byte_count(S, B), B >= Stop1
+        ->  N = N1, LName = Name2, LArity = Arity2, End = B
+        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, N1, N, LName, LArity, End)
+        )
+    ).
 
 % The tight loop: a fact of the same predicate as the previous one needs no
 % check beyond its functor; a new functor goes through check_/7 once.
