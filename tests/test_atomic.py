@@ -86,15 +86,25 @@ what = sys.argv[2]
 try:
     if what == "kb":
         write_prolog(out / "kb.pl", {"p": pd.DataFrame({"x": np.arange(200_000)})})
-    else:
+    elif what == "metrics":
         _write_rows(out / "metrics.csv", [{"frames": i} for i in range(100_000)])
+    else:
+        from neurosym.agent.checkpoint import save_checkpoint
+        from neurosym.agent.config import ModelConfig
+        from neurosym.agent.model import ActorCritic
+
+        config = ModelConfig.for_family("rgw", "predinet", (10, 10, 10), 1.0)
+        save_checkpoint(out / "checkpoint.pt", model=ActorCritic(config), config=config, env_name="rgw2")
 except NeurosymError as exc:
     print(exc, file=sys.stderr)
     sys.exit(1)
 """
 
 
-@pytest.mark.parametrize(("what", "name"), [("kb", "kb.pl"), ("metrics", "metrics.csv")])
+@pytest.mark.parametrize(
+    ("what", "name"),
+    [("kb", "kb.pl"), ("metrics", "metrics.csv"), ("checkpoint", "checkpoint.pt")],
+)
 def test_a_write_that_fails_part_way_leaves_the_old_file(
     tmp_path: Path, what: str, name: str
 ) -> None:

@@ -155,6 +155,20 @@ def _read_rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+def _frames(row: dict[str, Any]) -> int:
+    try:
+        return int(row.get("frames") or 0)
+    except ValueError:
+        return 0
+
+
+def _remove_stale_temporaries(out: Path) -> None:
+    """Temporary files a killed run left behind (``.checkpoint.pt.*.tmp``); the real files are whole."""
+    for name in (CHECKPOINT_NAME, METRICS_NAME):
+        for tmp in out.glob(f".{name}.*.tmp"):
+            tmp.unlink(missing_ok=True)
+
+
 def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
     buf = io.StringIO()
     writer = csv.DictWriter(
@@ -351,7 +365,10 @@ def train(
         optimizer.set_hyperparameters(train_config.lr, train_config.rms_alpha, train_config.rms_eps)
     optimizer.share_memory()
 
-    rows: list[dict[str, Any]] = _read_rows(out / METRICS_NAME) if resume else []
+    _remove_stale_temporaries(out)
+    rows: list[dict[str, Any]] = []
+    if resume:  # rows written after the checkpoint describe training that a kill lost
+        rows = [r for r in _read_rows(out / METRICS_NAME) if _frames(r) <= frames0]
     stats = _Stats(frames0, episodes0, options.window)
     eval_model = ActorCritic(model_config)
     eval_model.eval()
