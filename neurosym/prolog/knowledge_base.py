@@ -1,5 +1,19 @@
 """KnowledgeBase: fact files and rule files queried from Python through janus-swi.
 
+Fact files are data, rule files are code (DESIGN.md, "Prolog"). A KB is
+something people pass around, so a fact file is never consulted: it is read
+term by term (:mod:`neurosym.prolog.fact_reader`) and only facts and the
+writer's ``:- encoding``/``:- dynamic`` headers are accepted; anything else
+(directives, rules, hooks, built-in or rule-defined predicates) is refused
+with one line naming file and line, and nothing of the file has run or
+stays loaded. Rule files (``rules=``) are consulted as code, before the
+facts, so facts for a predicate the rules define are refused. ``trusted=``
+(True, or the fact files to trust) consults fact files as code. A ``.qlf``
+is compiled code and loads only when neurosym signed it on this account
+(:mod:`neurosym.prolog.signature`) or when trusted. Queries take
+``timeout=``, ``inferences=`` and ``stack_limit=``: a goal that goes past
+one stops with a one-line :class:`~neurosym.errors.PrologError`.
+
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
 one process even when they load the same rule file. Files are plain Prolog
 (no module header); they are loaded under a per-module source id because
@@ -21,11 +35,13 @@ procedure, type) raises :class:`~neurosym.errors.PrologError` with Prolog's
 message on one line; load errors name the file and line, load warnings
 become :class:`PrologWarning`.
 
-Several fact files add up: predicates already loaded are declared multifile
-before the next file, so a second ``relation/7`` file extends the first
-instead of replacing it. Large fact files load from ``.qlf`` with
-``qlf=True`` (compiled by :func:`neurosym.prolog.qlf.qcompile` on first use,
-again when the source is newer or the ``.qlf`` cannot be read); the
+Several fact files add up: facts are added with ``assertz``, so a second
+``relation/7`` file extends the first (trusted files consulted as code get
+their loaded predicates declared multifile first, to the same end). Large
+fact files load from ``.qlf`` with ``qlf=True`` (compiled by
+:func:`neurosym.prolog.qlf.qcompile`, after the source has been checked as
+data, on first use and again when the source changed, the signature does
+not check, or the ``.qlf`` cannot be read); the
 ``dynamic``/``discontiguous``/``multifile`` directives in such files apply to
 the KB's module, other directives run in module ``neurosym_qlf``.
 """
