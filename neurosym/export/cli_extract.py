@@ -6,7 +6,8 @@
 
 Writes into ``--out`` (default ``kb_out/<env>``):
 
-* ``kb.pl`` (format ``pl``) -- the knowledge base; ``kb.qlf`` beside it with ``--qlf``;
+* ``kb.pl`` (format ``pl``) -- the knowledge base; with ``--qlf`` also ``kb.qlf``
+  and its signature ``kb.qlf.sig`` beside it;
 * ``facts/<predicate>.parquet`` (format ``parquet``) -- the same fact tables;
 * ``recording/`` -- the Recording itself, for ``neurosym plot --recording``.
 
@@ -158,7 +159,7 @@ def write_outputs(
 ) -> dict[str, Path]:
     """Write into a staging folder inside ``out``, then move each product into place by rename.
 
-    Only neurosym's own names (kb.pl, kb.qlf, facts/, recording/) are replaced in
+    Only neurosym's own names (kb.pl, kb.qlf, kb.qlf.sig, facts/, recording/) are replaced in
     ``out``; anything else there is left alone. A run killed part-way (``kill -9``)
     leaves the previous products as they were: everything is written in the
     staging folder first, a file replaces its old version in one rename, and a
