@@ -9,8 +9,15 @@ episode: 16 steps x 4 heads x 8 relations, entity atoms including
 * ``qcompile_s``: compiling it to .qlf (a swipl subprocess);
 * ``consult_s`` / ``qlf_load_s``: loading in a plain ``swipl`` process, timed
   inside Prolog (CPU and wall), i.e. without process start-up;
-* ``janus_consult_s`` / ``janus_qlf_s``: ``KnowledgeBase(path)`` and
-  ``KnowledgeBase(path, qlf=True)`` in this process (wall);
+* ``janus_facts_s``: ``KnowledgeBase(path)`` in this process (wall), the
+  default and safe path: the file is read as data (facts only, nothing runs),
+  in parallel chunks on a machine with more than one core (``*_cpu_s``: CPU
+  seconds of all threads, the steadier figure on a shared machine);
+  ``janus_facts_1thread_s`` the same read front to back in one thread;
+* ``janus_consult_s``: ``KnowledgeBase(path, trusted=True)``, the file
+  consulted as code (what every load did before untrusted KBs were read as
+  data); ``janus_qlf_s``: ``KnowledgeBase(path, qlf=True)`` from the signed
+  ``.qlf`` (compiled beforehand);
 * queries through janus: the first-argument query ``relation(E, ...)`` with E
   bound, as ``once`` (first answer) and as ``query`` (all 500 facts of the
   episode converted to Python), and a third-argument query (Head bound) as
@@ -45,7 +52,7 @@ import pandas as pd
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from neurosym.export.prolog_writer import write_prolog  # noqa: E402
-from neurosym.prolog.knowledge_base import KnowledgeBase  # noqa: E402
+from neurosym.prolog.knowledge_base import KnowledgeBase, _janus  # noqa: E402
 from neurosym.prolog.locate import find_swipl  # noqa: E402
 from neurosym.prolog.qlf import qcompile  # noqa: E402
 from neurosym.terms import atom_text  # noqa: E402
@@ -123,8 +130,18 @@ def bench(n: int, directory: Path) -> dict[str, object]:
     cpu, wall = swipl_load(Path(qlf), qlf=True)
     out.update(qlf_load_s=round(wall, 3), qlf_load_cpu_s=round(cpu, 3))
 
-    wall, _, kb = timed(lambda: KnowledgeBase(path))
-    out["janus_consult_s"] = round(wall, 3)
+    wall, cpu, kb = timed(lambda: KnowledgeBase(path))
+    out.update(janus_facts_s=round(wall, 3), janus_facts_cpu_s=round(cpu, 3))
+    assert kb.count("relation(_, _, _, _, _, _, _)") == n
+    kb.close()
+    janus = _janus()
+    janus.query_once("neurosym_facts:set_chunk_bytes(B)", {"B": 1 << 62})
+    wall, cpu, kb = timed(lambda: KnowledgeBase(path))
+    janus.query_once("neurosym_facts:set_chunk_bytes(8388608)")
+    out.update(janus_facts_1thread_s=round(wall, 3), janus_facts_1thread_cpu_s=round(cpu, 3))
+    kb.close()
+    wall, cpu, kb = timed(lambda: KnowledgeBase(path, trusted=True))
+    out.update(janus_consult_s=round(wall, 3), janus_consult_cpu_s=round(cpu, 3))
     kb.close()
     wall, _, kb = timed(lambda: KnowledgeBase(path, qlf=True))
     out["janus_qlf_s"] = round(wall, 3)

@@ -34,3 +34,7 @@ class PrologError(NeurosymError):
     def __init__(self, message: str, term: object | None = None) -> None:
         super().__init__(message)
         self.term = term
+
+
+class OutputError(NeurosymError):
+    """A file neurosym could not write (disk full, file-size limit, no permission); one line."""

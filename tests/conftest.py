@@ -13,6 +13,15 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """Sign .qlf files with a key of the test session, never the user's own (subprocesses inherit it)."""
+    import tempfile
+
+    if "NEUROSYM_KEY_FILE" not in os.environ:
+        key_dir = tempfile.mkdtemp(prefix="neurosym-test-key-")
+        os.environ["NEUROSYM_KEY_FILE"] = os.path.join(key_dir, "qlf.key")
+
+
 @pytest.fixture(scope="session")
 def swipl() -> Path:
     """The swipl binary neurosym uses (tests fail, not skip, when there is none)."""

@@ -95,10 +95,11 @@ def test_errors_are_one_line_and_exit_non_zero(
     assert message.format(**fill) in proc.stderr
 
 
-def test_load_warnings_go_to_stderr(run_neurosym, tmp_path: Path) -> None:
-    rules = tmp_path / "w.pl"
+def test_load_warnings_go_to_stderr(run_neurosym, kb_files: tuple[Path, Path]) -> None:
+    facts, _ = kb_files
+    rules = facts.parent / "w.pl"
     rules.write_text("p(X) :- true.\n")
-    proc = run_neurosym("query", "--kb", rules, "--format", "csv", "p(1)")
+    proc = run_neurosym("query", "--kb", facts, "--rules", rules, "--format", "csv", "p(1)")
     assert proc.returncode == 0
     assert proc.stdout == "\n\n"  # no output variables: an empty header, one empty row
     assert "neurosym query: warning: " in proc.stderr and "Singleton variables: [X]" in proc.stderr

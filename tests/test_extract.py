@@ -67,6 +67,7 @@ def test_extract_writes_the_kb_and_prints_the_answers(
         "facts",
         "kb.pl",
         "kb.qlf",
+        "kb.qlf.sig",  # neurosym's signature: this .qlf loads without --trust
         "notes.txt",
         "recording",
     ]

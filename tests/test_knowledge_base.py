@@ -194,9 +194,14 @@ def test_load_errors_name_the_file_and_line(tmp_path: Path) -> None:
         KnowledgeBase(bad)
     static = _write(tmp_path / "static.pl", "atom(1).\n")
     with pytest.raises(
-        PrologError, match=rf"{static}:1: No permission to modify static procedure `atom/1'"
+        PrologError,
+        match=rf"^cannot load {static}:1: found a fact for the built-in predicate atom/1",
     ):
         KnowledgeBase(static)
+    with pytest.raises(  # consulted as code, Prolog itself refuses
+        PrologError, match=rf"{static}:1: No permission to modify static procedure `atom/1'"
+    ):
+        KnowledgeBase(static, trusted=True)
     with pytest.raises(KnowledgeBaseFileNotFoundError, match="no such Prolog file: .*missing.pl"):
         KnowledgeBase(tmp_path / "missing.pl")
     good = _write(tmp_path / "good.pl", "p(1).\n")
@@ -251,10 +256,13 @@ def test_qlf_is_compiled_once_and_shared_by_kbs(tmp_path: Path) -> None:
 
 def test_qlf_compile_errors_name_the_file(tmp_path: Path) -> None:
     bad = _write(tmp_path / "bad.pl", "p(.\n")
+    with pytest.raises(PrologError, match=rf"^cannot load {bad}:1:\d+: Syntax error"):
+        KnowledgeBase(bad, qlf=True)  # the source is checked as data before compiling
+    assert not (tmp_path / "bad.qlf").exists()
     with pytest.raises(
         PrologError, match=r"qcompile .*bad.pl failed: .*bad.pl:1:\d+: Syntax error"
     ):
-        KnowledgeBase(bad, qlf=True)
+        KnowledgeBase(bad, qlf=True, trusted=True)
     assert not (tmp_path / "bad.qlf").exists()
 
 

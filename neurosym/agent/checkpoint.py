@@ -25,9 +25,9 @@ config) is one line of :class:`~neurosym.errors.CheckpointError`.
 from __future__ import annotations
 
 import datetime as _dt
+import io
 import os
 import pickle
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,6 +39,7 @@ from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.introspection import Introspection
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
+from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 
 FORMAT = "neurosym-checkpoint"
@@ -114,17 +115,11 @@ def save_checkpoint(
     }
     _check_plain(payload, "checkpoint")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            torch.save(payload, fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    # Serialised in memory first: torch reports a failed file write as a
+    # RuntimeError, a plain write reports it as the OSError it is.
+    buf = io.BytesIO()
+    torch.save(payload, buf)
+    return write_bytes_atomic(path, buf.getvalue())
 
 
 def _load_raw(path: Path) -> Any:

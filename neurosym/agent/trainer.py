@@ -28,7 +28,6 @@ import os
 import queue as _queue
 import signal
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -44,6 +43,7 @@ from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpo
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, play_episodes, select_actions
+from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 
 CHECKPOINT_NAME = "checkpoint.pt"
@@ -162,6 +162,20 @@ def _read_rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+def _frames(row: dict[str, Any]) -> int:
+    try:
+        return int(row.get("frames") or 0)
+    except ValueError:
+        return 0
+
+
+def _remove_stale_temporaries(out: Path) -> None:
+    """Temporary files a killed run left behind (``.checkpoint.pt.*.tmp``); the real files are whole."""
+    for name in (CHECKPOINT_NAME, METRICS_NAME):
+        for tmp in out.glob(f".{name}.*.tmp"):
+            tmp.unlink(missing_ok=True)
+
+
 def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
     buf = io.StringIO()
     writer = csv.DictWriter(
@@ -169,10 +183,7 @@ def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
     )
     writer.writeheader()
     writer.writerows(rows)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(buf.getvalue())
-    os.replace(tmp, path)
+    write_bytes_atomic(path, buf.getvalue().encode())
 
 
 class _TensorBoard:
@@ -415,7 +426,10 @@ def train(
         set_optimizer_hyperparameters(optimizer, train_config)
     optimizer.share_memory()
 
-    rows: list[dict[str, Any]] = _read_rows(out / METRICS_NAME) if resume else []
+    _remove_stale_temporaries(out)
+    rows: list[dict[str, Any]] = []
+    if resume:  # rows written after the checkpoint describe training that a kill lost
+        rows = [r for r in _read_rows(out / METRICS_NAME) if _frames(r) <= frames0]
     board = _TensorBoard(out / "tensorboard") if options.tensorboard else None
 
     def log_row(row: dict[str, Any]) -> None:

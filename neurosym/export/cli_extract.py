@@ -6,7 +6,8 @@
 
 Writes into ``--out`` (default ``kb_out/<env>``):
 
-* ``kb.pl`` (format ``pl``) -- the knowledge base; ``kb.qlf`` beside it with ``--qlf``;
+* ``kb.pl`` (format ``pl``) -- the knowledge base; with ``--qlf`` also ``kb.qlf``
+  and its signature ``kb.qlf.sig`` beside it;
 * ``facts/<predicate>.parquet`` (format ``parquet``) -- the same fact tables;
 * ``recording/`` -- the Recording itself, for ``neurosym plot --recording``.
 
@@ -19,6 +20,7 @@ another env, is refused before anything is recorded.
 from __future__ import annotations
 
 import argparse
+import ctypes
 import os
 import shutil
 import tempfile
@@ -26,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from neurosym.cli import add_action_mode
-from neurosym.errors import ConfigError
+from neurosym.errors import ConfigError, OutputError
 
 FORMATS = ("pl", "parquet")
 
@@ -149,17 +151,27 @@ def _tty() -> bool:
     return sys.stderr.isatty()
 
 
+STAGE_PREFIX = ".extract-"
+
+
 def write_outputs(
     out: Path, rec: Any, facts: Any, formats: tuple[str, ...], qlf: bool = False
 ) -> dict[str, Path]:
     """Write into a staging folder inside ``out``, then move each product into place by rename.
 
-    Only neurosym's own names (kb.pl, kb.qlf, facts/, recording/) are replaced in
-    ``out``; anything else there is left alone. Returns name -> final path.
+    Only neurosym's own names (kb.pl, kb.qlf, kb.qlf.sig, facts/, recording/) are replaced in
+    ``out``; anything else there is left alone. A run killed part-way (``kill -9``)
+    leaves the previous products as they were: everything is written in the
+    staging folder first, a file replaces its old version in one rename, and a
+    folder is swapped with its old version in one ``renameat2(RENAME_EXCHANGE)``
+    where Linux offers it. What a killed run left (its staging folder, a folder
+    half-swapped by the fallback) is cleaned up or put back by the next run.
+    Returns name -> final path.
     """
     created = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".extract-", dir=out))
+    _recover(out)
+    stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=out))
     ok = False
     try:
         if "pl" in formats:
@@ -174,15 +186,58 @@ def write_outputs(
             written[name] = out / name
         ok = True
         return written
+    except OSError as exc:
+        raise OutputError(f"cannot write into {out}: {exc.strerror or exc}") from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
         if created and not ok:
             shutil.rmtree(out, ignore_errors=True)
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _recover(out: Path) -> None:
+    """Undo what a killed run left in ``out``: its staging folder, a folder it had moved aside."""
+    for entry in out.iterdir():
+        name = entry.name
+        if name.startswith(STAGE_PREFIX):
+            pid = name[len(STAGE_PREFIX) :].split("-", 1)[0]
+            if pid.isdigit() and not _alive(int(pid)):
+                shutil.rmtree(entry, ignore_errors=True)
+        elif name.startswith(".") and ".old-" in name:
+            product, _, pid = name[1:].rpartition(".old-")
+            if product in ("facts", "recording") and pid.isdigit() and not _alive(int(pid)):
+                if (out / product).exists():
+                    shutil.rmtree(entry, ignore_errors=True)
+                else:  # killed between moving the old folder aside and the new one in
+                    os.replace(entry, out / product)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths in one step (Linux renameat2 RENAME_EXCHANGE); False where unsupported."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
+
+
 def _move_into_place(src: Path, dst: Path) -> None:
     """Rename ``src`` onto ``dst``: a file in one os.replace, a folder by swapping it with the old one."""
     if src.is_dir():
+        if dst.is_dir() and _exchange(src, dst):
+            shutil.rmtree(src, ignore_errors=True)  # src now holds the old folder
+            return
         old = None
         if dst.exists():
             old = dst.with_name(f".{dst.name}.old-{os.getpid()}")

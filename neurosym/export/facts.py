@@ -37,8 +37,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.atomic import atomic_write
 from neurosym.errors import ConfigError
-from neurosym.export.recording import META_KEYS, Recording, atomic_write
+from neurosym.export.recording import META_KEYS, Recording
 from neurosym.export.thresholds import Threshold, parse_threshold
 
 # predicate -> argument columns, in argument order.

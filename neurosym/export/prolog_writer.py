@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -43,6 +42,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
 
+from neurosym.atomic import open_atomic
 from neurosym.errors import FactError
 from neurosym.terms import atom_text, float_text, format_value, parse_term
 
@@ -224,12 +224,6 @@ def _indicator(spec: str | tuple[str, int]) -> tuple[str, int]:
     return name, arity
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def write_prolog(
     path: str | os.PathLike[str],
     tables: Mapping[str, pd.DataFrame],
@@ -272,23 +266,16 @@ def write_prolog(
             declared[(name, df.shape[1])] = None
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with open(fd, "wb") as out:
-            lines = [f"% {line}".rstrip() for line in (header or "").splitlines()]
-            lines.append(":- encoding(utf8).")
-            lines += [f":- dynamic {atom_text(name)}/{arity}." for name, arity in declared]
-            out.write(("\n".join(lines) + "\n").encode("utf-8"))
-            for name, df in tables.items():
-                if len(df):
-                    out.write(b"\n")
-                    for block in _table_blocks(name, df, term_columns.get(name, set())):
-                        out.write(block)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with open_atomic(path, "wb") as out:
+        lines = [f"% {line}".rstrip() for line in (header or "").splitlines()]
+        lines.append(":- encoding(utf8).")
+        lines += [f":- dynamic {atom_text(name)}/{arity}." for name, arity in declared]
+        out.write(("\n".join(lines) + "\n").encode("utf-8"))
+        for name, df in tables.items():
+            if len(df):
+                out.write(b"\n")
+                for block in _table_blocks(name, df, term_columns.get(name, set())):
+                    out.write(block)
     if qlf:
         from neurosym.prolog.qlf import qcompile
 

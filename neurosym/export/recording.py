@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from neurosym.atomic import atomic_write
 from neurosym.errors import ConfigError
 
 # table -> ordered (column, dtype); "str" columns hold Prolog text (atoms or terms).
@@ -117,18 +117,6 @@ def conform(name: str, df: pd.DataFrame | None) -> pd.DataFrame:
     if dtypes:
         out = out.astype(dtypes)
     return out.reset_index(drop=True)
-
-
-def atomic_write(path: Path, write: Any) -> None:
-    """Call ``write(tmp_path)`` and move the result onto ``path`` in one rename."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 @dataclass

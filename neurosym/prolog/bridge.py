@@ -13,7 +13,7 @@ package without any package-data settings. What it does, and why in Prolog:
   warnings printed during the load are captured with ``message_hook/3`` and
   returned instead of being printed. The ``dynamic``, ``discontiguous`` and
   ``multifile`` directives a ``.qlf`` replays land in the KB's module.
-* ``solve/7`` parses the goal text in the KB module, binds the inputs by
+* ``solve/8`` parses the goal text in the KB module, binds the inputs by
   variable name (values never pass through goal text), runs it under
   ``limit/2`` and returns every answer in one call, each value encoded so
   janus converts it unambiguously: atoms and strings -> str, numbers, lists
@@ -25,7 +25,8 @@ from __future__ import annotations
 MODULE = "neurosym_bridge"
 
 SOURCE = r"""
-:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/7, count/6]).
+:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/8, count/7]).
+:- use_module(library(time), [call_with_time_limit/2]).
 :- use_module(library(solution_sequences), [limit/2]).
 :- use_module(library(apply), [maplist/3, exclude/3, partition/4]).
 :- use_module(library(lists), [member/2]).
@@ -130,36 +131,79 @@ load_module_(M) :-
     ;   M = neurosym_qlf
     ).
 
-%!  solve(+M, +Text, +Inputs, +Limit, -Names, -Rows, -Status) is det.
-%   Status: ok, missing-Names or error-Text (pairs: janus makes them tuples).
-solve(M, Text, Inputs, Limit, Names, Rows, Status) :-
-    catch(solve_(M, Text, Inputs, Limit, Names, Rows, Status), E,
-          ( error_text_(E, Msg), Names = [], Rows = [], Status = error-Msg )).
+%!  solve(+M, +Text, +Inputs, +Limit, +Bounds, -Names, -Rows, -Status) is det.
+%   Status: ok, missing-Names, limit-Text or error-Text (pairs: janus makes
+%   them tuples). Bounds: see bounded_/2.
+solve(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
+    catch(solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status), E,
+          ( failure_(E, Bounds, Status), Names = [], Rows = [] )).
 
-solve_(M, Text, Inputs, Limit, Names, Rows, Status) :-
+solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
     prepare_(M, Text, Inputs, Goal, Names, Vars, Missing),
     (   Missing \== []
     ->  Rows = [], Status = missing-Missing
     ;   Template =.. [v|Vars],
         (   Limit == all
-        ->  findall(Template, M:Goal, Raw)
-        ;   findall(Template, limit(Limit, M:Goal), Raw)
+        ->  bounded_(Bounds, findall(Template, M:Goal, Raw))
+        ;   bounded_(Bounds, findall(Template, limit(Limit, M:Goal), Raw))
         ),
         maplist(encode_row_, Raw, Rows),
         Status = ok
     ).
 
-%!  count(+M, +Text, +Inputs, +Limit, -N, -Status) is det.
-count(M, Text, Inputs, Limit, N, Status) :-
+%!  count(+M, +Text, +Inputs, +Limit, +Bounds, -N, -Status) is det.
+count(M, Text, Inputs, Limit, Bounds, N, Status) :-
     catch(( prepare_(M, Text, Inputs, Goal, _, _, Missing),
             (   Missing \== []
             ->  N = 0, Status = missing-Missing
             ;   Limit == all
-            ->  aggregate_all(count, M:Goal, N), Status = ok
-            ;   aggregate_all(count, limit(Limit, M:Goal), N), Status = ok
+            ->  bounded_(Bounds, aggregate_all(count, M:Goal, N)), Status = ok
+            ;   bounded_(Bounds, aggregate_all(count, limit(Limit, M:Goal), N)), Status = ok
             )
           ), E,
-          ( error_text_(E, Msg), N = 0, Status = error-Msg )).
+          ( failure_(E, Bounds, Status), N = 0 )).
+
+%   bounded_(+Bounds, :Goal): run the deterministic Goal (a findall) within
+%   Bounds, a list of timeout-Seconds, inferences-N, stack-Bytes. Going
+%   past one throws neurosym_limit(Which); the KB stays usable.
+bounded_([], Goal) :- !, call(Goal).
+bounded_([timeout-T|Bs], Goal) :- !,
+    catch(call_with_time_limit(T, bounded_(Bs, Goal)), time_limit_exceeded,
+          throw(neurosym_limit(timeout(T)))).
+bounded_([inferences-N|Bs], Goal) :- !,
+    call_with_inference_limit(bounded_(Bs, Goal), N, Result),
+    (   Result == inference_limit_exceeded
+    ->  throw(neurosym_limit(inferences(N)))
+    ;   true
+    ).
+bounded_([stack-Bytes|Bs], Goal) :- !,
+    current_prolog_flag(stack_limit, Old),
+    setup_call_cleanup(set_prolog_flag(stack_limit, Bytes),
+                       bounded_(Bs, Goal),
+                       set_prolog_flag(stack_limit, Old)).
+
+failure_(E, Bounds, Status) :-
+    (   limit_text_(E, Bounds, Msg)
+    ->  Status = limit-Msg
+    ;   error_text_(E, Msg),
+        Status = error-Msg
+    ).
+
+limit_text_(neurosym_limit(timeout(T)), _, Msg) :-
+    format(string(Msg), "time limit exceeded: the goal ran longer than ~w s and was stopped", [T]).
+limit_text_(neurosym_limit(inferences(N)), _, Msg) :-
+    format(string(Msg), "inference limit exceeded: the goal took more than ~D inferences and was stopped", [N]).
+limit_text_(E, Bounds, Msg) :-
+    E = error(resource_error(What), _),
+    stack_overflow_(What, E),
+    (   memberchk(stack-Bytes, Bounds) -> true ; current_prolog_flag(stack_limit, Bytes) ),
+    MB is Bytes / 1048576,
+    format(string(Msg), "stack limit exceeded: the goal needed more than ~1f MB of Prolog stack \c
+                         (a runaway recursion?) and was stopped", [MB]).
+
+stack_overflow_(What, _) :- memberchk(What, [stack, global_stack, local_stack, trail_stack,
+                                             stack_overflow, memory]), !.
+stack_overflow_(_, error(_, Context)) :- is_dict(Context, stack_overflow).
 
 prepare_(M, Text, Inputs, Goal, Names, Vars, Missing) :-
     term_string(Goal, Text, [variable_names(Bindings), module(M)]),

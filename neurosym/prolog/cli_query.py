@@ -8,6 +8,14 @@ compound values print as their canonical Prolog text. A goal without output
 variables prints ``true`` or ``false``. ``--bind NAME=TERM`` passes a value
 (read as Prolog term text: ``3``, ``sword``, ``key(red)``) through janus's
 input dict, never through the goal text.
+
+Fact files (``--kb``) are data: they are read term by term and only facts
+are accepted, so a KB someone sent you runs nothing when it loads; ``--trust
+FILE`` loads that one file as code (directives run), and a ``.qlf`` is
+loaded only when neurosym compiled it on this account or it is trusted.
+Rule files (``--rules``) are code. ``--timeout``, ``--max-inferences`` and
+``--stack-limit`` stop a runaway goal with one line (no limit by default,
+beyond SWI-Prolog's own 1 GB stack).
 """
 
 from __future__ import annotations
@@ -17,6 +25,7 @@ import csv
 import json
 import sys
 import warnings
+from pathlib import Path
 from typing import Any
 
 from neurosym.errors import ConfigError, FactError
@@ -28,11 +37,27 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("goal", metavar="GOAL", help="Prolog goal, e.g. 'object(Id, Type)'.")
     parser.add_argument(
         "--kb", action="append", required=True, metavar="FILE",
-        help="Fact file (.pl or .qlf) to load; repeat for several.",
+        help="Fact file (.pl or .qlf) to load as data (facts only, nothing runs); repeatable.",
     )  # fmt: skip
     parser.add_argument(
         "--rules", action="append", default=[], metavar="FILE",
-        help="Rule file to load after the facts; repeat for several.",
+        help="Rule file to load as code, before the facts; repeatable.",
+    )  # fmt: skip
+    parser.add_argument(
+        "--trust", action="append", default=[], metavar="FILE",
+        help="Load this --kb file as code (its directives run; any .qlf); repeatable. Default: none.",
+    )  # fmt: skip
+    parser.add_argument(
+        "--timeout", type=float, default=None, metavar="SECONDS",
+        help="Stop the goal after SECONDS of wall time (default: none).",
+    )  # fmt: skip
+    parser.add_argument(
+        "--max-inferences", type=int, default=None, metavar="N",
+        help="Stop the goal after N inferences (default: none).",
+    )  # fmt: skip
+    parser.add_argument(
+        "--stack-limit", type=float, default=None, metavar="MB",
+        help="Prolog stack the goal may use, in MB (default: SWI-Prolog's 1024).",
     )  # fmt: skip
     parser.add_argument(
         "--bind", action="append", default=[], metavar="NAME=TERM",
@@ -51,6 +76,24 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--qlf", action="store_true", help="Load .pl fact files through .qlf (compiled when stale)."
     )
+
+
+def _bounds(args: argparse.Namespace) -> dict[str, Any]:
+    """--timeout / --max-inferences / --stack-limit as KnowledgeBase.solve's keywords, checked."""
+    out: dict[str, Any] = {}
+    if args.timeout is not None:
+        if not args.timeout > 0:
+            raise ConfigError(f"--timeout must be a positive number of seconds, not {args.timeout}")
+        out["timeout"] = args.timeout
+    if args.max_inferences is not None:
+        if args.max_inferences < 1:
+            raise ConfigError(f"--max-inferences must be at least 1, not {args.max_inferences}")
+        out["inferences"] = args.max_inferences
+    if args.stack_limit is not None:
+        if not args.stack_limit >= 1:
+            raise ConfigError(f"--stack-limit must be at least 1 (MB), not {args.stack_limit}")
+        out["stack_limit"] = int(args.stack_limit * 1024 * 1024)
+    return out
 
 
 def _bindings(specs: list[str]) -> dict[str, Any]:
@@ -116,13 +159,20 @@ def run(args: argparse.Namespace) -> int:
 
     if args.limit is not None and args.limit < 1:
         raise ConfigError(f"--limit must be at least 1, not {args.limit}")
+    bounds = _bounds(args)
     inputs = _bindings(args.bind)
+    kbs = {Path(p).resolve() for p in args.kb}
+    for name in args.trust:
+        if Path(name).resolve() not in kbs:
+            raise ConfigError(
+                f"--trust {name}: not one of the --kb files (trust names a --kb FILE)"
+            )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        kb = KnowledgeBase(args.kb, rules=args.rules, qlf=args.qlf)
+        kb = KnowledgeBase(args.kb, rules=args.rules, qlf=args.qlf, trusted=args.trust)
     for w in caught:
         print(f"neurosym query: warning: {w.message}", file=sys.stderr)
     with kb:
-        names, rows = kb.solve(args.goal, limit=args.limit, **inputs)
+        names, rows = kb.solve(args.goal, limit=args.limit, **bounds, **inputs)
     print_answers(names, [dict(zip(names, row, strict=True)) for row in rows], args.format)
     return 0

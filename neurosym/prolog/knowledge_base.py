@@ -1,5 +1,19 @@
 """KnowledgeBase: fact files and rule files queried from Python through janus-swi.
 
+Fact files are data, rule files are code (DESIGN.md, "Prolog"). A KB is
+something people pass around, so a fact file is never consulted: it is read
+term by term (:mod:`neurosym.prolog.fact_reader`) and only facts and the
+writer's ``:- encoding``/``:- dynamic`` headers are accepted; anything else
+(directives, rules, hooks, built-in or rule-defined predicates) is refused
+with one line naming file and line, and nothing of the file has run or
+stays loaded. Rule files (``rules=``) are consulted as code, before the
+facts, so facts for a predicate the rules define are refused. ``trusted=``
+(True, or the fact files to trust) consults fact files as code. A ``.qlf``
+is compiled code and loads only when neurosym signed it on this account
+(:mod:`neurosym.prolog.signature`) or when trusted. Queries take
+``timeout=``, ``inferences=`` and ``stack_limit=``: a goal that goes past
+one stops with a one-line :class:`~neurosym.errors.PrologError`.
+
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
 one process even when they load the same rule file. Files are plain Prolog
 (no module header); they are loaded under a per-module source id because
@@ -21,11 +35,13 @@ procedure, type) raises :class:`~neurosym.errors.PrologError` with Prolog's
 message on one line; load errors name the file and line, load warnings
 become :class:`PrologWarning`.
 
-Several fact files add up: predicates already loaded are declared multifile
-before the next file, so a second ``relation/7`` file extends the first
-instead of replacing it. Large fact files load from ``.qlf`` with
-``qlf=True`` (compiled by :func:`neurosym.prolog.qlf.qcompile` on first use,
-again when the source is newer or the ``.qlf`` cannot be read); the
+Several fact files add up: facts are added with ``assertz``, so a second
+``relation/7`` file extends the first (trusted files consulted as code get
+their loaded predicates declared multifile first, to the same end). Large
+fact files load from ``.qlf`` with ``qlf=True`` (compiled by
+:func:`neurosym.prolog.qlf.qcompile`, after the source has been checked as
+data, on first use and again when the source changed, the signature does
+not check, or the ``.qlf`` cannot be read); the
 ``dynamic``/``discontiguous``/``multifile`` directives in such files apply to
 the KB's module, other directives run in module ``neurosym_qlf``.
 """
@@ -43,7 +59,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from neurosym.errors import ConfigError, NeurosymError, PrologError
-from neurosym.prolog import bridge
+from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
 from neurosym.terms import Term
@@ -74,6 +90,21 @@ class KnowledgeBaseFileNotFoundError(NeurosymError, FileNotFoundError):
     """A fact or rule file that does not exist."""
 
 
+def _existing(path: PathArg) -> Path:
+    path = Path(path)
+    if not path.is_file():
+        raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {path}")
+    return path.resolve()
+
+
+def _trust(trusted: bool | PathArg | Sequence[PathArg]) -> Any:
+    """``trusted`` (True, False, or the files to trust) -> path -> bool."""
+    if isinstance(trusted, bool):
+        return lambda path: trusted
+    chosen = {Path(p).resolve() for p in _as_paths(trusted)}
+    return lambda path: Path(path).resolve() in chosen
+
+
 def _janus() -> Any:
     """janus with the bridge module loaded (once per process)."""
     global _bridge_loaded
@@ -82,6 +113,7 @@ def _janus() -> Any:
         with _bridge_lock:
             if not _bridge_loaded:
                 janus.consult(f"/neurosym/{bridge.MODULE}.pl", data=bridge.SOURCE)
+                janus.consult(f"/neurosym/{fact_reader.MODULE}.pl", data=fact_reader.SOURCE)
                 _bridge_loaded = True
     return janus
 
@@ -132,6 +164,27 @@ def _from_prolog(value: Any) -> Any:
     return value
 
 
+def _bounds(
+    timeout: float | None, inferences: int | None, stack_limit: int | None
+) -> list[tuple[str, float | int]]:
+    """The query's bounds as ``Name-Value`` pairs for the bridge, checked."""
+    out: list[tuple[str, float | int]] = []
+    if timeout is not None:
+        if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
+            raise ConfigError(f"timeout must be a positive number of seconds, not {timeout!r}")
+        out.append(("timeout", float(timeout)))
+    for name, value, floor in (
+        ("inferences", inferences, 1),
+        ("stack_limit", stack_limit, 1 << 20),
+    ):
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int) or value < floor:
+            raise ConfigError(f"{name} must be an integer of at least {floor}, not {value!r}")
+        out.append(("inferences" if name == "inferences" else "stack", value))
+    return out
+
+
 def _as_paths(paths: PathArg | Iterable[PathArg] | None) -> list[Path]:
     if paths is None:
         return []
@@ -154,55 +207,114 @@ class KnowledgeBase:
         rules: PathArg | Sequence[PathArg] = (),
         *,
         qlf: bool = False,
+        trusted: bool | PathArg | Sequence[PathArg] = False,
     ) -> None:
         self.module = f"neurosym_kb_{next(_ids)}"
         self.files: list[Path] = []
         self._closed = False
         _call_once(f"{bridge.MODULE}:new_kb(M)", {"M": self.module})
         self._source_ids: list[str] = []  # what to unload on close
+        self._rule_ids: list[str] = []  # the source ids of the rule files
         self._finalizer = weakref.finalize(self, _close_module, self.module, self._source_ids)
         self._finalizer.atexit = False
+        trust = _trust(trusted)
         try:
-            for path in _as_paths(facts):
-                self.load(path, qlf=qlf)
+            # Rules first: a fact file may then be checked against what they define.
             for path in _as_paths(rules):
-                self.load(path)
+                self.load_rules(path)
+            for path in _as_paths(facts):
+                self.load(path, qlf=qlf, trusted=trust(path))
         except BaseException:
             self.close()
             raise
 
     # -- loading -----------------------------------------------------------
 
-    def load(self, path: PathArg, *, qlf: bool = False) -> None:
-        """Load one more Prolog file (facts or rules) into this KB.
+    def load(self, path: PathArg, *, qlf: bool = False, trusted: bool = False) -> None:
+        """Load one more fact file into this KB, as data.
 
-        A ``.qlf`` path is loaded as a quick-load file; with ``qlf=True`` a
-        ``.pl`` source is compiled to ``.qlf`` first (when missing, stale, or
-        written by another SWI-Prolog version). Syntax and other load errors
-        raise :class:`PrologError` naming the file and line; the file's
-        clauses are then unloaded again. Warnings become :class:`PrologWarning`.
+        The file is read term by term and only facts (and the ``:- encoding``
+        and ``:- dynamic`` headers neurosym writes) are accepted; a directive,
+        a rule, a hook or built-in predicate, or a predicate the rules define
+        raises :class:`PrologError` naming file and line, and nothing of the
+        file is loaded or run. ``trusted=True`` consults the file as code
+        instead (directives run). A ``.qlf`` is compiled code: it is loaded
+        only when neurosym compiled it on this account (its signature checks,
+        :mod:`neurosym.prolog.signature`) or when trusted. With ``qlf=True`` a
+        ``.pl`` source loads through its ``.qlf``, compiled (after the source
+        has been checked as data) when missing, stale, unsigned, or written by
+        another SWI-Prolog version.
         """
         self._check_open()
-        path = Path(path)
-        if not path.is_file():
-            raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {path}")
-        path = path.resolve()
-        if path.suffix != ".qlf" and qlf:
-            compiled = not is_fresh(path)
-            if compiled:
-                qcompile(path)
-            errors, notes = self._load_file(path, "qlf")
-            if errors and not compiled:  # e.g. a .qlf from another SWI-Prolog version
-                qcompile(path)
-                errors, notes = self._load_file(path, "qlf")
+        path = _existing(path)
+        if path.suffix == ".qlf":
+            if not trusted:
+                reason = signature.check(path)
+                if reason is not None:
+                    raise PrologError(
+                        f"cannot load {path}: a .qlf is compiled code and this one was not "
+                        f"compiled by neurosym on this account ({reason}); load its .pl source "
+                        f"instead, or trust the file (--trust {path.name} / trusted=True)"
+                    )
+            self._finish(path, *self._load_file(path, "qlf"))
+        elif qlf:
+            self._load_through_qlf(path, trusted)
+        elif trusted:
+            self._finish(path, *self._load_file(path, "source"))
         else:
-            errors, notes = self._load_file(path, "qlf" if path.suffix == ".qlf" else "source")
+            self._read_facts(path, "assert")
+            self.files.append(path)
+
+    def load_rules(self, path: PathArg) -> None:
+        """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
+
+        Syntax and other load errors raise :class:`PrologError` naming the
+        file and line, and the file's clauses are unloaded again; warnings
+        become :class:`PrologWarning`.
+        """
+        self._check_open()
+        path = _existing(path)
+        fmt = "qlf" if path.suffix == ".qlf" else "source"
+        before = len(self._source_ids)
+        self._finish(path, *self._load_file(path, fmt))
+        self._rule_ids.extend([*self._source_ids[before:], str(path)])
+
+    def _load_through_qlf(self, path: Path, trusted: bool) -> None:
+        if trusted:
+            compiled = not is_fresh(path)
+        else:
+            compiled = signature.check(qlf_path(path), source=path) is not None
+            if compiled:
+                self._read_facts(path, "check")  # nothing of an unchecked source is compiled
+        if compiled:
+            qcompile(path)
+        errors, notes = self._load_file(path, "qlf")
+        if errors and not compiled:  # e.g. a .qlf from another SWI-Prolog version
+            if not trusted:
+                self._read_facts(path, "check")
+            qcompile(path)
+            errors, notes = self._load_file(path, "qlf")
+        self._finish(path, errors, notes)
+
+    def _read_facts(self, path: Path, mode: str) -> int:
+        """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms."""
+        answer = _call_once(
+            f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, Count, Status)",
+            {"M": self.module, "File": str(path), "Mode": mode, "Rules": self._rule_ids},
+        )
+        status = answer["Status"]
+        if status != "ok":
+            _, text = status
+            raise PrologError(f"cannot load {self._clean(text)}")
+        return int(answer["Count"])
+
+    def _finish(self, path: Path, errors: list[str], notes: list[str]) -> None:
         if errors:
             more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
             first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
             raise PrologError(f"cannot load {first}{more}")
         for note in notes:
-            warnings.warn(note, PrologWarning, stacklevel=2)
+            warnings.warn(note, PrologWarning, stacklevel=3)
         self.files.append(path)
 
     def _load_file(self, path: Path, fmt: str) -> tuple[list[str], list[str]]:
@@ -238,16 +350,33 @@ class KnowledgeBase:
 
     # -- querying ----------------------------------------------------------
 
-    def solve(self, goal: str, /, *, limit: int | None = None, **inputs: Any) -> Answers:
-        """Every answer as rows of values, with the output variable names (the cheapest form)."""
+    def solve(
+        self,
+        goal: str,
+        /,
+        *,
+        limit: int | None = None,
+        timeout: float | None = None,
+        inferences: int | None = None,
+        stack_limit: int | None = None,
+        **inputs: Any,
+    ) -> Answers:
+        """Every answer as rows of values, with the output variable names (the cheapest form).
+
+        ``timeout`` (seconds), ``inferences`` (a count) and ``stack_limit``
+        (bytes of Prolog stack, default SWI-Prolog's 1 GB) bound the goal: going
+        past one stops it with a one-line :class:`PrologError` whose ``term`` is
+        ``"timeout"``, ``"inferences"`` or ``"stack"``; the KB stays usable.
+        """
         self._check_open()
         answer = _call_once(
-            f"{bridge.MODULE}:solve(M, Goal, Inputs, Limit, Names, Rows, Status)",
+            f"{bridge.MODULE}:solve(M, Goal, Inputs, Limit, Bounds, Names, Rows, Status)",
             {
                 "M": self.module,
                 "Goal": self._goal(goal),
                 "Inputs": self._inputs(inputs),
                 "Limit": self._limit(limit),
+                "Bounds": _bounds(timeout, inferences, stack_limit),
             },
         )
         self._check_status(answer["Status"], goal)
@@ -259,34 +388,49 @@ class KnowledgeBase:
         return Answers(answer["Names"], rows)
 
     def query(
-        self, goal: str, /, *, limit: int | None = None, **inputs: Any
+        self, goal: str, /, *, limit: int | None = None, **options: Any
     ) -> list[dict[str, Any]]:
         """Every answer of ``goal`` (at most ``limit``) as a dict: output variable -> value.
 
         Keyword arguments named like the goal's variables bind them:
-        ``kb.query("holds(E, T, R, A, B)", A="agent")``.
+        ``kb.query("holds(E, T, R, A, B)", A="agent")``; ``timeout``,
+        ``inferences`` and ``stack_limit`` bound the goal (see :meth:`solve`).
         """
-        names, rows = self.solve(goal, limit=limit, **inputs)
+        names, rows = self.solve(goal, limit=limit, **options)
         return [dict(zip(names, row, strict=True)) for row in rows]
 
-    def query_df(self, goal: str, /, *, limit: int | None = None, **inputs: Any) -> pd.DataFrame:
+    def query_df(self, goal: str, /, *, limit: int | None = None, **options: Any) -> pd.DataFrame:
         """Like :meth:`query`, as a DataFrame with one column per output variable (even when empty)."""
         import pandas as pd
 
-        names, rows = self.solve(goal, limit=limit, **inputs)
+        names, rows = self.solve(goal, limit=limit, **options)
         return pd.DataFrame(rows, columns=names)
 
-    def once(self, goal: str, /, **inputs: Any) -> dict[str, Any] | None:
+    def once(self, goal: str, /, **options: Any) -> dict[str, Any] | None:
         """The first answer of ``goal``, or None when it has none."""
-        answers = self.query(goal, limit=1, **inputs)
+        answers = self.query(goal, limit=1, **options)
         return answers[0] if answers else None
 
-    def count(self, goal: str, /, **inputs: Any) -> int:
+    def count(
+        self,
+        goal: str,
+        /,
+        *,
+        timeout: float | None = None,
+        inferences: int | None = None,
+        stack_limit: int | None = None,
+        **inputs: Any,
+    ) -> int:
         """How many answers ``goal`` has (counted in Prolog; nothing is converted)."""
         self._check_open()
         answer = _call_once(
-            f"{bridge.MODULE}:count(M, Goal, Inputs, all, N, Status)",
-            {"M": self.module, "Goal": self._goal(goal), "Inputs": self._inputs(inputs)},
+            f"{bridge.MODULE}:count(M, Goal, Inputs, all, Bounds, N, Status)",
+            {
+                "M": self.module,
+                "Goal": self._goal(goal),
+                "Inputs": self._inputs(inputs),
+                "Bounds": _bounds(timeout, inferences, stack_limit),
+            },
         )
         self._check_status(answer["Status"], goal)
         return int(answer["N"])
@@ -325,6 +469,9 @@ class KnowledgeBase:
         kind, detail = status
         if kind == "missing":
             raise ConfigError(f"input {', '.join(detail)} is not a variable of the goal {goal!r}")
+        if kind == "limit":
+            which = {"time": "timeout", "inference": "inferences"}.get(detail.split(" ", 1)[0])
+            raise PrologError(self._clean(detail), term=which or "stack")
         raise PrologError(self._clean(detail))
 
     @staticmethod

@@ -13,6 +13,7 @@ import subprocess
 from pathlib import Path
 
 from neurosym.errors import PrologError
+from neurosym.prolog import signature
 from neurosym.prolog.locate import swipl_executable
 from neurosym.terms import atom_text
 
@@ -31,9 +32,12 @@ def is_fresh(source: Path | str) -> bool:
 
 
 def qcompile(source: Path | str) -> Path:
-    """Compile ``source`` into ``<stem>.qlf`` beside it and return that path.
+    """Compile ``source`` into ``<stem>.qlf`` beside it, sign it, and return that path.
 
-    Raises :class:`PrologError` with swipl's first error (file:line included)
+    Compiling runs the source's directives (in a separate swipl), so only
+    call this on a source that is trusted or has been checked as data; the
+    signature (:mod:`neurosym.prolog.signature`) then lets later loads tell
+    this ``.qlf`` from one that came from elsewhere. Raises :class:`PrologError` with swipl's first error (file:line included)
     when the source does not compile cleanly; no ``.qlf`` is left behind then.
     """
     source = Path(source).resolve()
@@ -44,6 +48,7 @@ def qcompile(source: Path | str) -> Path:
     goal = f"qcompile({QLF_MODULE}:{atom_text(str(source))})"
     cmd = [str(swipl_executable()), "-f", "none", "--no-packs", "-q", "--on-error=status",
            "-g", goal, "-t", "halt"]  # fmt: skip
+    signature.signature_path(target).unlink(missing_ok=True)  # stale until signed again
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0 or not target.is_file():
         target.unlink(missing_ok=True)
@@ -54,4 +59,5 @@ def qcompile(source: Path | str) -> Path:
         )
         more = f" (and {len(errors) - 1} more errors)" if len(errors) > 1 else ""
         raise PrologError(f"qcompile {source} failed: {detail}{more}")
+    signature.sign(target, source)
     return target

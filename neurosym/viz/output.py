@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import io
 import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -19,6 +18,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
+from neurosym import atomic
 from neurosym.errors import ConfigError
 
 IMAGE_FORMATS = ("png", "svg")
@@ -66,16 +66,7 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
         raise ConfigError(
             f"cannot write {os.fspath(path)!r}: folder {os.fspath(folder)!r} does not exist"
         )
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return target
+    return atomic.write_bytes_atomic(target, data)
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Path:

@@ -1,0 +1,114 @@
+"""Atomic file writes: the one helper behind every file neurosym writes.
+
+A file is written to a temporary name in the same folder and renamed onto
+its final name, so a reader (or a ``kill -9`` half-way) never leaves half a
+file under that name. Two details every writer needs and used to get wrong:
+
+* permissions: ``mkstemp`` creates the temporary file 0600, and a rename
+  keeps them, so KBs, recordings and checkpoints were unreadable for
+  colleagues on a shared drive. The file is given ``0o666 & ~umask`` before
+  the rename, as ``open()`` would have done.
+* failure: a write that fails part-way (a full disk, a quota, a file-size
+  limit) removes the temporary file and raises :class:`OutputError`, one line
+  naming the file; whatever was at the final name is left untouched.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+import threading
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import IO, Any
+
+from neurosym.errors import OutputError
+
+_umask_lock = threading.Lock()
+
+
+def umask() -> int:
+    """The process umask, read without changing it where the OS allows.
+
+    Linux reports it in ``/proc/self/status``; elsewhere it is read by setting
+    and restoring it under a lock (``os.umask`` has no read-only form).
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    with _umask_lock:
+        mask = os.umask(0o022)
+        os.umask(mask)
+    return mask
+
+
+def file_mode() -> int:
+    """The mode a new file gets from ``open()``: ``0o666 & ~umask``."""
+    return 0o666 & ~umask()
+
+
+def _error(path: Path, exc: OSError) -> OutputError:
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    return OutputError(f"cannot write {path}: {reason}; it was left as it was")
+
+
+def atomic_write(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> Path:
+    """Call ``write(tmp_path)`` and move the result onto ``path`` in one rename.
+
+    ``write`` must create or fill the file at ``tmp_path`` (it exists, empty).
+    Raises :class:`OutputError` when writing or renaming fails with an OSError.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise _error(path, exc) from None
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.chmod(tmp, file_mode())
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise _error(path, exc) from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+@contextlib.contextmanager
+def open_atomic(path: str | os.PathLike[str], mode: str = "wb", **kwargs: Any) -> Iterator[IO[Any]]:
+    """``with open_atomic(p, "w") as fh: ...``: the file appears at ``p`` only if the block succeeds."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise _error(path, exc) from None
+    try:
+        with os.fdopen(fd, mode, **kwargs) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, file_mode())
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise _error(path, exc) from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically (see :func:`open_atomic`)."""
+    with open_atomic(path, "wb") as fh:
+        fh.write(data)
+    return Path(path)

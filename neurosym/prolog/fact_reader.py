@@ -1,0 +1,445 @@
+"""Reading a fact file as data: the Prolog half, loaded once per process beside the bridge.
+
+A knowledge base is something people pass around, so loading one must not
+run it. Consulting a file runs its directives (``:- shell(...)``) and lets
+it define ``term_expansion/2`` and other hooks; this reader never consults.
+It reads the file term by term with ``read_term/3`` (syntax errors raise,
+nothing is expanded, quasi-quotations are returned unparsed so no parser
+runs, and a term holding one is refused) and accepts only:
+
+* facts: a callable term that is not a directive, not ``Head :- Body``, not
+  a grammar rule, not module-qualified, and whose predicate is not built in,
+  not a hook (``term_expansion``, ``goal_expansion``, ``portray``,
+  ``message_hook``, ...), not autoloadable from the library, and not defined
+  by the KB's rule files (static) or imported into its module;
+* the headers neurosym's writer emits: ``:- encoding(Enc).`` (applied to the
+  stream) and ``:- dynamic Name/Arity, ...`` (the same checks on each
+  predicate).
+
+Anything else stops the load with ``error-Text``, one line naming file, line
+and what was found. Clauses are added with ``assertz/1`` as they are read;
+a refusal further down erases what this file added, so a refused file
+leaves the KB as it was. With mode ``check`` nothing is asserted (used
+before compiling a source to ``.qlf``). Reading is the cost (``read_term``
+takes about 2.5 us a fact here, consult about 20), so files of 8 MB and more
+are cut at line starts and read by one helper thread per core (up to 4) in
+small checked batches, added in file order; a cut is used only when the
+chunk before it ends exactly there, so results, order and error lines are
+those of a front-to-back read.
+"""
+
+from __future__ import annotations
+
+MODULE = "neurosym_facts"
+
+SOURCE = r"""
+:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1]).
+:- use_module(library(lists), [member/2, append/3]).
+:- use_module(library(apply), [exclude/3]).
+
+:- thread_local touched_/3.   % touched_(Name, Arity, ClausesBefore | new)
+:- dynamic chunk_bytes_/1.    % files this large are read in parallel chunks
+chunk_bytes_(8388608).
+
+%!  set_chunk_bytes(+Bytes) is det.
+%   Tests read small files in chunks with this.
+set_chunk_bytes(Bytes) :-
+    retractall(chunk_bytes_(_)),
+    assertz(chunk_bytes_(Bytes)).
+
+%!  load_facts(+Module, +File, +Mode, +RuleFiles, -Count, -Status) is det.
+%   Mode: assert or check. RuleFiles: the source ids of the KB's rule files.
+%   Count: terms read. Status: ok or error-Text.
+load_facts(M, File, Mode, RuleFiles, Count, Status) :-
+    retractall(touched_(_, _, _)),
+    b_setval(neurosym_rule_files, RuleFiles),
+    catch(load_(M, File, Mode, RuleFiles, Count), E, true),
+    (   var(E)
+    ->  Status = ok
+    ;   Count = 0,
+        ( Mode == assert -> rollback_(M) ; true ),
+        message_(E, File, Text),
+        Status = error-Text
+    ),
+    retractall(touched_(_, _, _)).
+
+% A large file is cut at line starts into one chunk per core; helper threads
+% read and check chunks 1.. into lists while this thread reads chunk 0 and
+% adds it, then adds each helper's list in order. A cut is used only once the
+% chunk before it is known to end exactly there (so a cut inside a quoted
+% atom or comment is detected); otherwise, and on any helper trouble, this
+% thread simply reads on, so results, order and error lines never depend on
+% the cuts.
+load_(M, File, Mode, RuleFiles, Count) :-
+    cuts_(File, Cuts),
+    setup_call_cleanup(
+        ( open(File, read, S, [encoding(utf8)]),
+          start_helpers_(Cuts, File, M, RuleFiles, Helpers) ),
+        read_chunks_(Helpers, S, M, Mode, Count),
+        ( close(S), stop_helpers_(Helpers) )).
+
+cuts_(File, Cuts) :-
+    size_file(File, Size),
+    current_prolog_flag(cpu_count, Cores0),
+    Cores is min(Cores0, 4),
+    chunk_bytes_(Min),
+    (   Size >= Min, Cores >= 2, current_prolog_flag(threads, true)
+    ->  setup_call_cleanup(open(File, read, S, [type(binary)]),
+                           findall(Cut, ( between(1, Cores, I), I < Cores,
+                                          Guess is I * Size // Cores,
+                                          line_start_(S, Guess, Cut) ), Cuts0),
+                           close(S)),
+        sort(Cuts0, Cuts)
+    ;   Cuts = []
+    ).
+
+line_start_(S, Guess, Cut) :-
+    seek(S, Guess, bof, _),
+    skip(S, 0'\n),
+    \+ at_end_of_stream(S),
+    byte_count(S, Cut).
+
+% helper(Thread, Queue, From, To): the chunk [From, To), To = eof for the last one.
+start_helpers_(Cuts, File, M, RuleFiles, Helpers) :-
+    append(Cuts, [eof], Ends),
+    start_helpers_(Cuts, Ends, File, M, RuleFiles, Helpers).
+
+start_helpers_([], _, _, _, _, []).
+start_helpers_([From|Fs], [_, To|Ts], File, M, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
+    message_queue_create(Q, [max_size(64)]),
+    thread_create(read_chunk_(File, M, RuleFiles, Q, From, To), Id, []),
+    start_helpers_(Fs, [To|Ts], File, M, RuleFiles, Hs).
+
+% A helper blocked on its full queue is woken by the queue's destruction.
+stop_helpers_(Helpers) :-
+    forall(member(helper(Id, Q, _, _), Helpers),
+           (   catch(thread_signal(Id, throw(neurosym_stop)), _, true),
+               catch(message_queue_destroy(Q), _, true),
+               catch(thread_join(Id, _), _, true)
+           )).
+
+% In a helper thread: sends batch(Terms, Pos) messages, then done(End), End
+% the byte after the last term (eof at the end of the file); it stops at
+% anything but plain facts, so the main thread reads that part itself.
+% Small batches keep the helper's stacks (and its garbage collections) small.
+read_chunk_(File, M, RuleFiles, Q, From, To) :-
+    b_setval(neurosym_rule_files, RuleFiles),
+    catch(setup_call_cleanup(
+              ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
+              chunk_batches_(S, M, Q, To, -, -1),
+              close(S)),
+          _, true),
+    catch(thread_send_message(Q, stop), _, true).
+
+% batch(Terms, Pos): whole, checked terms, Pos the byte after them. The main
+% thread reads on by itself from the last Pos when no done(End) comes.
+chunk_batches_(S, M, Q, To, PName, PArity) :-
+    catch(chunk_terms_(S, M, To, PName, PArity, 2000, Terms, Name, Arity, End), _, fail),
+    byte_count(S, Pos),
+    thread_send_message(Q, batch(Terms, Pos)),
+    (   End == more
+    ->  chunk_batches_(S, M, Q, To, Name, Arity)
+    ;   thread_send_message(Q, done(End))
+    ).
+
+% Up to K terms; End0 is more, eof, or the byte position past To.
+chunk_terms_(_, _, _, PName, PArity, 0, [], PName, PArity, more) :- !.
+chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    (   T == end_of_file
+    ->  Terms = [], LName = PName, LArity = PArity, End = eof
+    ;   QQ == [],
+        (   nonvar(T), functor(T, PName, PArity)
+        ->  Name = PName, Arity = PArity
+        ;   T \= (:- _),
+            check_(T, S, M, check, 0, Name, Arity)
+        ),
+        Terms = [T|Terms1],
+        byte_count(S, B),
+        (   To \== eof, B >= To
+        ->  Terms1 = [], LName = Name, LArity = Arity, End = B
+        ;   K1 is K - 1,
+            chunk_terms_(S, M, To, Name, Arity, K1, Terms1, LName, LArity, End)
+        )
+    ).
+
+% Chunk 0 from the stream, then each helper's chunk while the cuts hold.
+read_chunks_([], S, M, Mode, N) :- !,
+    read_loop_(S, M, Mode, -, -1, 0, N).
+read_chunks_(Helpers, S, M, Mode, N) :-
+    Helpers = [helper(_, _, Cut, _)|_],
+    read_until_(S, M, Mode, Cut, -, -1, 0, N0, PName, PArity, End),
+    (   End == Cut
+    ->  take_chunks_(Helpers, S, M, Mode, PName, PArity, N0, N)
+    ;   End == eof
+    ->  N = N0
+    ;   read_loop_(S, M, Mode, PName, PArity, N0, N)
+    ).
+
+take_chunks_([], _, _, _, _, _, N, N).
+take_chunks_([helper(_, Q, From, To)|Hs], S, M, Mode, PName, PArity, N0, N) :-
+    take_batches_(Q, S, M, Mode, From, PName, PArity, N0, N1, Name, Arity, End),
+    (   End == To
+    ->  take_chunks_(Hs, S, M, Mode, Name, Arity, N1, N)
+    ;   End == eof
+    ->  N = N1
+    ;   End = failed(Pos)
+    ->  seek(S, Pos, bof, _),     % the batches before Pos were added
+        read_loop_(S, M, Mode, Name, Arity, N1, N)
+    ;   seek(S, End, bof, _),
+        read_loop_(S, M, Mode, Name, Arity, N1, N)
+    ).
+
+% Batches are added as they come: each is whole and checked. Anything but
+% done(End) (a helper that stopped, or one that is too slow) means: read on
+% from the byte after the last batch.
+take_batches_(Q, S, M, Mode, Pos, PName, PArity, N0, N, Name, Arity, End) :-
+    (   thread_get_message(Q, Msg, [timeout(60)]) -> true ; Msg = timeout ),
+    (   Msg = batch(Terms, Pos1)
+    ->  add_terms_(Terms, S, M, Mode, PName, PArity, N0, N1, Name1, Arity1),
+        take_batches_(Q, S, M, Mode, Pos1, Name1, Arity1, N1, N, Name, Arity, End)
+    ;   N = N0, Name = PName, Arity = PArity,
+        (   Msg = done(End)
+        ->  true
+        ;   End = failed(Pos)
+        )
+    ).
+
+add_terms_([], _, _, _, PName, PArity, N, N, PName, PArity).
+add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
+    N1 is N0 + 1,
+    (   functor(T, PName, PArity)
+    ->  Name1 = PName, Arity1 = PArity
+    ;   check_(T, S, M, Mode, N1, Name1, Arity1)
+    ),
+    ( Mode == assert -> assertz(M:T) ; true ),
+    add_terms_(Ts, S, M, Mode, Name1, Arity1, N1, N, Name, Arity).
+
+% Like read_loop_, stopping after the term that reaches byte Stop: End is
+% that byte position, or eof.
+read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    (   T == end_of_file
+    ->  N = N0, LName = PName, LArity = PArity, End = eof
+    ;   N1 is N0 + 1,
+        (   QQ \== []
+        ->  refuse_(N1, 'a quasi-quotation', T)
+        ;   nonvar(T), functor(T, PName, PArity)
+        ->  Name = PName, Arity = PArity
+        ;   check_(T, S, M, Mode, N1, Name, Arity),
+            (   T = (:- encoding(Enc)), Enc \== utf8
+            ->  Stop1 = never   % the helpers decoded the rest as UTF-8
+            ;   true
+            )
+        ),
+        (   Name == (:-)
+        ->  Name2 = PName, Arity2 = PArity
+        ;   ( Mode == assert -> assertz(M:T) ; true ),
+            Name2 = Name, Arity2 = Arity
+        ),
+        ( var(Stop1) -> Stop1 = Stop ; true ),
+        (   Stop1 \== never, byte_count(S, B), B >= Stop1
+        ->  N = N1, LName = Name2, LArity = Arity2, End = B
+        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, N1, N, LName, LArity, End)
+        )
+    ).
+
+% The tight loop: a fact of the same predicate as the previous one needs no
+% check beyond its functor; a new functor goes through check_/7 once.
+read_loop_(S, M, Mode, PName, PArity, N0, N) :-
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    (   T == end_of_file
+    ->  N = N0
+    ;   N1 is N0 + 1,
+        (   QQ \== []
+        ->  refuse_(N1, 'a quasi-quotation', T)
+        ;   nonvar(T), functor(T, PName, PArity)
+        ->  Name = PName, Arity = PArity
+        ;   check_(T, S, M, Mode, N1, Name, Arity)
+        ),
+        (   Name == (:-)
+        ->  read_loop_(S, M, Mode, PName, PArity, N1, N)  % an accepted header
+        ;   ( Mode == assert -> assertz(M:T) ; true ),
+            read_loop_(S, M, Mode, Name, Arity, N1, N)
+        )
+    ).
+
+%   check_(+Term, +Stream, +M, +Mode, +N, -Name, -Arity): the predicate of a
+%   fact, or (:-)/1 for an accepted header; throws neurosym_refused/3.
+check_(T, _, _, _, N, _, _) :- var(T), !, refuse_(N, 'a variable where a fact should be', T).
+check_((:- D), S, M, Mode, N, (:-), 1) :- !, header_(D, S, M, Mode, N).
+check_(T, _, _, _, N, _, _) :- T = (?- _), !, refuse_(N, 'a directive', T).
+check_(T, _, _, _, N, _, _) :- T = (_ :- _), !, refuse_(N, 'a clause with a body (a rule)', T).
+check_(T, _, _, _, N, _, _) :- T = (_ --> _), !, refuse_(N, 'a grammar rule', T).
+check_(T, _, _, _, N, _, _) :- T = (_ : _), !, refuse_(N, 'a module-qualified clause', T).
+check_(T, _, _, _, N, _, _) :- \+ callable(T), !, refuse_(N, 'a term that is not a fact', T).
+check_(T, _, M, _, N, Name, Arity) :-
+    functor(T, Name, Arity),
+    predicate_check_(M, Name, Arity, N, T),
+    note_touched_(M, Name, Arity).
+
+header_(D, S, M, Mode, N) :-
+    (   nonvar(D), D = encoding(Enc), atom(Enc),
+        catch(set_stream(S, encoding(Enc)), _, fail)
+    ->  true
+    ;   nonvar(D), D = dynamic(Spec), specs_(Spec, PIs)
+    ->  forall(member(Name/Arity, PIs),
+               (   predicate_check_(M, Name, Arity, N, (:- D)),
+                   note_touched_(M, Name, Arity),
+                   ( Mode == assert -> dynamic(M:Name/Arity) ; true )
+               ))
+    ;   refuse_(N, 'a directive', (:- D))
+    ).
+
+specs_(Spec, _) :- var(Spec), !, fail.
+specs_((A, B), PIs) :- !, specs_(A, P1), specs_(B, P2), append(P1, P2, PIs).
+specs_(List, PIs) :- is_list(List), !, specs_list_(List, PIs).
+specs_(Name/Arity, [Name/Arity]) :- atom(Name), integer(Arity), Arity >= 0.
+
+specs_list_([], []).
+specs_list_([H|T], PIs) :- specs_(H, P1), specs_list_(T, P2), append(P1, P2, PIs).
+
+predicate_check_(M, Name, Arity, N, T) :-
+    (   predicate_problem_(M, Name, Arity, What)
+    ->  refuse_(N, What, T)
+    ;   true
+    ).
+
+% The library index is asked before anything that could autoload.
+predicate_problem_(M, Name, Arity, What) :-
+    functor(Head, Name, Arity),
+    (   hook_(Name, Arity)
+    ->  format(atom(What), 'a fact for the hook predicate ~q/~w', [Name, Arity])
+    ;   catch('$in_library'(Name, Arity, Lib), _, fail)
+    ->  file_base_name(Lib, Base),
+        format(atom(What), 'a fact for the library predicate ~q/~w (library ~w)', [Name, Arity, Base])
+    ;   predicate_property(system:Head, defined)
+    ->  format(atom(What), 'a fact for the built-in predicate ~q/~w', [Name, Arity])
+    ;   predicate_property(M:Head, imported_from(From))
+    ->  format(atom(What), 'a fact for ~q/~w, which the rules import from module ~q', [Name, Arity, From])
+    ;   predicate_property(M:Head, defined), \+ predicate_property(M:Head, dynamic),
+        predicate_property(M:Head, file(File)),
+        b_getval(neurosym_rule_files, RuleFiles), memberchk(File, RuleFiles)
+    ->  format(atom(What), 'a fact for ~q/~w, which the rule files define', [Name, Arity])
+    ).
+
+% Hook and expansion predicates: SWI-Prolog calls these by name (some in the
+% loading module, most in user or prolog), so data may never define them.
+hook_(term_expansion, 2).
+hook_(term_expansion, 4).
+hook_(goal_expansion, 2).
+hook_(goal_expansion, 4).
+hook_(portray, 1).
+hook_(message_hook, 3).
+hook_(prolog_load_file, 2).
+hook_(exception, 3).
+hook_(expand_query, 4).
+hook_(expand_answer, 2).
+hook_(file_search_path, 2).
+hook_(library_directory, 1).
+hook_(prolog_file_type, 2).
+hook_(resource, 2).
+hook_(resource, 3).
+hook_(message_property, 2).
+hook_(prolog_message, 3).
+hook_(message, 3).
+hook_(prolog_list_goal, 1).
+hook_(prolog_predicate_name, 2).
+hook_(prolog_clause_name, 2).
+hook_(prolog_uncaught_exception_hook, 4).
+hook_(prolog_exception_hook, 4).
+hook_(prolog_exception_hook, 5).
+hook_(prolog_trace_interception, 4).
+hook_(prolog_event_hook, 1).
+hook_(attr_unify_hook, 2).
+hook_(attribute_goals, 3).
+hook_(attr_portray_hook, 2).
+hook_(term_to_atom_hook, 2).
+hook_(Name, Arity) :-
+    functor(Head, Name, Arity),
+    (   predicate_property(user:Head, multifile)
+    ;   predicate_property(prolog:Head, multifile)
+    ;   predicate_property(system:Head, multifile)
+    ),
+    !.
+
+note_touched_(M, Name, Arity) :-
+    functor(Head, Name, Arity),
+    (   touched_(Name, Arity, _)
+    ->  true
+    ;   predicate_property(M:Head, number_of_clauses(C))
+    ->  assertz(touched_(Name, Arity, C))
+    ;   predicate_property(M:Head, defined)
+    ->  assertz(touched_(Name, Arity, 0))
+    ;   assertz(touched_(Name, Arity, new))
+    ).
+
+% What this file added is taken out again: clauses past the count a
+% predicate had before, and predicates the file created.
+rollback_(M) :-
+    forall(touched_(Name, Arity, Before),
+           (   functor(Head, Name, Arity),
+               (   Before == new
+               ->  catch(abolish(M:Name/Arity), _, true)
+               ;   forall(( nth_clause(M:Head, I, Ref), I > Before ), erase(Ref))
+               )
+           )).
+
+refuse_(N, What, Term) :- throw(neurosym_refused(N, What, Term)).
+
+% One line: File:Line: what was found, and what a fact file may hold.
+message_(neurosym_refused(N, What, Term), File, Text) :- !,
+    term_line_(File, N, Line),
+    with_output_to(string(Shown),
+                   \+ \+ ( numbervars(Term, 0, _),
+                           write_term(Term, [quoted(true), max_depth(8), portray(false),
+                                             numbervars(true), spacing(next_argument)]) )),
+    format(string(Text),
+           "~w:~w: found ~w: ~w; a fact file holds only facts such as p(a, 1). and the \c
+            writer's :- encoding/dynamic headers (load code as rules, or trust the file)",
+           [File, Line, What, Shown]).
+message_(error(syntax_error(What), Context), File, Text) :- !,
+    (   catch('$messages':translate_message(error(syntax_error(What), _), Lines, []), _, fail),
+        lines_text_(Lines, Msg)
+    ->  true
+    ;   format(string(Msg), "Syntax error: ~w", [What])
+    ),
+    (   compound(Context), Context =.. [_, _, Line, LinePos, _], integer(Line)
+    ->  format(string(Text), "~w:~w:~w: ~w", [File, Line, LinePos, Msg])
+    ;   format(string(Text), "~w: ~w", [File, Msg])
+    ).
+message_(E, File, Text) :-
+    (   catch('$messages':translate_message(E, Lines, []), _, fail),
+        lines_text_(Lines, Msg)
+    ->  true
+    ;   format(string(Msg), "~q", [E])
+    ),
+    format(string(Text), "~w: ~w", [File, Msg]).
+
+lines_text_(Lines, Text) :-
+    with_output_to(string(Text0), print_message_lines(current_output, '', Lines)),
+    split_string(Text0, "\n", " \t", Parts0),
+    exclude(==(""), Parts0, Parts),
+    atomic_list_concat(Parts, ' ', Atom),
+    atom_string(Atom, Text).
+
+% The line where the N-th term starts (only computed for an error).
+term_line_(File, N, Line) :-
+    catch(setup_call_cleanup(
+              open(File, read, S, [encoding(utf8)]),
+              nth_term_line_(S, N, Line),
+              close(S)),
+          _, Line = '?').
+
+nth_term_line_(S, N, Line) :-
+    read_term(S, T, [syntax_errors(quiet), term_position(P), quasi_quotations(_),
+                     module(neurosym_facts)]),
+    (   N =:= 1
+    ->  stream_position_data(line_count, P, Line)
+    ;   T == end_of_file
+    ->  Line = '?'
+    ;   ( T = (:- encoding(Enc)), atom(Enc) -> catch(set_stream(S, encoding(Enc)), _, true) ; true ),
+        N1 is N - 1,
+        nth_term_line_(S, N1, Line)
+    ).
+"""
