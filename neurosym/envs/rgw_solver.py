@@ -425,12 +425,53 @@ class Plan:
         return float(v[self._state(b, pos, removed)]) / 10.0
 
     def action(self, b: int, pos: int, removed: int, remaining: int) -> int:
-        """An optimal action (0 up, 1 right, 2 down, 3 left); the first of equals."""
+        """An optimal action (0 up, 1 right, 2 down, 3 left) that secures it soonest.
+
+        Among equally good actions it takes one of the fewest-step plan that
+        earns the best value (the smallest horizon j <= remaining with
+        V_j = V_remaining), so it does not dawdle; then the first of equals.
+        """
         s = self._state(b, pos, removed)
-        v = self.layers[min(max(remaining - 1, 0), len(self.layers) - 1)]
+        last = len(self.layers) - 1  # V_i = V_last for every i >= last
+
+        def layer(i: int) -> np.ndarray:
+            return self.layers[min(i, last)]
+
+        k = min(max(remaining, 1), max(last, 1))
+        j = next(i for i in range(1, k + 1) if layer(i)[s] == layer(k)[s])
+        v = layer(j - 1)
         g = self.graph
         q = [int(g.reward[a, s]) + int(v[g.nxt[a, s]]) for a in range(4)]
         return int(np.argmax(q))
 
     def _state(self, b: int, pos: int, removed: int) -> int:
         return int(b * self.graph.states + int(removed) * self.cells_per_level + int(pos))
+
+
+class Planner:
+    """An optimal scripted policy for a batched RGW env: ``planner(obs, venv) -> actions``.
+
+    Reads each sub-env's level and state (``venv.current_levels()``,
+    ``venv.agent_states()``) and acts by :class:`Plan`, one per level (cached),
+    so every episode earns its level's optimal return. For tests and for
+    checking evaluation figures; it looks at the state, not at the pixels.
+    """
+
+    def __init__(self) -> None:
+        self._plans: dict[tuple[bytes, int], Plan] = {}
+
+    def __call__(self, obs: np.ndarray, venv: object) -> np.ndarray:
+        env = getattr(venv, "unwrapped", venv)
+        cells, starts = env.current_levels()
+        pos, removed, t = env.agent_states()
+        limit = env.rules.max_steps
+        actions = np.zeros(len(cells), dtype=np.int64)
+        for i in range(len(cells)):
+            key = (cells[i].tobytes(), int(starts[i]))
+            plan = self._plans.get(key)
+            if plan is None:
+                plan = Plan(cells[i], starts[i], env.height, env.width, env.rules)
+                self._plans[key] = plan
+            remaining = int(limit - t[i]) if limit is not None else len(plan.layers)
+            actions[i] = plan.action(0, int(pos[i]), int(removed[i]), max(remaining, 1))
+        return actions

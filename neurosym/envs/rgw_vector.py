@@ -276,6 +276,29 @@ class RGWVectorEnv(VectorEnv):
 
     # -- symbolic views and rendering ----------------------------------------
 
+    @property
+    def rules(self) -> Rules:
+        """The rule options the levels are played and searched by (rgw_solver.Rules)."""
+        return self.source.rules
+
+    def current_levels(self) -> tuple[np.ndarray, np.ndarray]:
+        """(n, H * W) uint8 initial cells and (n,) start cells of each sub-env's level.
+
+        For searches over the levels being played (rgw_solver), e.g. what a
+        route without the sword earns in evaluation.
+        """
+        b = self._batch
+        slots = b.slot
+        return b.level_cells[slots].copy(), b.level_start[slots].copy()
+
+    def agent_states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(n,) agent cells, (n,) removed-objects bitmasks and (n,) steps taken this episode.
+
+        With :meth:`current_levels`, the state a search needs (rgw_solver.Planner).
+        """
+        b = self._batch
+        return b.pos.copy(), b.removed.copy(), b.t.copy()
+
     def entity_grid(self) -> np.ndarray:
         """(n, H, W) entity codes of the current states; names in ``entity_names``."""
         return self._batch.entity_grid()

@@ -25,7 +25,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from neurosym.cli import add_action_mode
+from neurosym.cli import add_action_mode, add_env_options, map_option
 from neurosym.errors import ConfigError
 
 FORMATS = ("pl", "parquet")
@@ -34,11 +34,7 @@ FORMATS = ("pl", "parquet")
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the extract options."""
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment to record, e.g. rgw2; must be the checkpoint's (default: it)",
-    )
+    add_env_options(parser)
     parser.add_argument(
         "--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)"
     )
@@ -109,16 +105,13 @@ def run(args: argparse.Namespace) -> int:
     if args.top_keys < 1:
         raise ConfigError(f"--top-keys must be at least 1, got {args.top_keys}")
 
-    from neurosym.envs import canonical_name
-
-    env = canonical_name(args.env) if args.env else None
-
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.checkpoint import env_for, load_agent
     from neurosym.export.facts import extract_facts
     from neurosym.export.recorder import record
 
-    agent = load_agent(args.checkpoint, env=env)
-    env = env or canonical_name(agent.env_name)
+    agent = load_agent(args.checkpoint)
+    env, overrides = map_option(args.env, args.map, agent.env_name)
+    env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once: the default folder needs the checkpoint's env
     out = Path(args.out) if args.out else Path("kb_out") / env
     if out.exists() and not out.is_dir():
@@ -133,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
         batch=args.batch,
         progress=show and _tty(),
         top_keys=args.top_keys,
+        env_kwargs=env_kwargs,
     )
     facts = extract_facts(rec, threshold=threshold)
     written = write_outputs(out, rec, facts, formats, qlf=args.qlf)
