@@ -39,7 +39,7 @@ def test_the_planner_on_the_shipped_maps() -> None:
 
 def test_random_actions_are_rarely_optimal() -> None:
     rng = np.random.default_rng(0)
-    report = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 200, seed=5)
+    report = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 120, seed=5)
     assert report["optimal_rate"] < 0.1
     assert report["sword_first_guarded"] < 0.5
 
@@ -110,23 +110,10 @@ def test_eval_cli_on_other_envs(run_neurosym, tmp_path: Path) -> None:
     proc = run_neurosym("eval", "--checkpoint", RGW2_PREDINET, "--map", mine, "--episodes", "1")
     assert proc.returncode == 0, proc.stderr
     assert "optimal      100.0 %" in proc.stdout
-    proc = run_neurosym("eval", "--checkpoint", RGW2_PREDINET, "--env", "boxworld")
-    assert proc.returncode == 1 and len(proc.stderr.strip().splitlines()) == 1
-    assert "boxworld is a boxworld environment" in proc.stderr
 
 
-def test_extract_and_plot_on_another_env(run_neurosym, tmp_path: Path) -> None:
-    out = tmp_path / "kb"
-    proc = run_neurosym(
-        "extract", "--checkpoint", RGW2_PREDINET, "--env", "rgw1", "--episodes", "2",
-        "--out", out, "--quiet",
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "kb_meta(env,rgw1)." in (out / "kb.pl").read_text().replace(" ", "")
-    png = tmp_path / "ep.png"
-    proc = run_neurosym(
-        "plot", "episode", "--checkpoint", RGW2_PREDINET, "--env", "rgw-random",
-        "--frames", "2", "--max-steps", "3", "--out", png,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert png.stat().st_size > 0
+def test_plot_on_another_env() -> None:
+    from neurosym.viz.episode import episode_figure
+
+    fig = episode_figure(load_agent(RGW2_PREDINET), "rgw-random", frames=2, max_steps=3)
+    assert fig.axes
