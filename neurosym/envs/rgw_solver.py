@@ -226,35 +226,40 @@ def _graph(cells: np.ndarray, starts: np.ndarray, height: int, width: int, r: Ru
         np.where(cells == rules.SWORD, bits, np.uint64(0)), axis=1
     )  # (B,)
     masks = np.arange(M, dtype=np.uint64)
-    present = (bits[:, None, :] & masks[None, :, None]) == 0  # (B, M, N)
-    under = np.where(present, cells[:, None, :], np.uint8(rules.EMPTY)).astype(np.intp)
     holding = ((masks[None, :] & sword_bits[:, None]) != 0).astype(np.intp)[:, :, None]  # (B, M, 1)
     dest, code = rules.compile_moves(cells, height, width, r.classic)  # (B, N, 4)
     T = rules.rule_tables(r.classic, r.enemy)
     tenths = np.rint(T.reward * 10).astype(np.int32)
     assert np.allclose(tenths / 10, T.reward), "RGW rewards are multiples of 0.1"
+    # One gather for four flags of the landing: 1 ends, 2 removes, 4 blocked, 8 wins.
+    flag_table = (
+        T.terminated * 1 + T.removes * 2 + T.blocked * 4 + ((T.events & rules.EV_TERMINAL) != 0) * 8
+    ).astype(np.uint8)
+    cells_i = cells.astype(np.intp)
     here = np.arange(N)
-    lvl = np.arange(B)[:, None, None]
     base = (np.arange(B, dtype=np.intp) * S1)[:, None, None]
     nxt = np.empty((4, B, S1), dtype=np.intp)
     reward = np.zeros((4, B, S1), dtype=np.int32)
     wins = np.zeros((4, B, S1), dtype=bool)
     for a in range(4):
-        d = np.broadcast_to(dest[:, None, :, a], (B, M, N))
-        c = np.take_along_axis(under, d, axis=2)  # (B, M, N) code of the landing cell
+        d = dest[:, :, a]  # (B, N) where the action leads, before the landing's rule
+        bits_d = np.take_along_axis(bits, d, axis=1)[:, None, :]  # (B, 1, N)
+        cell_d = np.take_along_axis(cells_i, d, axis=1)[:, None, :]
+        gone = (bits_d & masks[None, :, None]) != 0  # (B, M, N): the landing's object is gone
+        c = np.where(gone, rules.EMPTY, cell_d)  # (B, M, N) code of the landing cell
         if r.classic:
             held = holding * (here != 0)[None, None, :]  # the original's `state > nS_pos`
             idx = c * 4 + held * 2 + holding
         else:
             stayed = (code[:, None, :, a] & rules.MV_STAY).astype(np.intp)
             idx = c * 4 + holding * 2 + stayed
-        gone = np.where(T.removes[idx], bits[lvl, d], np.uint64(0))
-        new_mask = (masks[None, :, None] | gone).astype(np.intp)
-        new_pos = np.where(T.blocked[idx], here[None, None, :], d)
-        to = np.where(T.terminated[idx], M * N, new_mask * N + new_pos) + base
+        f = flag_table.take(idx)
+        new_mask = masks[None, :, None] | np.where(f & 2, bits_d, np.uint64(0))
+        new_pos = np.where(f & 4, here[None, None, :], d[:, None, :])
+        to = np.where(f & 1, M * N, new_mask.astype(np.intp) * N + new_pos) + base
         nxt[a, :, : M * N] = to.reshape(B, M * N)
-        reward[a, :, : M * N] = tenths[idx].reshape(B, M * N)
-        wins[a, :, : M * N] = ((T.events[idx] & rules.EV_TERMINAL) != 0).reshape(B, M * N)
+        reward[a, :, : M * N] = tenths.take(idx).reshape(B, M * N)
+        wins[a, :, : M * N] = (f & 8).astype(bool).reshape(B, M * N)
         nxt[a, :, M * N] = base[:, 0, 0] + M * N  # the sink stays put, worth 0
     start = np.arange(B, dtype=np.intp) * S1 + np.asarray(starts, dtype=np.intp)
     return _Graph(nxt.reshape(4, -1), reward.reshape(4, -1), wins.reshape(4, -1), start, S1)
