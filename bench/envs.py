@@ -118,10 +118,19 @@ def level_rates(seconds: float, sizes: tuple[int, ...] = (1, 64, 4096)) -> None:
         row |= {"wall_s": round(wall, 3), "levels_per_s": round(levels / wall)}
         row |= {"cpu_levels_per_s": round(levels / cpu) if cpu > 0 else None}
         print(json.dumps(row), flush=True)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     make_batched("rgw-random", 4096, seed=12345).reset()
     first = {"bench": "levels", "env": "rgw-random", "mode": "first_reset", "n": 4096}
-    print(json.dumps(first | {"wall_s": round(time.perf_counter() - t0, 3)}), flush=True)
+    first |= {"wall_s": round(time.perf_counter() - t0, 3)}
+    print(json.dumps(first | {"cpu_s": round(time.thread_time() - c0, 3)}), flush=True)
+    # What uniformly random actions score against the levels' optimal returns.
+    from neurosym.agent.cli_eval import score
+
+    rng = np.random.default_rng(0)
+    got = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 500, seed=0)
+    keys = ("success_rate", "optimal_rate", "sword_first_guarded", "no_detour_decoy")
+    row = {"bench": "random_policy", "env": "rgw-random", "episodes": 500}
+    print(json.dumps(row | {k: round(got[k], 4) for k in keys}), flush=True)
 
 
 def emit(env: str, mode: str, n: int, result: tuple[int, float, float], **extra) -> None:

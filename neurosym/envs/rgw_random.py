@@ -53,7 +53,7 @@ from neurosym.envs.rgw_solver import (
     UNREACHED,
     Rules,
     bfs,
-    level_kinds,
+    kinds_and_route,
     solve_levels,
 )
 from neurosym.errors import ConfigError
@@ -299,8 +299,8 @@ def generate_levels(
     for attempt in range(cfg.max_attempts):
         keys = level_keys(seeds[pending], episodes[pending], attempt)
         c, s, ok = _candidates(cfg, keys, want[pending])
-        k = np.stack(level_kinds(c, s, H, W), axis=1)  # (b, 3)
-        route = _route_length(c, s, H, W)
+        kinds_c, route = kinds_and_route(c, s, H, W)
+        k = np.stack(kinds_c, axis=1)  # (b, 3)
         ok &= (k == want[pending]).all(axis=1) & (route >= cfg.min_route_length)
         idx = np.flatnonzero(ok)
         if len(idx):
@@ -319,14 +319,6 @@ def generate_levels(
         f"no solvable level found in {cfg.max_attempts} attempts for {len(pending)} of {B} keys "
         f"with {asdict(cfg)}; use fewer walls, pits or enemies"
     )
-
-
-def _route_length(cells: np.ndarray, starts: np.ndarray, height: int, width: int) -> np.ndarray:
-    """(B,) fewest steps to the terminal, pits avoided, enemies and mountains passable."""
-    from neurosym.envs.rgw_solver import terminal_steps
-
-    passable = (cells != rules.WALL) & (cells != rules.PIT)
-    return terminal_steps(cells, starts, height, width, passable)
 
 
 class LevelRing:

@@ -158,10 +158,26 @@ def teleport_pairs(cells: np.ndarray) -> np.ndarray:
 def terminal_steps(
     cells: np.ndarray, starts: np.ndarray, height: int, width: int, passable: np.ndarray
 ) -> np.ndarray:
-    """(B,) fewest steps from the start to any terminal over ``passable`` cells (UNREACHED: none)."""
+    """Fewest steps from the start to any terminal over ``passable`` cells (UNREACHED: none).
+
+    ``passable`` may stack several variants of the levels: (V, B, N) gives (V, B).
+    """
     is_terminal = cells == rules.TERMINAL
-    d = bfs(starts, passable | is_terminal, ~is_terminal, teleport_pairs(cells), height, width)
-    return np.where(is_terminal, d, UNREACHED).min(axis=1)
+    B, N = cells.shape
+    stacked = passable.ndim == 3
+    passable = passable.reshape(-1, B, N)
+    V = len(passable)
+    term = np.broadcast_to(is_terminal, (V, B, N)).reshape(V * B, N)
+    d = bfs(
+        np.tile(starts, V),
+        passable.reshape(V * B, N) | term,
+        ~term,
+        np.tile(teleport_pairs(cells), (V, 1)),
+        height,
+        width,
+    )
+    steps = np.where(term, d, UNREACHED).min(axis=1).reshape(V, B)
+    return steps if stacked else steps[0]
 
 
 class LevelKinds(NamedTuple):
@@ -181,24 +197,36 @@ def level_kinds(cells: np.ndarray, starts: np.ndarray, height: int, width: int) 
     the shortest route with mountains and pits counted as empty cells is
     shorter than the shortest route that avoids them, or only the former exists.
     """
-    cells = np.asarray(cells)
-    starts = np.asarray(starts)
+    return kinds_and_route(cells, starts, height, width)[0]
+
+
+def kinds_and_route(
+    cells: np.ndarray, starts: np.ndarray, height: int, width: int
+) -> tuple[LevelKinds, np.ndarray]:
+    """:func:`level_kinds` and (B,) the fewest steps to a terminal avoiding pits, in one search.
+
+    The five variants of the map (clear, no enemy, no teleport, hazards as
+    empty, no hazards) are searched side by side as one batch.
+    """
+    cells = np.atleast_2d(np.asarray(cells))
+    starts = np.atleast_1d(np.asarray(starts))
     wall = cells == rules.WALL
     pit = cells == rules.PIT
     enemy = cells == rules.ENEMY
     mountain = cells == rules.MOUNTAIN
     tele = (cells == rules.TELEPORT) | (cells == rules.TELEPORT_MOUNTAIN)
     clear = ~wall & ~pit
-    reach = terminal_steps(cells, starts, height, width, clear) < UNREACHED
-    unguarded = terminal_steps(cells, starts, height, width, clear & ~enemy) < UNREACHED
-    no_tele = terminal_steps(cells, starts, height, width, clear & ~tele) < UNREACHED
-    geometric = terminal_steps(cells, starts, height, width, ~wall)
-    avoiding = terminal_steps(cells, starts, height, width, clear & ~mountain)
-    return LevelKinds(
-        guarded=reach & ~unguarded,
-        needs_teleport=reach & ~no_tele,
+    variants = np.stack([clear, clear & ~enemy, clear & ~tele, ~wall, clear & ~mountain])
+    route, unguarded, no_tele, geometric, avoiding = terminal_steps(
+        cells, starts, height, width, variants
+    )
+    reach = route < UNREACHED
+    kinds = LevelKinds(
+        guarded=reach & (unguarded >= UNREACHED),
+        needs_teleport=reach & (no_tele >= UNREACHED),
         hazard_on_route=(geometric < UNREACHED) & (avoiding > geometric),
     )
+    return kinds, route
 
 
 # -- the optimal-return search ---------------------------------------------------------
