@@ -10,9 +10,11 @@ the most likely action.
 On Relational-Grid-World the report adds the level-aware figures of
 :mod:`neurosym.agent.evaluation`: ``optimal_rate``, ``sword_first_guarded``,
 ``no_detour_decoy`` (and their episode counts). On rgw-random the level is a
-function of the reset seed: evaluate on seeds that training did not use
-(training seeds its sub-envs from ``--seed``; ``neurosym eval --seed 1000000``
-plays levels no short run has seen).
+function of the reset seed (and the resets since): episode k plays level
+(seed + k, 0). Training's sub-envs play levels (s + i, 0), (s + i, 1), ...
+with s below 2**31 (``trainer._env_seed``), so ``--seed 3000000000`` evaluates
+on levels no training run has played; the default ``--seed 0`` shares a few
+first levels with a run trained with ``--seed 0``.
 """
 
 from __future__ import annotations

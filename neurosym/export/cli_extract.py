@@ -1,6 +1,6 @@
 """``neurosym extract``: record episodes, extract the R-vector facts, write the KB, print answers.
 
-    neurosym extract --checkpoint ckpt.pt [--env rgw2] [--episodes 20] [--seed 0]
+    neurosym extract --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--episodes 20] [--seed 0]
         [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
         [--format pl,parquet] [--qlf]
 
@@ -12,8 +12,9 @@ Writes into ``--out`` (default ``kb_out/<env>``):
 
 Everything is computed in memory first and then moved into place, each file
 or folder by one rename, so a failed run writes nothing and a reader never
-sees half a KB. A checkpoint that cannot be read, or that was trained on
-another env, is refused before anything is recorded.
+sees half a KB. A checkpoint that cannot be read, or that cannot play
+``--env`` (another env family or observation shape), is refused before
+anything is recorded; any env of its family with its shape is fine.
 """
 
 from __future__ import annotations
