@@ -3,8 +3,8 @@
 Two questions about a level, asked of many levels at once with array operations:
 
 * :func:`solve_levels`: the best return any route earns within the step limit,
-  and whether any route reaches a terminal at all (solvable, whatever the limit). The search runs over the
-  env's own state space -- agent cell x which swords and enemies are gone
+  and whether any route reaches a terminal at all (solvable, whatever the
+  limit). The search runs over the env's own state space -- agent cell x which swords and enemies are gone
   (holding the sword is "a sword is gone") -- and its transitions are built
   from the very tables the env steps with (:func:`rgw_rules.compile_moves`,
   :func:`rgw_rules.rule_tables`): walls, borders, teleports, mountains' costs,
@@ -22,7 +22,8 @@ Two questions about a level, asked of many levels at once with array operations:
   a pit: the agent pays or detours).
 
 :class:`Plan` keeps every layer of the search and acts optimally from any
-state: the scripted policy that the tests and ``neurosym eval`` checks use.
+state; :class:`Planner` wraps it as a policy for a batched env, the scripted
+agent whose evaluation must show ``optimal_rate`` 1.0 (tests/test_evaluation.py).
 """
 
 from __future__ import annotations
