@@ -12,6 +12,11 @@ line describes the machine, including its load average.
 
     python bench/envs.py                       # rgw2, rgw-random, bw1 (and the rest of --envs)
     python bench/envs.py --envs rgw2 --seconds 0.5 --sizes 1,4096
+    python bench/envs.py --levels-only         # rgw-random level generation: levels/s
+
+For rgw-random it also measures level generation alone (``generate_levels``
+in batches of 1, 64 and 4096, each level searched for its optimal return) and
+the first reset of a batched env of 4096 (which generates its 4096 levels).
 """
 
 from __future__ import annotations
@@ -94,6 +99,40 @@ def batched(name: str, n: int, seconds: float, **kwargs) -> tuple[int, float, fl
     return timed(chunk, seconds)
 
 
+def level_rates(seconds: float, sizes: tuple[int, ...] = (1, 64, 4096)) -> None:
+    """rgw-random: levels generated per second (wall and CPU) per batch size; the first reset."""
+    from neurosym.envs.rgw_random import RandomLevelConfig, generate_levels
+
+    cfg = RandomLevelConfig()
+    for size in sizes:
+        calls = [0]
+
+        def chunk(size: int = size, calls: list[int] = calls) -> int:
+            seeds = np.arange(size, dtype=np.uint64) + np.uint64(calls[0] * size)
+            generate_levels(cfg, seeds, np.zeros(size, dtype=np.int64))
+            calls[0] += 1
+            return size
+
+        levels, wall, cpu = timed(chunk, seconds)
+        row = {"bench": "levels", "env": "rgw-random", "batch": size, "levels": levels}
+        row |= {"wall_s": round(wall, 3), "levels_per_s": round(levels / wall)}
+        row |= {"cpu_levels_per_s": round(levels / cpu) if cpu > 0 else None}
+        print(json.dumps(row), flush=True)
+    t0, c0 = time.perf_counter(), time.thread_time()
+    make_batched("rgw-random", 4096, seed=12345).reset()
+    first = {"bench": "levels", "env": "rgw-random", "mode": "first_reset", "n": 4096}
+    first |= {"wall_s": round(time.perf_counter() - t0, 3)}
+    print(json.dumps(first | {"cpu_s": round(time.thread_time() - c0, 3)}), flush=True)
+    # What uniformly random actions score against the levels' optimal returns.
+    from neurosym.agent.cli_eval import score
+
+    rng = np.random.default_rng(0)
+    got = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 500, seed=0)
+    keys = ("success_rate", "optimal_rate", "sword_first_guarded", "no_detour_decoy")
+    row = {"bench": "random_policy", "env": "rgw-random", "episodes": 500}
+    print(json.dumps(row | {k: round(got[k], 4) for k in keys}), flush=True)
+
+
 def emit(env: str, mode: str, n: int, result: tuple[int, float, float], **extra) -> None:
     steps, wall, cpu = result
     row = {
@@ -119,6 +158,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--seconds", type=float, default=1.0, help="Time per measurement (default 1).")
     p.add_argument("--naive-n", type=int, default=64, help="Envs in the naive loop (default 64).")
+    p.add_argument("--levels-only", action="store_true", help="Only rgw-random's level generation.")
     args = p.parse_args(argv)
     names = [s for s in args.envs.split(",") if s]
     for name in names:
@@ -138,7 +178,12 @@ def main(argv: list[str] | None = None) -> int:
         ),
         flush=True,
     )
+    if args.levels_only:
+        level_rates(args.seconds)
+        return 0
     for name in names:
+        if name == "rgw-random":
+            level_rates(args.seconds)
         rgw = env_family(name) == "rgw"
         emit(name, "single", 1, single(name, args.seconds))
         emit(name, "naive_loop", args.naive_n, naive_loop(name, args.naive_n, args.seconds))

@@ -26,6 +26,7 @@ _LAZY = {
     "Recording": "neurosym.export.recording",
     "extract_facts": "neurosym.export.facts",
     "FactSet": "neurosym.export.facts",
+    "head_summary": "neurosym.export.heads",
     "KnowledgeBase": "neurosym.prolog.knowledge_base",
     "NeurosymError": "neurosym.errors",
     "PrologError": "neurosym.errors",

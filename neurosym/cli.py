@@ -18,9 +18,10 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 from neurosym import __version__
-from neurosym.errors import NeurosymError
+from neurosym.errors import ConfigError, NeurosymError
 
 
 def add_action_mode(parser: argparse.ArgumentParser) -> None:
@@ -36,6 +37,44 @@ def add_action_mode(parser: argparse.ArgumentParser) -> None:
     mode.add_argument(
         "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
     )
+
+
+def add_env_options(parser: argparse.ArgumentParser) -> None:
+    """``--env NAME`` and ``--map FILE``: where eval and extract play the checkpoint."""
+    parser.add_argument(
+        "--env",
+        metavar="NAME",
+        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
+        "shape (default: the checkpoint's own)",
+    )
+    parser.add_argument(
+        "--map",
+        metavar="FILE",
+        help="RGW: play this map file on a fixed-map env (--env rgw1 or rgw2, default rgw2)",
+    )
+
+
+def map_option(
+    env: str | None, map_file: str | None, trained: str
+) -> tuple[str | None, dict[str, Any] | None]:
+    """(env name or None, env options or None) for ``--env`` and ``--map``.
+
+    ``--map FILE`` plays a user's map on a fixed-map RGW env: ``--env`` rgw1 or
+    rgw2, or none (then rgw2's: a checkpoint of rgw-random plays it too).
+    """
+    from neurosym.envs import canonical_name, env_family
+
+    if map_file is None:
+        return env, None
+    name = canonical_name(env) if env else None
+    if env_family(name or trained) != "rgw" or name not in (None, "rgw1", "rgw2"):
+        raise ConfigError(
+            f"--map goes with a fixed-map RGW env (--env rgw1 or rgw2, or none), not {name or trained}"
+        )
+    from neurosym.envs.rgw_maps import load_map
+
+    load_map(map_file)  # a bad map is refused here, naming its row and column
+    return name or "rgw2", {"map": map_file}
 
 
 # name -> (module, one-line help)

@@ -55,7 +55,10 @@ def test_single_env_contract(name: str) -> None:
     assert obs.dtype == np.uint8 and obs.shape == space.shape and obs in space
     C, H, W = obs.shape
     assert env.unwrapped.obs_scale == (1.0 if name.startswith("rgw") else 1 / 255)
-    assert set(info) == {"agent", "holding", "objects", "events", "outcome"}
+    level = {"optimal_return", "guarded", "needs_teleport", "hazard_on_route"}
+    assert set(info) == {"agent", "holding", "objects", "events", "outcome"} | (
+        level if name.startswith("rgw") else set()
+    )
     assert info["events"] == () and info["outcome"] is None
     grid = env.unwrapped.entity_grid()
     names = env.unwrapped.entity_names
@@ -68,7 +71,14 @@ def test_single_env_contract(name: str) -> None:
         assert obs in space and isinstance(r, float), f"[{t}]"
         assert all(isinstance(e, str) for e in info["events"]), f"[{t}]"
         if term or trunc:
-            assert info["outcome"] in ("terminal", "pit", "timeout", "gem", "distractor"), f"[{t}]"
+            assert info["outcome"] in (
+                "terminal",
+                "pit",
+                "enemy",
+                "timeout",
+                "gem",
+                "distractor",
+            ), f"[{t}]"
             break
 
 
@@ -79,6 +89,7 @@ def test_batched_env_contract(name: str) -> None:
     obs, info = vec.reset()
     assert obs.shape == (6, *single.observation_space.shape) and obs.dtype == np.uint8
     assert vec.unwrapped.entity_grid().shape == (6, *obs.shape[2:])
+    level = {"optimal_return", "guarded", "needs_teleport", "hazard_on_route"}
     for i in range(6):
         assert set(vec.unwrapped.decode_info(info, i)) == {
             "agent",
@@ -86,7 +97,7 @@ def test_batched_env_contract(name: str) -> None:
             "objects",
             "events",
             "outcome",
-        }
+        } | (level if name.startswith("rgw") else set())
     for _ in range(10):
         obs, r, term, trunc, info = vec.step(np.arange(6) % 4)
     assert r.shape == term.shape == trunc.shape == (6,)

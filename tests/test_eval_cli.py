@@ -68,7 +68,8 @@ def test_eval_text_and_sample(neurosym, untrained: Path) -> None:
     [
         (("--checkpoint", "missing.pt"), "checkpoint not found: missing.pt"),
         (("--episodes", "0"), "--episodes must be a positive integer"),
-        (("--env", "rgw1"), "was trained on rgw2, not rgw1"),
+        (("--env", "bw2"), "bw2 is a boxworld environment: pick one of rgw1, rgw2, rgw-random"),
+        (("--env", "rgw-random", "--map", "m.txt"), "--map goes with a fixed-map RGW env"),
     ],
 )
 def test_eval_errors_are_one_line(

@@ -106,7 +106,9 @@ def test_extract_writes_the_kb_and_prints_the_answers(
 @pytest.mark.parametrize(
     ("args", "parts"),
     [
-        (["--env", "rgw1"], ["was trained on rgw2, not rgw1"]),
+        (["--env", "bw1"], ["was trained on rgw2 (rgw family", "bw1 is a boxworld environment"]),
+        (["--map", "nowhere.txt"], ["map 'nowhere.txt'"]),
+        (["--env", "rgw-random", "--map", "x.txt"], ["--map goes with a fixed-map RGW env"]),
         (["--env", "nowhere"], ["nowhere"]),
         (["--env", "rgw2", "--threshold", "top:5"], ["bad threshold 'top:5'", "quantile:0.9"]),
         (["--env", "rgw2", "--format", "pl,csv"], ["bad --format 'pl,csv'", "pl, parquet"]),

@@ -203,9 +203,20 @@ def test_torch_threads_are_restored() -> None:
     assert torch.get_num_threads() == before
 
 
-def test_env_the_agent_was_not_trained_on_is_refused() -> None:
-    with pytest.raises(CheckpointError, match="was trained on rgw2, not rgw1"):
-        record(small_agent("rgw2"), "rgw1", episodes=1)
+def test_env_of_another_family_or_shape_is_refused() -> None:
+    with pytest.raises(CheckpointError, match=r"bw1 is a boxworld environment"):
+        record(small_agent("rgw2"), "bw1", episodes=1)
+    with pytest.raises(
+        CheckpointError, match=r"observations \(9, 10, 10\); rgw2 .* gives \(9, 2, 3\)"
+    ):
+        record(small_agent("rgw2"), "rgw2", episodes=1, env_kwargs={"map": "AET\nS..\n"})
+
+
+def test_an_agent_records_on_other_envs_of_its_family() -> None:
+    rec = record(small_agent("rgw2"), "rgw-random", episodes=2, seed=4)
+    assert rec.meta["env"] == "rgw-random" and len(rec.episodes) == 2
+    rec = record(small_agent("rgw2"), "rgw1", episodes=1)
+    assert rec.meta["env"] == "rgw1" and rec.meta["env_kwargs"] == {}
 
 
 @pytest.mark.parametrize(

@@ -106,8 +106,12 @@ def test_no_route_on_rgw2_beats_10_7() -> None:
 # -- reference models -----------------------------------------------------------
 
 
-def reference_default(rows: list[str], pos, holding, enemy_alive, action):
-    """The thesis text's rules, cell by cell. Returns (pos, reward, done, holding, events)."""
+def reference_default(rows: list[str], pos, holding, enemy_alive, action, enemy="pass"):
+    """The thesis text's rules, cell by cell. Returns (pos, reward, done, holding, events).
+
+    ``enemy``: what an unarmed meeting does: pass (-1, stand on its cell),
+    block (-1, stay where it was), end (-1, the episode ends).
+    """
     H, W = len(rows), len(rows[0])
     r, c = pos
     dr, dc = DELTA[action]
@@ -127,6 +131,10 @@ def reference_default(rows: list[str], pos, holding, enemy_alive, action):
     if ch == "E" and enemy_alive:
         if holding:
             return (nr, nc), 1.0, False, holding, [*events, "defeated(enemy)"]
+        if enemy == "block":
+            return pos, -1.0, False, holding, [*events, "hurt_by(enemy)", "bumped(enemy)"]
+        if enemy == "end":
+            return (nr, nc), -1.0, True, holding, [*events, "hurt_by(enemy)", "killed_by(enemy)"]
         return (nr, nc), -1.0, False, holding, [*events, "hurt_by(enemy)"]
     if ch == "M":
         return (nr, nc), -0.1, False, holding, [*events, "crossed(mountain)"]
@@ -172,15 +180,16 @@ def all_states(rows: list[str]):
                         yield (r, c), holding, a
 
 
+@pytest.mark.parametrize("enemy", ["pass", "block", "end"])
 @pytest.mark.parametrize("name", ["rgw1", "rgw2"])
-def test_every_transition_matches_the_default_reference(name: str) -> None:
+def test_every_transition_matches_the_default_reference(name: str, enemy: str) -> None:
     rows = load_map(name).text().replace("A", ".").split()
-    env = RGWEnv(name)
+    env = RGWEnv(name, enemy=enemy)
     env.reset(seed=0)
     for (r, c), holding, a in all_states(rows):
         env.set_state((r, c), holding=holding)
         _, rew, term, trunc, info = env.step(a)
-        want = reference_default(rows, (r, c), holding, True, a)
+        want = reference_default(rows, (r, c), holding, True, a, enemy)
         got = (info["agent"], rew, term, bool(info["holding"]), list(info["events"]))
         assert got == want, f"({r},{c}) holding={holding} action={a}: {got} != {want}"
         assert not trunc
@@ -415,3 +424,124 @@ def test_bad_actions_are_refused() -> None:
         with pytest.raises(ValueError, match="action must be an integer 0..3"):
             env.step(bad)
     env.step(np.int64(2))  # numpy integers are fine
+
+
+# -- what an unarmed meeting with the enemy does: exact tables, single and batched -------
+
+# Agent on a mountain beside the enemy: a blocked step keeps it on the mountain.
+GUARD = """\
+AME
+S.T
+"""
+
+# (enemy, actions, expected per step: (agent, reward, terminated, events, holding, outcome))
+ENEMY_CASES = [
+    pytest.param(
+        "pass",
+        [RIGHT, RIGHT, DOWN],
+        [
+            ((0, 1), -0.1, False, ("crossed(mountain)",), (), None),
+            ((0, 2), -1.0, False, ("hurt_by(enemy)",), (), None),  # passes, stands on it
+            ((1, 2), 10.0, True, ("reached(terminal)",), (), "terminal"),
+        ],
+        id="pass",
+    ),
+    pytest.param(
+        "block",
+        [RIGHT, RIGHT, RIGHT, UP, LEFT, LEFT, DOWN, RIGHT, RIGHT],
+        [
+            ((0, 1), -0.1, False, ("crossed(mountain)",), (), None),
+            ((0, 1), -1.0, False, ("hurt_by(enemy)", "bumped(enemy)"), (), None),  # stays
+            ((0, 1), -1.0, False, ("hurt_by(enemy)", "bumped(enemy)"), (), None),  # every time
+            ((0, 1), 0.0, False, ("bumped(border)",), (), None),  # staying pays nothing
+            ((0, 0), 0.0, False, (), (), None),
+            ((0, 0), 0.0, False, ("bumped(border)",), (), None),
+            ((1, 0), 0.0, False, ("picked(sword)",), ("sword",), None),
+            ((1, 1), 0.0, False, (), ("sword",), None),
+            ((1, 2), 10.0, True, ("reached(terminal)",), ("sword",), "terminal"),
+        ],
+        id="block",
+    ),
+    pytest.param(
+        "block",
+        [DOWN, UP, RIGHT, RIGHT, LEFT, RIGHT, DOWN],
+        [
+            ((1, 0), 0.0, False, ("picked(sword)",), ("sword",), None),
+            ((0, 0), 0.0, False, (), ("sword",), None),
+            ((0, 1), -0.1, False, ("crossed(mountain)",), ("sword",), None),
+            ((0, 2), 1.0, False, ("defeated(enemy)",), ("sword",), None),  # armed: unchanged
+            ((0, 1), -0.1, False, ("crossed(mountain)",), ("sword",), None),
+            ((0, 2), 0.0, False, (), ("sword",), None),  # the enemy is gone
+            ((1, 2), 10.0, True, ("reached(terminal)",), ("sword",), "terminal"),
+        ],
+        id="block-armed",
+    ),
+    pytest.param(
+        "end",
+        [RIGHT, RIGHT],
+        [
+            ((0, 1), -0.1, False, ("crossed(mountain)",), (), None),
+            ((0, 2), -1.0, True, ("hurt_by(enemy)", "killed_by(enemy)"), (), "enemy"),
+        ],
+        id="end",
+    ),
+    pytest.param(
+        "end",
+        [DOWN, UP, RIGHT, RIGHT, DOWN],
+        [
+            ((1, 0), 0.0, False, ("picked(sword)",), ("sword",), None),
+            ((0, 0), 0.0, False, (), ("sword",), None),
+            ((0, 1), -0.1, False, ("crossed(mountain)",), ("sword",), None),
+            ((0, 2), 1.0, False, ("defeated(enemy)",), ("sword",), None),
+            ((1, 2), 10.0, True, ("reached(terminal)",), ("sword",), "terminal"),
+        ],
+        id="end-armed",
+    ),
+]
+
+
+def _redraw(grid: np.ndarray, holding: bool) -> np.ndarray:
+    """The onehot observation drawn from scratch from an entity grid."""
+    obs = (grid[None] == np.arange(9)[:, None, None]).astype(np.uint8)
+    obs[8] = holding
+    return obs
+
+
+@pytest.mark.parametrize(("enemy", "actions", "expected"), ENEMY_CASES)
+def test_enemy_mode_table_single_and_batched(enemy: str, actions: list[int], expected) -> None:
+    from neurosym.envs.rgw_vector import RGWVectorEnv
+
+    env = RGWEnv(GUARD, enemy=enemy)
+    vec = RGWVectorEnv(1, map=GUARD, enemy=enemy)
+    env.reset(seed=0)
+    vec.reset(seed=0)
+    for t, (a, (agent, reward, term, events, holding, outcome)) in enumerate(
+        zip(actions, expected, strict=True)
+    ):
+        obs, r, te, tr, info = env.step(a)
+        vobs, vr, vte, vtr, vinfo = vec.step([a])
+        want = (agent, reward, term, events, holding, outcome)
+        got = (info["agent"], r, te, info["events"], info["holding"], info["outcome"])
+        assert got == want, f"[{t}] single {got} != {want}"
+        vgot = vec.decode_info(vinfo, 0)
+        vgot = (vgot["agent"], vr[0], vte[0], vgot["events"], vgot["holding"], vgot["outcome"])
+        assert vgot == want, f"[{t}] batched {vgot} != {want}"
+        assert not tr and not vtr[0], f"[{t}] truncated"
+        assert (obs == vobs[0]).all(), f"[{t}] observations differ"
+        assert (obs == _redraw(env.entity_grid(), bool(holding))).all(), f"[{t}] not a redraw"
+
+
+def test_enemy_mode_is_checked() -> None:
+    from neurosym.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="enemy 'wall' is not one of pass, block, end"):
+        RGWEnv("rgw2", enemy="wall")
+    with pytest.raises(ConfigError, match="classic=True: the original release always lets"):
+        RGWEnv("rgw2", classic=True, enemy="block")
+    assert RGWEnv("rgw2").enemy == "pass"  # the thesis's rule stays the default
+
+
+@pytest.mark.parametrize("enemy", ["pass", "block", "end"])
+def test_rgw2_optimal_route_in_every_enemy_mode(enemy: str) -> None:
+    total, _ = play(RGWEnv("rgw2", enemy=enemy), RGW2_OPTIMAL)
+    assert round(total, 9) == 10.7

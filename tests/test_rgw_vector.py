@@ -68,8 +68,10 @@ def run_lockstep(
         {"map": "rgw1", "max_steps": 25},
         {"map": "rgw2", "classic": True, "obs_mode": "grey", "max_steps": 30},
         {"map": "rgw2", "classic": True, "max_steps": 40},
+        {"map": "rgw1", "enemy": "block", "max_steps": 40},
+        {"map": "rgw2", "enemy": "end", "obs_mode": "grey"},
     ],
-    ids=["rgw2", "rgw1-short", "rgw2-classic-grey", "rgw2-classic"],
+    ids=["rgw2", "rgw1-short", "rgw2-classic-grey", "rgw2-classic", "rgw1-block", "rgw2-end-grey"],
 )
 def test_lockstep_fixed_maps(kwargs: dict) -> None:
     single_kwargs = dict(kwargs)
@@ -80,9 +82,18 @@ def test_lockstep_fixed_maps(kwargs: dict) -> None:
     assert episodes >= 5  # autoresets were exercised
 
 
-@pytest.mark.parametrize("classic", [False, True])
-def test_lockstep_random_levels(classic: bool) -> None:
-    kw = {"classic": classic, "max_steps": 30, "num_enemies": 2}
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"classic": False},  # enemy="block", rgw-random's default
+        {"classic": True},  # enemy="pass", the only one classic rules have
+        {"enemy": "end"},
+        {"enemy": "pass"},
+    ],
+    ids=["block", "classic", "end", "pass"],
+)
+def test_lockstep_random_levels(kw: dict) -> None:
+    kw = {**kw, "max_steps": 30, "num_enemies": 2}
     episodes = run_lockstep(lambda: RGWRandomEnv(**kw), lambda n: RGWRandomVectorEnv(n, **kw))
     assert episodes >= 10
 
@@ -157,8 +168,10 @@ def test_render_modes() -> None:
         (lambda: RGWVectorEnv(16, map="rgw2", classic=True, max_steps=40), "onehot"),
         (lambda: RGWVectorEnv(16, map="rgw2", obs_mode="grey", max_steps=40), "grey"),
         (lambda: RGWRandomVectorEnv(16, max_steps=40, num_enemies=3), "onehot"),
+        (lambda: RGWVectorEnv(16, map="rgw2", enemy="block", max_steps=40), "onehot"),
+        (lambda: RGWRandomVectorEnv(16, max_steps=40, obs_mode="grey", enemy="end"), "grey"),
     ],
-    ids=["default", "classic", "grey", "random"],
+    ids=["default", "classic", "grey", "random", "block", "random-end-grey"],
 )
 def test_incremental_observation_equals_a_full_redraw(make_vec, obs_mode: str) -> None:
     """The in-place updates must give what drawing the state from scratch gives."""

@@ -180,7 +180,7 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
         ),
         (
             ["rvectors", "--checkpoint", "{predinet}", "--env", "bw1"],
-            "expects observations of shape (9, 10, 10), but bw1 gives (3, 14, 14)",
+            "bw1 is a boxworld environment: pick one of rgw1, rgw2, rgw-random",
         ),
         (
             ["relations", "--recording", "{recording}", "--threshold", "quantile:2"],

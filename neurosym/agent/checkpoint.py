@@ -18,8 +18,16 @@ A checkpoint is a dict of tensors and plain values (DESIGN.md "Checkpoint"):
 
 It is always read with ``torch.load(weights_only=True)``, so a pickled object
 (a malicious ``__reduce__``) is refused without running it. Every way a file
-can be wrong (missing, truncated, foreign, for another env, another model
-config) is one line of :class:`~neurosym.errors.CheckpointError`.
+can be wrong (missing, truncated, foreign, for another env family or
+observation shape, another model config) is one line of
+:class:`~neurosym.errors.CheckpointError`.
+
+A checkpoint runs on any environment of its family whose observations have
+its shape (DESIGN.md): an agent trained on rgw-random plays rgw1, rgw2 or a
+user's map, and the other way round. :func:`env_for` decides which env and
+which options: on its own env, the options it was trained with; on another,
+that env's own options, except those that shape the observation
+(``CARRIED_OPTIONS``), which carry over.
 """
 
 from __future__ import annotations
@@ -41,6 +49,9 @@ from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
 from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
+
+CARRIED_OPTIONS = ("obs_mode",)
+"""env options a checkpoint brings to another env of its family: they decide the observation"""
 
 FORMAT = "neurosym-checkpoint"
 FORMAT_VERSION = 1
@@ -179,8 +190,9 @@ def read_checkpoint(
 ) -> dict[str, Any]:
     """Read and validate a checkpoint; the payload dict with ``model_config`` as a ModelConfig.
 
-    ``env``: refuse a checkpoint trained on another environment. ``config``:
-    refuse one whose model config differs (named field by field).
+    ``env``: refuse a checkpoint that cannot run there (another family or
+    observation shape, see :func:`env_for`). ``config``: refuse one whose
+    model config differs (named field by field).
     """
     path = Path(path)
     payload = _load_raw(path)
@@ -216,11 +228,7 @@ def read_checkpoint(
     except ConfigError as exc:
         raise CheckpointError(f"checkpoint {path} has a bad model config: {exc}") from None
     if env is not None:
-        from neurosym.envs import canonical_name
-
-        want = canonical_name(env)
-        if canonical_name(env_name) != want:
-            raise CheckpointError(f"{path} was trained on {env_name}, not {want}")
+        check_env_fits(str(path), env_name, model_config.obs_shape, env, env_options(payload, env))
     if config is not None:
         expected = config if isinstance(config, ModelConfig) else ModelConfig.from_dict(config)
         mine, theirs = model_config.to_dict(), expected.to_dict()
@@ -301,3 +309,77 @@ def load_agent(
         meta=meta,
         path=str(path),
     )
+
+
+def env_options(
+    payload: dict[str, Any] | Any, env: str, overrides: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The options to make ``env`` with for this checkpoint (a payload dict or an Agent).
+
+    Its own env: the options it was trained with; another env: only
+    CARRIED_OPTIONS of them. ``overrides`` (the user's, e.g. ``map``) win.
+    """
+    from neurosym.envs import canonical_name
+
+    if isinstance(payload, dict):
+        trained, kwargs = payload["env"], payload["env_kwargs"]
+    else:  # an Agent, or anything shaped like one
+        trained, kwargs = payload.env_name, getattr(payload, "env_kwargs", None)
+    kwargs = dict(kwargs or {})
+    if canonical_name(env) != canonical_name(trained):
+        kwargs = {k: v for k, v in kwargs.items() if k in CARRIED_OPTIONS}
+    return {**kwargs, **dict(overrides or {})}
+
+
+def check_env_fits(
+    label: str,
+    trained: str,
+    obs_shape: tuple[int, ...] | list[int],
+    env: str,
+    env_kwargs: dict[str, Any],
+) -> None:
+    """Refuse, in one line naming both, an env of another family or observation shape."""
+    from neurosym.envs import ENVS, canonical_name, env_family, make
+
+    name, trained = canonical_name(env), canonical_name(trained)
+    family, theirs = env_family(trained), env_family(name)
+    shape = tuple(int(v) for v in obs_shape)
+    if family != theirs:
+        same = ", ".join(n for n in ENVS if env_family(n) == family)
+        raise CheckpointError(
+            f"{label} was trained on {trained} ({family} family, observations {shape}); "
+            f"{name} is a {theirs} environment: pick one of {same}"
+        )
+    probe = make(name, **env_kwargs)
+    try:
+        got = tuple(int(v) for v in probe.observation_space.shape)
+    finally:
+        probe.close()
+    if got != shape:
+        raise CheckpointError(
+            f"{label} was trained on {trained} with observations {shape}; {name} "
+            f"{_options_text(env_kwargs)}gives {got}: pick an environment of the same shape"
+        )
+
+
+def _options_text(kwargs: dict[str, Any]) -> str:
+    return f"({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) " if kwargs else ""
+
+
+def env_for(
+    agent: Agent | Any, env: str | None = None, overrides: dict[str, Any] | None = None
+) -> tuple[str, dict[str, Any]]:
+    """(short env name, options) to run ``agent`` on: its own env by default, or ``env``.
+
+    ``env`` may be any env of the agent's family whose observations have its
+    shape (checked; CheckpointError otherwise); ``overrides`` are options of
+    the user's (e.g. ``{"map": "my_map.txt"}``) on top of :func:`env_options`.
+    """
+    from neurosym.envs import canonical_name
+
+    name = canonical_name(env if env is not None else agent.env_name)
+    kwargs = env_options(agent, name, overrides)
+    if name != canonical_name(agent.env_name) or overrides:
+        label = getattr(agent, "path", None) or "the agent"
+        check_env_fits(label, agent.env_name, agent.config.obs_shape, name, kwargs)
+    return name, kwargs

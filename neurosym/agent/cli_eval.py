@@ -1,9 +1,20 @@
 """``neurosym eval``: mean return, success rate and outcome counts of a checkpoint.
 
 Episode k is played from ``reset(seed=seed + k)`` on the env the checkpoint
-was trained on (with its env options); episodes run side by side in batches.
-``--sample`` draws actions from the policy with a torch generator seeded with
-``--seed``; ``--greedy`` (the default) takes the most likely action.
+was trained on (with its env options), or on ``--env`` (any env of its family
+with its observation shape; ``--map FILE`` for a map of one's own); episodes
+run side by side in batches. ``--sample`` draws actions from the policy with
+a torch generator seeded with ``--seed``; ``--greedy`` (the default) takes
+the most likely action.
+
+On Relational-Grid-World the report adds the level-aware figures of
+:mod:`neurosym.agent.evaluation`: ``optimal_rate``, ``sword_first_guarded``,
+``no_detour_decoy`` (and their episode counts). On rgw-random the level is a
+function of the reset seed (and the resets since): episode k plays level
+(seed + k, 0). Training's sub-envs play levels (s + i, 0), (s + i, 1), ...
+with s below 2**31 (``trainer._env_seed``), so ``--seed 3000000000`` evaluates
+on levels no training run has played; the default ``--seed 0`` shares a few
+first levels with a run trained with ``--seed 0``.
 """
 
 from __future__ import annotations
@@ -13,7 +24,7 @@ import json
 from collections import Counter
 from typing import Any
 
-from neurosym.cli import add_action_mode
+from neurosym.cli import add_action_mode, add_env_options, map_option
 from neurosym.errors import ConfigError
 
 
@@ -21,9 +32,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--checkpoint", required=True, help="checkpoint file (.pt) written by neurosym train"
     )
-    parser.add_argument(
-        "--env", help="environment to evaluate on; must be the checkpoint's (default: it)"
-    )
+    add_env_options(parser)
     parser.add_argument("--episodes", type=int, default=100, help="episodes to play (100)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode (0)")
     add_action_mode(parser)
@@ -31,42 +40,78 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def evaluate(
-    agent: Any, env: str, episodes: int, greedy: bool = True, seed: int = 0
+    agent: Any,
+    env: str | None = None,
+    episodes: int = 100,
+    greedy: bool = True,
+    seed: int = 0,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Play ``episodes`` episodes of ``agent``; a dict of plain values (what --json prints)."""
-    import numpy as np
+    """Play ``episodes`` episodes of ``agent``; a dict of plain values (what --json prints).
+
+    ``env``: any env of the agent's family with its observation shape
+    (default: its own); ``env_kwargs``: options on top (e.g. ``{"map": path}``).
+    """
     import torch
 
-    from neurosym.agent.rollout import SUCCESS_OUTCOMES, play_episodes
-    from neurosym.envs import make_batched
+    from neurosym.agent.checkpoint import env_for
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"--seed must be a non-negative integer, got {seed!r}")
+    env, kwargs = env_for(agent, env, env_kwargs)
     generator = None if greedy else torch.Generator().manual_seed(seed)
-    done = play_episodes(
-        lambda obs: agent.act(obs, greedy=greedy, generator=generator)[0],
-        lambda n: make_batched(env, n, seed=seed, **agent.env_kwargs),
+    report = score(
+        lambda obs, _venv: agent.act(obs, greedy=greedy, generator=generator)[0],
+        env,
+        episodes,
+        seed,
+        kwargs,
+    )
+    return {
+        "checkpoint": agent.path,
+        "env": env,
+        "env_kwargs": kwargs,
+        "module": agent.config.module,
+        "episodes": episodes,
+        "greedy": greedy,
+        "seed": seed,
+        **report,
+        "trained_frames": agent.meta.get("frames"),
+    }
+
+
+def score(
+    act: Any, env: str, episodes: int, seed: int = 0, env_kwargs: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """Play and score ``episodes`` episodes of a policy ``act(obs, venv) -> actions`` on ``env``.
+
+    The figures of the report (returns, success, lengths, outcomes and, on
+    RGW, the level-aware ones); any policy, e.g. a scripted one in tests.
+    """
+    import numpy as np
+
+    from neurosym.agent.evaluation import level_scores, play_scored
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES
+    from neurosym.envs import make_batched
+
+    done = play_scored(
+        act,
+        lambda n: make_batched(env, n, seed=seed, **dict(env_kwargs or {})),
         episodes,
         seed,
     )
     returns = np.asarray(done.returns)
     return {
-        "checkpoint": agent.path,
-        "env": env,
-        "module": agent.config.module,
-        "episodes": episodes,
-        "greedy": greedy,
-        "seed": seed,
         "mean_return": float(returns.mean()),
         "std_return": float(returns.std()),
         "min_return": float(returns.min()),
         "max_return": float(returns.max()),
         "success_rate": float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes])),
+        **level_scores(done),
         "mean_length": float(np.mean(done.lengths)),
         "outcomes": dict(sorted(Counter(done.outcomes).items())),
-        "trained_frames": agent.meta.get("frames"),
     }
 
 
@@ -76,8 +121,12 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.agent.checkpoint import load_agent
 
     torch.set_num_threads(1)
-    agent = load_agent(args.checkpoint, env=args.env)
-    report = evaluate(agent, agent.env_name, args.episodes, args.greedy, args.seed)
+    from neurosym.agent.checkpoint import env_for
+
+    agent = load_agent(args.checkpoint)
+    env, overrides = map_option(args.env, args.map, agent.env_name)
+    env, kwargs = env_for(agent, env, overrides)
+    report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs)
     if args.json:
         print(json.dumps(report))
         return 0
@@ -90,6 +139,22 @@ def run(args: argparse.Namespace) -> int:
     )
     print(f"mean return  {report['mean_return']:.3f} (std {report['std_return']:.3f})")
     print(f"success      {100 * report['success_rate']:.1f} %")
+    for key, label in (
+        ("optimal_rate", "optimal     "),
+        ("sword_first_guarded", "sword first "),
+        ("no_detour_decoy", "no detour   "),
+    ):
+        if report.get(key) is not None:
+            print(f"{label} {100 * report[key]:.1f} %{_of(report, key)}")
     print(f"mean length  {report['mean_length']:.1f} steps")
     print(f"outcomes     {outcomes}")
     return 0
+
+
+def _of(report: dict[str, Any], key: str) -> str:
+    """' (of N guarded levels)' for the shares that count only some episodes."""
+    if key == "sword_first_guarded":
+        return f" (of {report['guarded_episodes']} guarded levels)"
+    if key == "no_detour_decoy":
+        return f" (of {report['decoy_episodes']} decoy levels)"
+    return f" (mean optimal return {report['mean_optimal_return']:.3f})"

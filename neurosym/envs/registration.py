@@ -58,7 +58,8 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "rgw",
         "neurosym.envs.rgw_random:RGWRandomEnv",
         "neurosym.envs.rgw_vector:RGWRandomVectorEnv",
-        "RGW on procedural levels: a new solvable level every episode",
+        "RGW on procedural levels, a new one every episode: blocking enemy; guarded, decoy, "
+        "teleport-only and hazard levels, each with its optimal return",
     ),
     EnvEntry(
         "bw1",

@@ -19,13 +19,21 @@ from neurosym.envs import rgw_rules as rules
 from neurosym.envs.actions import Action
 from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, batch_for
 from neurosym.envs.rgw_maps import load_map
+from neurosym.envs.rgw_solver import Rules
 from neurosym.errors import ConfigError
 
 OBS_MODES = ("onehot", "grey")
 
 
-def check_options(obs_mode: str, max_steps: int | None, render_mode: str | None) -> None:
+def check_options(
+    obs_mode: str,
+    max_steps: int | None,
+    render_mode: str | None,
+    enemy: str = "pass",
+    classic: bool = False,
+) -> None:
     """Refuse bad constructor options with one line naming what would be right."""
+    rules.check_enemy(enemy, bool(classic))
     if obs_mode not in OBS_MODES:
         raise ConfigError(f"obs_mode {obs_mode!r} is not one of {', '.join(OBS_MODES)}")
     if max_steps is not None and (not isinstance(max_steps, int | np.integer) or max_steps < 1):
@@ -77,13 +85,22 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
     ## Rewards
     Default rules (the thesis text), paid on *entering* a cell: mountain -0.1;
     pit -1; terminal +10; enemy +1 when holding the sword (the enemy is
-    defeated and removed) and -1 otherwise (it stays, and the agent stands on
-    its cell); sword and teleport 0.
+    defeated and removed) and -1 otherwise; sword and teleport 0.
     Bumping into a wall or the border leaves the agent in place, pays nothing
     and triggers nothing (not even a teleport under the agent). Entering a
     teleport end puts the agent on the other end.
 
-    ``classic=True`` reproduces the original release exactly: the cell reward
+    What an unarmed meeting with the enemy does besides the -1 is the
+    ``enemy`` option: ``"pass"`` (default for rgw1, rgw2 and maps: the thesis's
+    rule; the enemy stays and the agent stands on its cell), ``"block"`` (the
+    enemy blocks the way like a wall: the agent stays where it was; -1 every
+    time it tries; event ``bumped(enemy)``) or ``"end"`` (the episode ends as
+    in a pit; event ``killed_by(enemy)``, outcome ``enemy``). Every mode also
+    lists ``hurt_by(enemy)``, so "met the enemy unarmed" reads the same in all.
+    A meeting with the sword is the same in every mode: +1, defeated, removed.
+
+    ``classic=True`` reproduces the original release exactly (and allows only
+    ``enemy="pass"``): the cell reward
     is paid whenever a step ends on a cell, staying in place included; the
     enemy is never removed, so it pays +1 (with the sword) or -1 on every such
     step; the original's ``state > nS_pos`` test makes an agent at cell (0, 0)
@@ -93,8 +110,9 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
     ``classic=True, max_steps=None`` is the original release exactly.
 
     ## Termination
-    Terminated on reaching the terminal (outcome ``terminal``) or falling into
-    a pit (``pit``); truncated after ``max_steps`` steps (default 100; None for
+    Terminated on reaching the terminal (outcome ``terminal``), falling into
+    a pit (``pit``) or, with ``enemy="end"``, meeting the enemy unarmed
+    (``enemy``); truncated after ``max_steps`` steps (default 100; None for
     no limit) with outcome ``timeout``. A step that terminates is never also
     reported as truncated.
 
@@ -104,13 +122,24 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
     still on the map); ``events`` (Prolog text of this step's events, in this
     order: ``bumped(border)``, ``bumped(wall)``, ``teleported``,
     ``crossed(mountain)``, ``picked(sword)``, ``defeated(enemy)``,
-    ``hurt_by(enemy)``, ``fell(pit)``, ``reached(terminal)``); ``outcome``.
+    ``hurt_by(enemy)``, ``fell(pit)``, ``reached(terminal)``,
+    ``bumped(enemy)``, ``killed_by(enemy)``); ``outcome``. And the level:
+    ``optimal_return`` (the best return any route earns within ``max_steps``
+    under these rules, found by exhaustive search,
+    :mod:`neurosym.envs.rgw_solver`; NaN for a map with more than 8 swords and
+    enemies, or classic rules without a step limit), ``guarded`` (every route
+    to a terminal meets an enemy), ``needs_teleport`` (every route goes
+    through the teleport), ``hazard_on_route`` (every shortest route crosses a
+    mountain or a pit).
 
     ## Registered Configurations
     * ``neurosym/RGW1-v0`` (``rgw1``): Configuration-1, optimal return 11.
     * ``neurosym/RGW2-v0`` (``rgw2``): Configuration-2, optimal return 10.7.
-    * ``neurosym/RGWRandom-v0`` (``rgw-random``): procedural levels
-      (:class:`~neurosym.envs.rgw_random.RGWRandomEnv`).
+    * ``neurosym/RGWRandom-v0`` (``rgw-random``): procedural levels with a
+      blocking enemy (:class:`~neurosym.envs.rgw_random.RGWRandomEnv`).
+
+    Every configuration takes ``enemy=`` and ``classic=``; ``map=`` (a shipped
+    name, a file or map text) plays any map with the same rules.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array", "ansi"], "render_fps": 4}
@@ -124,8 +153,11 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         obs_mode: str = "onehot",
         max_steps: int | None = 100,
         render_mode: str | None = None,
+        enemy: str = "pass",
     ) -> None:
-        self._setup(FixedLevel(load_map(map)), classic, obs_mode, max_steps, render_mode)
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
+        source = FixedLevel(load_map(map), Rules(bool(classic), enemy, max_steps))
+        self._setup(source, classic, obs_mode, max_steps, render_mode, enemy)
 
     def _setup(
         self,
@@ -134,9 +166,11 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         obs_mode: str,
         max_steps: int | None,
         render_mode: str | None,
+        enemy: str,
     ) -> None:
-        check_options(obs_mode, max_steps, render_mode)
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
         self.source = source
+        self.enemy = enemy
         self.classic = bool(classic)
         self.obs_mode = obs_mode
         self.max_steps = max_steps
@@ -148,7 +182,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         self.action_space = spaces.Discrete(len(Action))
         self.obs_scale = 1.0 if obs_mode == "onehot" else 1 / 255
         self._batch = batch_for(
-            source, 1, classic=self.classic, obs_mode=obs_mode, max_steps=max_steps
+            source, 1, classic=self.classic, obs_mode=obs_mode, max_steps=max_steps, enemy=enemy
         )
         self.level_seed: int | None = None
         """seed of the current level key (see rgw_levels)"""
@@ -156,6 +190,10 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         """episodes begun since the last seeded reset"""
         self._objects = None if source.per_episode else source.objects(0, 0)
         self._ring = source.ring(1) if source.per_episode else None
+        self._level: dict[str, Any] = {}
+        """the current level's LevelInfo entries (optimal_return, guarded, ...)"""
+        if not source.per_episode:
+            self._level = source.levels(np.zeros(1, np.uint64), np.zeros(1, np.int64))[2].row(0)
 
     # -- gymnasium API --------------------------------------------------------
 
@@ -172,9 +210,10 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
         if self.source.per_episode:
             key_s = np.array([self.level_seed], dtype=np.uint64)
             key_e = np.array([self.episode_index], dtype=np.int64)
-            cells, starts = self._ring.take(np.zeros(1, np.intp), key_s, key_e)
+            cells, starts, level = self._ring.take(np.zeros(1, np.intp), key_s, key_e)
             self._batch.set_levels(np.zeros(1, np.intp), cells, starts)
             self._objects = LevelObjects(cells[0], self.width)
+            self._level = level.row(0)
         self._batch.reset_rows()
         return self._batch.obs[0].copy(), self._info(0, False)
 
@@ -201,6 +240,7 @@ class RGWEnv(gym.Env[np.ndarray, np.int64]):
             "objects": self._objects.with_agent(pos, int(b.removed[0])),
             "events": rules.EVENT_TUPLES[events],
             "outcome": rules.outcome_name(events, truncated),
+            **self._level,
         }
 
     def set_state(self, agent: tuple[int, int], holding: bool = False) -> dict[str, Any]:

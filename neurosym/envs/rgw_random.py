@@ -1,19 +1,42 @@
 """Procedural Relational-Grid-World levels (``rgw-random``), the thesis's stated future work.
 
-Every level has random wall segments, an agent start, a terminal, a sword, one
-or more enemies, a teleport pair, mountains and pits. A level is accepted only
-when it is solvable: a search over (position, holding-sword) states must find
-the sword without meeting an enemy while unarmed, then the terminal, never
-through a pit. With probability ``enemy_on_route`` a level puts an enemy on
-*every* shortest route from the start to the terminal (the agent has to plan
-sword -> enemy -> terminal); the other levels keep the enemies off at least one
-shortest route, as decoys (thesis section 4.1).
+On one fixed map an agent can solve the level by where things are; levels that
+change every episode make it relate the sword, the enemy and the terminal. Every
+level has random wall segments, an agent start, a terminal, a sword, one or more
+enemies, a teleport pair, mountains and pits, and the terminal sits in a pocket:
+walls on all its sides but one, the *door*. Each level draws its kind from
+independent shares (:class:`RandomLevelConfig`):
+
+* ``guarded_share`` (0.5): the first enemy stands in the door, so every route to
+  the terminal meets an enemy. With a blocking or ending enemy (rgw-random's
+  default is ``enemy="block"``) the terminal can only be reached with the sword.
+  The other levels keep the door empty and the enemy elsewhere, off at least
+  one route: a decoy. The sword is not needed there; taking it is a detour
+  (steps, and return wherever the way to it crosses mountains).
+* ``teleport_share`` (0.25): a full wall line splits the grid; the start and
+  the sword lie on one side, the terminal on the other, and the teleport's two
+  ends one on each side: every route goes through the teleport.
+* ``hazard_share`` (0.3): mountains and pits are put on the shortest routes
+  first, so every shortest route crosses one (pay -0.1 per mountain or detour;
+  a pit ends the episode); the other levels keep them off the shortest routes.
+
+A candidate is accepted only when its measured kinds
+(:func:`neurosym.envs.rgw_solver.level_kinds`) are the ones it was drawn for and
+the exact search over the env's own rules (:func:`~neurosym.envs.rgw_solver.solve_levels`:
+cell x sword held x enemies left, teleports, mountains' costs, pits, the enemy
+mode, the step limit) finds a route to the terminal; that search also gives the
+level's optimal return, which the env reports in ``info["optimal_return"]`` and
+the kinds in ``info["guarded"]``, ``info["needs_teleport"]`` and
+``info["hazard_on_route"]``.
 
 Levels are keyed by ``(seed, episode)`` through a counter-based hash (splitmix64)
 instead of a stateful generator, so any batch of keys is generated at once with
 array operations, and the same key always gives the same level whatever else
-is generated beside it. Candidates that fail the checks are redrawn with the
-next attempt number until every key has its level.
+is generated beside it (and the same rules: the optimal return and the
+solvability check depend on them). Candidates that fail the checks are redrawn
+with the next attempt number until every key has its level. Evaluation seeds
+are fresh levels as long as they differ from the training seeds: the level is a
+function of the reset seed and the number of resets since.
 """
 
 from __future__ import annotations
@@ -24,11 +47,24 @@ from typing import Any
 import numpy as np
 
 from neurosym.envs import rgw_rules as rules
-from neurosym.envs.rgw import RGWEnv
-from neurosym.envs.rgw_levels import LevelObjects, ObjectsCache
+from neurosym.envs.rgw import RGWEnv, check_options
+from neurosym.envs.rgw_levels import LevelInfo, LevelObjects, ObjectsCache
+from neurosym.envs.rgw_solver import (
+    UNREACHED,
+    Rules,
+    bfs,
+    kinds_and_route,
+    solve_levels,
+)
 from neurosym.errors import ConfigError
 
-UNREACHED = np.int32(1 << 30)
+SHARES = ("guarded_share", "teleport_share", "hazard_share")
+
+RANDOM_RULES = Rules(enemy="block")
+"""rgw-random's default rules: a blocking enemy, 100 steps"""
+
+MAX_ENEMIES = 3
+"""enemies per level at most: the optimal-return search tracks which are left (2**(1 + E) masks)"""
 
 
 @dataclass(frozen=True)
@@ -40,9 +76,13 @@ class RandomLevelConfig:
     width: int = 10
     """columns of the grid"""
     num_enemies: int = 1
-    """enemies per level (the first one is the one placed on or off the route)"""
-    enemy_on_route: float = 0.5
-    """share of levels whose enemies lie on every shortest route to the terminal"""
+    """enemies per level, 1 to 3 (the first one guards the door or is the decoy)"""
+    guarded_share: float = 0.5
+    """share of levels whose terminal is guarded: an enemy in the only door"""
+    teleport_share: float = 0.25
+    """share of levels split by a wall line that only the teleport crosses"""
+    hazard_share: float = 0.3
+    """share of levels whose every shortest route crosses a mountain or a pit"""
     wall_segments: int = 6
     """straight wall segments per level"""
     max_wall_length: int = 5
@@ -59,12 +99,12 @@ class RandomLevelConfig:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name == "enemy_on_route":
-                if not 0.0 <= float(value) <= 1.0:
-                    raise ConfigError(f"enemy_on_route must be in [0, 1], got {value!r}")
+            if f.name in SHARES:
+                if not isinstance(value, int | float) or not 0.0 <= float(value) <= 1.0:
+                    raise ConfigError(f"{f.name} must be a number in [0, 1], got {value!r}")
                 continue
             low = (
-                3
+                5
                 if f.name in ("height", "width")
                 else 1
                 if f.name in ("num_enemies", "max_wall_length", "max_attempts", "min_route_length")
@@ -72,7 +112,12 @@ class RandomLevelConfig:
             )
             if not isinstance(value, int | np.integer) or value < low:
                 raise ConfigError(f"{f.name} must be an integer >= {low}, got {value!r}")
-        needed = 6 + self.num_enemies + self.num_mountains + self.num_pits
+        if self.num_enemies > MAX_ENEMIES:
+            raise ConfigError(
+                f"num_enemies must be at most {MAX_ENEMIES} (the optimal-return search tracks "
+                f"which enemies are left), got {self.num_enemies}"
+            )
+        needed = 8 + self.num_enemies + self.num_mountains + self.num_pits
         if needed > self.height * self.width // 2:
             raise ConfigError(
                 f"{needed} objects do not fit a {self.height}x{self.width} level with room to move; "
@@ -109,86 +154,6 @@ def uniform(keys: np.ndarray, stream: int, count: int) -> np.ndarray:
     return (bits >> np.uint64(11)).astype(np.float64) * (1.0 / (1 << 53))
 
 
-# -- search ----------------------------------------------------------------------
-
-
-def _swap(flat: np.ndarray, i1: np.ndarray, i2: np.ndarray) -> None:
-    """Exchange the entries at flat indices i1 and i2 (the two ends of each level's teleport)."""
-    a = flat[i1]
-    flat[i1] = flat[i2]
-    flat[i2] = a
-
-
-def _padded(x: np.ndarray, height: int, width: int) -> np.ndarray:
-    """(B, N) bool -> flat (B * (H + 1) * (W + 1),) with a False guard row and column per level."""
-    B = len(x)
-    out = np.zeros((B, height + 1, width + 1), dtype=bool)
-    out[:, :height, :width] = x.reshape(B, height, width)
-    return out.reshape(-1)
-
-
-def bfs(
-    sources: np.ndarray,
-    visit: np.ndarray,
-    expand: np.ndarray,
-    teleports: np.ndarray,
-    height: int,
-    width: int,
-    backward: bool = False,
-) -> np.ndarray:
-    """Layered search over many levels at once: (B, N) steps from (or, backward, to) ``sources``.
-
-    Forward: a step enters one of the four neighbours; entering a teleport end
-    (``teleports`` (B, 2) cells) lands on the other end; a cell is entered when
-    ``visit`` allows it and expanded further when ``expand`` allows it.
-    Backward gives the steps needed to reach the source instead.
-
-    All levels sit in one flat boolean array, each padded with a guard row and
-    column that ``visit`` keeps False, so a layer is four shifted ORs over the
-    whole batch plus a few masks: no per-level work, no gathers of neighbour lists.
-    Unreached cells hold UNREACHED.
-    """
-    B, N = visit.shape
-    W1 = width + 1
-    P = (height + 1) * W1
-    lvl = np.arange(B)
-
-    def flat_index(cells: np.ndarray) -> np.ndarray:
-        r, c = np.divmod(cells, width)
-        return lvl * P + r * W1 + c
-
-    i1, i2 = flat_index(teleports[:, 0]), flat_index(teleports[:, 1])
-    visit_p = _padded(visit, height, width)
-    expand_p = _padded(expand, height, width)
-    visited = np.zeros(B * P, dtype=bool)
-    visited[flat_index(sources)] = True
-    dist = np.full(B * P, UNREACHED, dtype=np.int32)
-    dist[visited] = 0
-    front = visited.copy()
-    d = 0
-    while True:
-        d += 1
-        if backward:
-            src = front  # a fresh array each layer, safe to modify
-            _swap(src, i1, i2)  # reaching end 1 means entering end 2
-        else:
-            src = front & expand_p
-        new = np.zeros_like(src)
-        new[1:] = src[:-1]
-        new[:-1] |= src[1:]
-        new[W1:] |= src[:-W1]
-        new[:-W1] |= src[W1:]
-        if not backward:
-            _swap(new, i1, i2)  # entering end 1 lands on end 2
-        new &= visit_p
-        new = new > visited
-        if not new.any():
-            return dist.reshape(B, height + 1, W1)[:, :height, :width].reshape(B, N)
-        visited |= new
-        np.copyto(dist, d, where=new)
-        front = new
-
-
 # -- generation ------------------------------------------------------------------
 
 
@@ -212,92 +177,144 @@ def _walls(cfg: RandomLevelConfig, keys: np.ndarray) -> np.ndarray:
     return wall
 
 
+def _pick(allowed: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One random allowed cell per level: (B,) cell and (B,) whether there was one."""
+    cell = np.argmin(np.where(allowed, u, 2.0), axis=1)
+    return cell, allowed[np.arange(len(allowed)), cell]
+
+
 def _candidates(
-    cfg: RandomLevelConfig, keys: np.ndarray, want_route: np.ndarray
+    cfg: RandomLevelConfig, keys: np.ndarray, want: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One candidate level per key: (cells (B, N), starts (B,), accepted (B,))."""
-    B, N = len(keys), cfg.height * cfg.width
+    """One candidate level per key, built to be of the kinds ``want`` (B, 3) asks for.
+
+    Returns (cells (B, N), starts (B,), ok (B,)): ``ok`` is False where the
+    construction ran out of room; the kinds are measured afterwards.
+    """
+    B, H, W, N = len(keys), cfg.height, cfg.width, cfg.height * cfg.width
     lvl = np.arange(B)
+    want_guard, want_tele, want_hazard = want[:, 0], want[:, 1], want[:, 2]
     wall = _walls(cfg, keys)
-    # Distinct random free cells: terminal, start, sword, 2 teleports, mountains, pits, extra enemies.
-    order = np.argsort(np.where(wall, 2.0, 0.0) + uniform(keys, 2, N), axis=1)
-    n_fixed = 5 + cfg.num_mountains + cfg.num_pits + (cfg.num_enemies - 1)
-    enough = (N - wall.sum(axis=1)) > n_fixed + 1
-    terminal, start, sword = order[:, 0], order[:, 1], order[:, 2]
+    row, col = np.divmod(np.arange(N), W)
+
+    # Teleport levels: a full wall line (row or column 2 .. size-3) splits the grid;
+    # side A (start, sword, one teleport end) and side B (terminal, the other end).
+    u = uniform(keys, 4, 3)
+    across = u[:, 0] < 0.5  # a horizontal line
+    size = np.where(across, H, W)
+    line = 2 + (u[:, 1] * (size - 4)).astype(np.intp)
+    coord = np.where(across[:, None], row[None, :], col[None, :])  # (B, N)
+    wall |= (coord == line[:, None]) & want_tele[:, None]
+    flip = (u[:, 2] < 0.5)[:, None]
+    side_a = np.where(want_tele[:, None], (coord < line[:, None]) ^ flip, True)
+    side_b = np.where(want_tele[:, None], (coord > line[:, None]) ^ flip, True)
+
+    # The terminal in a pocket: walls on every side but one, the door.
+    free = ~wall
+    terminal, ok = _pick(free & side_b, uniform(keys, 5, N))
+    target, border = rules._geometry(H, W)  # (4, N) each
+    nb = target[:, terminal].T  # (B, 4) neighbour cells
+    open_nb = ~border[:, terminal].T & free[lvl[:, None], nb]
+    door_k = np.argmin(np.where(open_nb, uniform(keys, 6, 4), 2.0), axis=1)
+    ok &= open_nb[lvl, door_k]
+    door = nb[lvl, door_k]
+    seal = open_nb.copy()
+    seal[lvl, door_k] = False
+    for k in range(4):
+        wall[lvl[seal[:, k]], nb[seal[:, k], k]] = True
+    free = ~wall
+    free[lvl, terminal] = False
+    free[lvl, door] = False
+
+    # Start, sword and teleport ends (side A, side A, one end per side).
+    picks = []
+    for stream, region in ((7, side_a), (8, side_a), (9, side_a), (10, side_b)):
+        cell, got = _pick(free & region, uniform(keys, stream, N))
+        ok &= got
+        free[lvl, cell] = False
+        picks.append(cell)
+    start, sword, tele_a, tele_b = picks
+
     cells = np.where(wall, rules.WALL, rules.EMPTY).astype(np.uint8)
     cells[lvl, terminal] = rules.TERMINAL
     cells[lvl, sword] = rules.SWORD
-    cells[lvl[:, None], order[:, 3:5]] = rules.TELEPORT
-    i = 5
-    for code, count in (
-        (rules.MOUNTAIN, cfg.num_mountains),
-        (rules.PIT, cfg.num_pits),
-        (rules.ENEMY, cfg.num_enemies - 1),
-    ):
-        cells[lvl[:, None], order[:, i : i + count]] = code
-        i += count
-    cells[~enough] = rules.EMPTY  # keep the arrays valid; these candidates are rejected
-    cells[~enough, 0] = rules.TERMINAL
+    cells[lvl, tele_a] = rules.TELEPORT
+    cells[lvl, tele_b] = rules.TELEPORT
 
-    # Shortest routes with enemies passable: forward from the start, backward from the terminal.
-    H, W = cfg.height, cfg.width
-    tele = np.where(enough[:, None], order[:, 3:5], 0)
-    standable = (cells != rules.WALL) & (cells != rules.PIT)
+    # The first enemy: in the door (guarded) or on a random free cell (decoy).
+    decoy, got = _pick(free, uniform(keys, 11, N))
+    enemy = np.where(want_guard, door, decoy)
+    ok &= want_guard | got
+    cells[lvl, enemy] = rules.ENEMY
+    free[lvl, enemy] = False
+
+    # Mountains and pits: on the shortest routes first (hazard levels) or last.
+    teleports = np.stack([tele_a, tele_b], axis=1)
+    open_ = cells != rules.WALL
     is_terminal = cells == rules.TERMINAL
-    d_start = bfs(start, standable, ~is_terminal, tele, H, W)
+    d_start = bfs(start, open_, ~is_terminal, teleports, H, W)
+    d_term = bfs(terminal, open_ & ~is_terminal, open_, teleports, H, W, backward=True)
     route = d_start[lvl, terminal]
-    d_term = bfs(terminal, standable & ~is_terminal, standable, tele, H, W, backward=True)
-
-    # Cells on every shortest route: on some shortest route and alone in their layer.
     on_route = (d_start + d_term == route[:, None]) & (route[:, None] < UNREACHED)
-    layer = np.where(on_route, d_start, 0)
-    counts = np.bincount((lvl[:, None] * (N + 1) + layer)[on_route], minlength=B * (N + 1)).reshape(
-        B, N + 1
-    )
-    choke = on_route & (np.take_along_axis(counts, layer, axis=1) == 1)
-    free = cells == rules.EMPTY
-    free[lvl, start] = False
-    # The first enemy: on a chokepoint when the level wants it on the route, elsewhere otherwise.
-    allowed = np.where(want_route[:, None], choke, ~choke) & free
-    pick = np.where(allowed, uniform(keys, 3, N), 2.0)
-    enemy = np.argmin(pick, axis=1)
-    placed = allowed[lvl, enemy]
-    cells[lvl[placed], enemy[placed]] = rules.ENEMY
-
-    # With enemies blocked: is the terminal further (enemy on every route)? Is the sword reachable?
-    no_enemy = standable & (cells != rules.ENEMY)
-    d_safe = bfs(start, no_enemy, ~is_terminal, tele, H, W)
-    enemy_on_route = d_safe[lvl, terminal] > route
-    solvable = (d_safe[lvl, sword] < UNREACHED) & (d_term[lvl, sword] < UNREACHED)
-    accepted = (
-        enough
-        & placed
-        & solvable
-        & (route >= cfg.min_route_length)
-        & (route < UNREACHED)
-        & (enemy_on_route == want_route)
-    )
-    return cells, start, accepted
+    bias = np.where(want_hazard[:, None], -1.0, 1.0) * on_route
+    score = np.where(free, uniform(keys, 12, N) + bias, 9.0)
+    order = np.argsort(score, axis=1)
+    n_haz = cfg.num_mountains + cfg.num_pits
+    extra = cfg.num_enemies - 1
+    ok &= free.sum(axis=1) > n_haz + extra
+    cells[lvl[:, None], order[:, : cfg.num_mountains]] = rules.MOUNTAIN
+    cells[lvl[:, None], order[:, cfg.num_mountains : n_haz]] = rules.PIT
+    if extra:
+        rest = np.where(free, uniform(keys, 13, N), 9.0)
+        rest[lvl[:, None], order[:, :n_haz]] = 9.0
+        cells[lvl[:, None], np.argsort(rest, axis=1)[:, :extra]] = rules.ENEMY
+    cells[~ok] = rules.EMPTY  # keep the arrays valid; these candidates are rejected
+    cells[~ok, 0] = rules.TERMINAL
+    start = np.where(ok, start, 1)
+    return cells, start, ok
 
 
 def generate_levels(
-    cfg: RandomLevelConfig, seeds: np.ndarray, episodes: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """(B, N) uint8 cells and (B,) starts of the levels keyed by (seed, episode)."""
+    cfg: RandomLevelConfig,
+    seeds: np.ndarray,
+    episodes: np.ndarray,
+    rules_: Rules = RANDOM_RULES,
+) -> tuple[np.ndarray, np.ndarray, LevelInfo]:
+    """(B, N) uint8 cells, (B,) starts and the LevelInfo of the levels keyed by (seed, episode).
+
+    ``rules_`` are the rules the levels will be played by: a level is accepted
+    only when a route reaches its terminal under them within the step limit,
+    and its optimal return is computed under them.
+    """
     seeds = np.atleast_1d(np.asarray(seeds, dtype=np.uint64))
     episodes = np.atleast_1d(np.asarray(episodes, dtype=np.int64))
-    B, N = len(seeds), cfg.height * cfg.width
-    want_route = uniform(level_keys(seeds, episodes), 0, 1)[:, 0] < cfg.enemy_on_route
-    cells = np.empty((B, N), dtype=np.uint8)
+    B, H, W = len(seeds), cfg.height, cfg.width
+    shares = np.array([cfg.guarded_share, cfg.teleport_share, cfg.hazard_share])
+    want = uniform(level_keys(seeds, episodes), 0, 3) < shares  # (B, 3)
+    cells = np.empty((B, H * W), dtype=np.uint8)
     starts = np.empty(B, dtype=np.intp)
+    best = np.empty(B)
+    kinds = np.empty((B, 3), dtype=bool)
     pending = np.arange(B)
     for attempt in range(cfg.max_attempts):
         keys = level_keys(seeds[pending], episodes[pending], attempt)
-        c, s, ok = _candidates(cfg, keys, want_route[pending])
-        cells[pending[ok]], starts[pending[ok]] = c[ok], s[ok]
+        c, s, ok = _candidates(cfg, keys, want[pending])
+        kinds_c, route = kinds_and_route(c, s, H, W)
+        k = np.stack(kinds_c, axis=1)  # (b, 3)
+        ok &= (k == want[pending]).all(axis=1) & (route >= cfg.min_route_length)
+        idx = np.flatnonzero(ok)
+        if len(idx):
+            sol = solve_levels(c[idx], s[idx], H, W, rules_)
+            ok[idx] = sol.solvable
+            best_ok = sol.optimal_return[sol.solvable]
+        else:
+            best_ok = np.empty(0)
+        done = pending[ok]
+        cells[done], starts[done], kinds[done], best[done] = c[ok], s[ok], k[ok], best_ok
         pending = pending[~ok]
         if not len(pending):
-            return cells, starts
+            info = LevelInfo(best, kinds[:, 0], kinds[:, 1], kinds[:, 2])
+            return cells, starts, info
     raise ConfigError(
         f"no solvable level found in {cfg.max_attempts} attempts for {len(pending)} of {B} keys "
         f"with {asdict(cfg)}; use fewer walls, pits or enemies"
@@ -319,11 +336,12 @@ class LevelRing:
         self,
         cfg: RandomLevelConfig,
         n: int,
+        rules_: Rules,
         first_batch: int = 2048,
         max_buffered: int = 16384,
         depth: int = 16,
     ) -> None:
-        self.cfg, self.n, self.depth = cfg, n, depth
+        self.cfg, self.n, self.depth, self.rules = cfg, n, depth, rules_
         # Levels kept ahead per env: few at first (a quick first reset), doubling per
         # refill up to `cap`, so that at most about max_buffered levels wait in all.
         self.cap = int(np.clip(max_buffered // n, 1, depth))
@@ -331,6 +349,9 @@ class LevelRing:
         N = cfg.height * cfg.width
         self.cells = np.zeros((n, depth, N), dtype=np.uint8)
         self.starts = np.zeros((n, depth), dtype=np.intp)
+        self.info = LevelInfo(
+            np.zeros((n, depth)), *(np.zeros((n, depth), dtype=bool) for _ in range(3))
+        )
         self.key_ep = np.full((n, depth), -1, dtype=np.int64)
         self.key_seed = np.zeros((n, depth), dtype=np.uint64)
         self.seeds = np.zeros(n, dtype=np.uint64)
@@ -338,8 +359,8 @@ class LevelRing:
 
     def take(
         self, rows: np.ndarray, seeds: np.ndarray, episodes: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Cells (k, N) and starts (k,) of the levels (seeds, episodes) for envs ``rows``."""
+    ) -> tuple[np.ndarray, np.ndarray, LevelInfo]:
+        """Cells (k, N), starts (k,) and info of the levels (seeds, episodes) for envs ``rows``."""
         rows = np.asarray(rows, dtype=np.intp)
         seeds = np.asarray(seeds, dtype=np.uint64)
         episodes = np.asarray(episodes, dtype=np.int64)
@@ -352,7 +373,8 @@ class LevelRing:
         if not hit.all():
             self._refill()
         self.next_ep[rows] = episodes + 1
-        return self.cells[rows, slot], self.starts[rows, slot]
+        info = LevelInfo(*(a[rows, slot] for a in self.info))
+        return self.cells[rows, slot], self.starts[rows, slot], info
 
     def _refill(self) -> None:
         eps = self.next_ep[:, None] + np.arange(self.window)  # (n, window)
@@ -361,9 +383,11 @@ class LevelRing:
         have = (self.key_ep[env, slot] == eps) & (self.key_seed[env, slot] == self.seeds[:, None])
         need_env, need_k = np.nonzero(~have)
         need_ep, need_slot = eps[need_env, need_k], slot[need_env, need_k]
-        cells, starts = generate_levels(self.cfg, self.seeds[need_env], need_ep)
+        cells, starts, info = generate_levels(self.cfg, self.seeds[need_env], need_ep, self.rules)
         self.cells[need_env, need_slot] = cells
         self.starts[need_env, need_slot] = starts
+        for mine, new in zip(self.info, info, strict=True):
+            mine[need_env, need_slot] = new
         self.key_ep[need_env, need_slot] = need_ep
         self.key_seed[need_env, need_slot] = self.seeds[need_env]
         self.window = min(self.cap, self.window * 2)
@@ -374,24 +398,26 @@ class RandomLevels:
 
     per_episode = True
 
-    def __init__(self, cfg: RandomLevelConfig) -> None:
-        self.cfg = cfg
+    def __init__(self, cfg: RandomLevelConfig, rules_: Rules) -> None:
+        self.cfg, self.rules = cfg, rules_
         self.name = "random"
         self.height, self.width = cfg.height, cfg.width
         self._cache = ObjectsCache()
 
-    def levels(self, seeds: np.ndarray, episodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return generate_levels(self.cfg, seeds, episodes)
+    def levels(
+        self, seeds: np.ndarray, episodes: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, LevelInfo]:
+        return generate_levels(self.cfg, seeds, episodes, self.rules)
 
     def ring(self, n: int) -> LevelRing:
         """A LevelRing for an env of n sub-envs."""
-        return LevelRing(self.cfg, n)
+        return LevelRing(self.cfg, n, self.rules)
 
     def objects(self, seed: int, episode: int) -> LevelObjects:
         key = (int(seed), int(episode))
         got = self._cache.get(key)
         if got is None:
-            cells, _ = generate_levels(self.cfg, np.array([seed]), np.array([episode]))
+            cells = self.levels(np.array([seed]), np.array([episode]))[0]
             got = LevelObjects(cells[0], self.width)
             self._cache.put(key, got)
         return got
@@ -408,18 +434,51 @@ def config_from_kwargs(kwargs: dict[str, Any]) -> RandomLevelConfig:
     return RandomLevelConfig(**kwargs)
 
 
+def random_enemy(enemy: str | None, classic: bool) -> str:
+    """rgw-random's enemy mode: ``block`` unless asked otherwise (``pass`` with classic rules)."""
+    if enemy is None:
+        return "pass" if classic else "block"
+    return enemy
+
+
 class RGWRandomEnv(RGWEnv):
     """Relational-Grid-World on procedural levels: a new solvable level every episode.
 
-    Rules, actions, observations, rewards, termination and info are those of
-    :class:`~neurosym.envs.rgw.RGWEnv` (default or ``classic`` rules). The
-    level of an episode is decided by the reset seed and the number of resets
-    since it: ``reset(seed=s)`` plays level (s, 0), each later ``reset()`` the
-    next one. The generator's parameters are those of :class:`RandomLevelConfig`.
+    ## Description
+    The sword, the enemy, the teleport and the terminal move every episode, so
+    an agent cannot solve the level by where it is; it has to relate them. The
+    mix of level kinds (guarded terminal, decoy enemy, teleport needed,
+    mountains and pits on the way) is set by :class:`RandomLevelConfig`'s
+    shares and described in this module's docstring. The level of an episode
+    is decided by the reset seed and the number of resets since it:
+    ``reset(seed=s)`` plays level (s, 0), each later ``reset()`` the next one.
+    Train and evaluate on different seeds: evaluation seeds are then unseen levels.
+
+    ## Action Space
+    ``Discrete(4)``, as :class:`~neurosym.envs.rgw.RGWEnv`.
+
+    ## Observation
+    As :class:`~neurosym.envs.rgw.RGWEnv`: ``(9, H, W)`` onehot or ``(1, H, W)`` grey.
+
+    ## Rewards
+    As :class:`~neurosym.envs.rgw.RGWEnv`, with ``enemy="block"`` by default: an
+    enemy met without the sword costs -1 and the agent stays where it was
+    (``enemy="end"``: -1 and the episode ends; ``"pass"``: the thesis's -1 and
+    pass, which makes the sword nearly worthless against the +10 terminal).
+    ``classic=True`` (the original release's rules) implies ``enemy="pass"``.
+
+    ## Termination
+    As :class:`~neurosym.envs.rgw.RGWEnv`; ``enemy="end"`` adds outcome ``enemy``.
+
+    ## Info
+    As :class:`~neurosym.envs.rgw.RGWEnv`, whose ``optimal_return``,
+    ``guarded``, ``needs_teleport`` and ``hazard_on_route`` describe the
+    episode's level (computed by the generator under the env's rules).
 
     ## Registered Configurations
-    * ``neurosym/RGWRandom-v0`` (``rgw-random``): 10 x 10, one enemy, on every
-      shortest route in half of the levels.
+    * ``neurosym/RGWRandom-v0`` (``rgw-random``): 10 x 10, one enemy, blocking;
+      half the levels guarded, a quarter needing the teleport, 30 % with
+      mountains or pits across every shortest route.
     """
 
     def __init__(
@@ -429,7 +488,11 @@ class RGWRandomEnv(RGWEnv):
         obs_mode: str = "onehot",
         max_steps: int | None = 100,
         render_mode: str | None = None,
+        enemy: str | None = None,
         **level_kwargs: Any,
     ) -> None:
         self.level_config = config_from_kwargs(level_kwargs)
-        self._setup(RandomLevels(self.level_config), classic, obs_mode, max_steps, render_mode)
+        enemy = random_enemy(enemy, classic)
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
+        source = RandomLevels(self.level_config, Rules(bool(classic), enemy, max_steps))
+        self._setup(source, classic, obs_mode, max_steps, render_mode, enemy)

@@ -18,6 +18,13 @@ How a step is computed (no Python loop over environments or cells):
 Cell codes are the entity codes of ``ENTITY_NAMES`` (agent 0 ... empty 8) plus
 ``TELEPORT_MOUNTAIN`` (9), the teleport end that the original release also
 counts as a mountain.
+
+What an unarmed meeting with the enemy does is a rule option (``ENEMY_MODES``):
+``pass`` (the thesis: -1, the agent stands on the enemy's cell), ``block``
+(-1, the agent stays where it was, as if the enemy were a wall) or ``end``
+(-1, the episode ends, outcome ``enemy``). A blocked step is the one rule whose
+destination depends on the state (holding the sword, the enemy still there),
+so it is handled with the rare steps, apart from the precomputed moves.
 """
 
 from __future__ import annotations
@@ -66,6 +73,8 @@ EVENT_TERMS: tuple[Term, ...] = (
     Term("hurt_by", ("enemy",)),
     Term("fell", ("pit",)),
     Term("reached", ("terminal",)),
+    Term("bumped", ("enemy",)),
+    Term("killed_by", ("enemy",)),
 )
 EVENT_NAMES: tuple[str, ...] = tuple(str(t) for t in EVENT_TERMS)
 (
@@ -78,6 +87,8 @@ EVENT_NAMES: tuple[str, ...] = tuple(str(t) for t in EVENT_TERMS)
     EV_HURT,
     EV_PIT,
     EV_TERMINAL,
+    EV_BUMP_ENEMY,
+    EV_KILLED,
 ) = (1 << i for i in range(len(EVENT_TERMS)))
 
 EVENT_TUPLES: tuple[tuple[str, ...], ...] = tuple(
@@ -87,7 +98,13 @@ EVENT_TUPLES: tuple[tuple[str, ...], ...] = tuple(
 """event bitmask -> tuple of event texts (what info["events"] holds)"""
 
 # Outcome codes of a finished episode.
-OUTCOME_NAMES: tuple[str | None, ...] = (None, "terminal", "pit", "timeout")
+OUTCOME_NAMES: tuple[str | None, ...] = (None, "terminal", "pit", "timeout", "enemy")
+
+ENEMY_MODES = ("pass", "block", "end")
+"""what meeting the enemy without the sword does: pass for -1, be blocked for -1, die for -1"""
+
+ENEMY_REWARD = -1.0
+"""reward of meeting the enemy without the sword, in every mode (Table 1's 'Enemy -1')"""
 
 # Move codes: bits of where an action led, precomputed per level and cell.
 MV_STAY, MV_WALL, MV_BORDER, MV_TELEPORT = 1, 2, 4, 8
@@ -120,17 +137,33 @@ class RuleTables:
     new_cell: np.ndarray  # uint8 code of the cell after the step
     new_holding: np.ndarray  # uint8
     removes: np.ndarray  # bool: the landing cell's object leaves the map
-    special: np.ndarray  # bool: removes an object or picks up the sword (rare; handled apart)
+    blocked: np.ndarray  # bool: the agent goes back to the cell it came from (enemy="block")
+    special: np.ndarray  # bool: removes, picks up the sword or is blocked (rare; handled apart)
 
 
-def rule_tables(classic: bool) -> RuleTables:
-    """Build the lookup tables of one rule set (default or classic)."""
+def check_enemy(enemy: str, classic: bool) -> None:
+    """Refuse an unknown enemy mode, and any but ``pass`` with the original release's rules."""
+    from neurosym.errors import ConfigError
+
+    if enemy not in ENEMY_MODES:
+        raise ConfigError(f"enemy {enemy!r} is not one of {', '.join(ENEMY_MODES)}")
+    if classic and enemy != "pass":
+        raise ConfigError(
+            f"enemy={enemy!r} with classic=True: the original release always lets the agent "
+            "pass the enemy; use enemy='pass' or classic=False"
+        )
+
+
+def rule_tables(classic: bool, enemy: str = "pass") -> RuleTables:
+    """Build the lookup tables of one rule set (default or classic; enemy mode, see ENEMY_MODES)."""
+    check_enemy(enemy, classic)
     size = NUM_CELL_CODES * 4
     reward = np.zeros(size, dtype=np.float64)
     events = np.zeros(size, dtype=np.uint16)
     terminated = np.zeros(size, dtype=bool)
     new_cell = np.zeros(size, dtype=np.uint8)
     new_holding = np.zeros(size, dtype=np.uint8)
+    blocked = np.zeros(size, dtype=bool)
     for cell in range(NUM_CELL_CODES):
         for a in (0, 1):
             for b in (0, 1):
@@ -156,8 +189,12 @@ def rule_tables(classic: bool) -> RuleTables:
                             hold, nc, ev = True, EMPTY, EV_PICKED
                         elif cell == ENEMY and hold:
                             r, ev, nc = 1.0, EV_DEFEATED, EMPTY
+                        elif cell == ENEMY and enemy == "block":
+                            r, ev, blocked[i] = ENEMY_REWARD, EV_HURT | EV_BUMP_ENEMY, True
+                        elif cell == ENEMY and enemy == "end":
+                            r, ev, term = ENEMY_REWARD, EV_HURT | EV_KILLED, True
                         elif cell == ENEMY:
-                            r, ev = -1.0, EV_HURT
+                            r, ev = ENEMY_REWARD, EV_HURT
                         elif cell == MOUNTAIN:
                             r, ev = MOUNTAIN_REWARD, EV_MOUNTAIN
                         elif cell == PIT:
@@ -167,22 +204,28 @@ def rule_tables(classic: bool) -> RuleTables:
                 reward[i], events[i], terminated[i] = r, ev, term
                 new_cell[i], new_holding[i] = nc, hold
     removes = (new_cell != np.repeat(np.arange(NUM_CELL_CODES), 4)) & (new_cell == EMPTY)
-    special = removes | ((events & EV_PICKED) != 0)
-    return RuleTables(reward, events, terminated, new_cell, new_holding, removes, special)
+    special = removes | ((events & EV_PICKED) != 0) | blocked
+    return RuleTables(reward, events, terminated, new_cell, new_holding, removes, blocked, special)
 
 
 def outcome_codes(events: np.ndarray, truncated: np.ndarray) -> np.ndarray:
     """(n,) index into OUTCOME_NAMES from a step's event bits and truncation flags."""
-    codes = np.where(events & EV_TERMINAL, 1, np.where(events & EV_PIT, 2, 0))
+    codes = np.where(
+        events & EV_TERMINAL,
+        1,
+        np.where(events & EV_PIT, 2, np.where(events & EV_KILLED, 4, 0)),
+    )
     return np.where(truncated, 3, codes).astype(np.uint8)
 
 
 def outcome_name(events: int, truncated: bool) -> str | None:
-    """The outcome of one step: terminal, pit, timeout, or None while the episode goes on."""
+    """The outcome of one step: terminal, pit, enemy, timeout, or None while the episode goes on."""
     if events & EV_TERMINAL:
         return "terminal"
     if events & EV_PIT:
         return "pit"
+    if events & EV_KILLED:
+        return "enemy"
     return "timeout" if truncated else None
 
 
@@ -309,10 +352,12 @@ class RGWBatch:
         obs_mode: str,
         max_steps: int | None,
         per_env_levels: bool,
+        enemy: str = "pass",
     ) -> None:
         self.n, self.height, self.width = n, height, width
         N = self.cells_per_level = height * width
         self.classic = classic
+        self.enemy = enemy
         self.obs_mode = obs_mode
         self.channels = NUM_PLANES if obs_mode == "onehot" else 1
         self.max_steps = np.iinfo(np.int64).max if max_steps is None else int(max_steps)
@@ -326,7 +371,7 @@ class RGWBatch:
         self.level_start = np.zeros(S, dtype=np.intp)
         self._level_obs = np.zeros((S, self.channels * N), dtype=np.uint8)
         self._level_bits = np.zeros((S, N), dtype=np.uint64)
-        self._tables = rule_tables(classic)
+        self._tables = rule_tables(classic, enemy)
         # Dynamic state.
         self.grid = np.full(n * N, EMPTY, dtype=np.uint8)  # (n * N,) cell codes
         self.obs = np.zeros((n, self.channels, height, width), dtype=np.uint8)
@@ -463,8 +508,8 @@ class RGWBatch:
         self.grid[gidx] = new_cell
         holding = T.new_holding.take(idx)
         special = T.special.take(idx)
-        if special.any():  # rare: a sword picked up or an object removed
-            self._special(np.flatnonzero(special), idx, new, holding)
+        if special.any():  # rare: a sword picked up, an object removed, a blocked step
+            self._special(np.flatnonzero(special), idx, new, cell, new_cell, holding)
         # Observation: restore the cell left behind, then draw the agent on the new one.
         o_new = self._orow + new
         obs = self._obs_flat
@@ -494,14 +539,32 @@ class RGWBatch:
         return StepResult(reward, terminated, truncated, events)
 
     def _special(
-        self, rows: np.ndarray, idx: np.ndarray, new: np.ndarray, holding: np.ndarray
+        self,
+        rows: np.ndarray,
+        idx: np.ndarray,
+        new: np.ndarray,
+        cell: np.ndarray,
+        new_cell: np.ndarray,
+        holding: np.ndarray,
     ) -> None:
-        """Bookkeeping of the rare steps: removed objects' bits, the holding plane."""
+        """The rare steps: removed objects' bits, the holding plane, blocked steps.
+
+        A blocked step (enemy="block") takes the agent back to the cell it came
+        from: ``new``, ``cell`` (what the agent stands on) and ``new_cell`` (what
+        will be under it) are rewritten in place for those rows, as for a bump.
+        """
         T = self._tables
         gone = rows[T.removes.take(idx[rows])]
         if len(gone):
             self.removed = self.removed.copy()
             self.removed[gone] |= self._level_bits[self.slot[gone], new[gone]]
+        back = rows[T.blocked.take(idx[rows])]
+        if len(back):
+            here = self.pos[back]
+            new[back] = here
+            self._key[back] = self.slot[back] * (self.cells_per_level * 4) + here * 4
+            cell[back] = self.under[back]
+            new_cell[back] = self.under[back]
         if self.channels > 1:
             picked = rows[holding[rows] > self.holding[rows]]
             self.obs[picked, HOLD_PLANE] = 1

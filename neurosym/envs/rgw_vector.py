@@ -14,6 +14,8 @@ episode with reward 0.
 * ``removed``: (n,) bitmask of swords and enemies gone from the map;
 * ``episode_id``: (n,) episodes begun by each sub-env since the seeded reset;
   ``seed``: (n,) level seeds (procedural levels only);
+* ``optimal_return`` (n,) float, ``guarded``, ``needs_teleport``,
+  ``hazard_on_route`` (n,) bool: each sub-env's current level (rgw_levels.LevelInfo);
 * on an autoreset step, ``final_info`` (the previous step's info, which
   described the last state of the old episode) and ``_final_info`` (mask).
 
@@ -35,9 +37,18 @@ from gymnasium.vector.utils import batch_space
 from neurosym.envs import render as draw
 from neurosym.envs import rgw_rules as rules
 from neurosym.envs.rgw import check_options, observation_space
-from neurosym.envs.rgw_levels import FixedLevel, LevelObjects, LevelSource, ObjectsCache, batch_for
+from neurosym.envs.rgw_levels import (
+    LEVEL_KEYS,
+    FixedLevel,
+    LevelInfo,
+    LevelObjects,
+    LevelSource,
+    ObjectsCache,
+    batch_for,
+)
 from neurosym.envs.rgw_maps import load_map
-from neurosym.envs.rgw_random import RandomLevels, config_from_kwargs
+from neurosym.envs.rgw_random import RandomLevels, config_from_kwargs, random_enemy
+from neurosym.envs.rgw_solver import Rules
 from neurosym.errors import ConfigError
 
 
@@ -45,7 +56,7 @@ class RGWVectorEnv(VectorEnv):
     """n Relational-Grid-World environments (see RGWEnv) stepped together.
 
     ``RGWVectorEnv(num_envs, seed=None, map="rgw2", classic=False,
-    obs_mode="onehot", max_steps=100, render_mode=None, copy=True)``.
+    obs_mode="onehot", max_steps=100, render_mode=None, enemy="pass", copy=True)``.
     ``seed`` is used by the first ``reset()`` when that gets none; sub-env i
     is seeded ``seed + i``. ``copy=False`` returns the internal observation
     buffer itself, which the next step overwrites (faster; copy it if you keep it).
@@ -68,10 +79,12 @@ class RGWVectorEnv(VectorEnv):
         obs_mode: str = "onehot",
         max_steps: int | None = 100,
         render_mode: str | None = None,
+        enemy: str = "pass",
         copy: bool = True,
     ) -> None:
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
         self._setup(
-            FixedLevel(load_map(map)),
+            FixedLevel(load_map(map), Rules(bool(classic), enemy, max_steps)),
             num_envs,
             seed,
             classic,
@@ -79,6 +92,7 @@ class RGWVectorEnv(VectorEnv):
             max_steps,
             render_mode,
             copy,
+            enemy,
         )
 
     def _setup(
@@ -91,11 +105,13 @@ class RGWVectorEnv(VectorEnv):
         max_steps: int | None,
         render_mode: str | None,
         copy: bool,
+        enemy: str,
     ) -> None:
         if not isinstance(num_envs, int | np.integer) or num_envs < 1:
             raise ConfigError(f"num_envs must be a positive integer, got {num_envs!r}")
-        check_options(obs_mode, max_steps, render_mode)
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
         self.source = source
+        self.enemy = enemy
         self.num_envs = int(num_envs)
         self.classic, self.obs_mode, self.max_steps = bool(classic), obs_mode, max_steps
         self.render_mode = render_mode
@@ -107,7 +123,12 @@ class RGWVectorEnv(VectorEnv):
         self.action_space = spaces.MultiDiscrete(np.full(self.num_envs, 4))
         self.obs_scale = 1.0 if obs_mode == "onehot" else 1 / 255
         self._batch = batch_for(
-            source, self.num_envs, classic=self.classic, obs_mode=obs_mode, max_steps=max_steps
+            source,
+            self.num_envs,
+            classic=self.classic,
+            obs_mode=obs_mode,
+            max_steps=max_steps,
+            enemy=enemy,
         )
         self._first_seed = seed
         self._seeds: np.ndarray | None = None
@@ -115,6 +136,13 @@ class RGWVectorEnv(VectorEnv):
         self._pending: np.ndarray | None = None  # sub-envs to autoreset on the next step
         self._last_info: dict[str, Any] | None = None
         self._ring = source.ring(self.num_envs) if source.per_episode else None
+        # Each sub-env's level description, (n,) arrays replaced (never written) on new levels.
+        if source.per_episode:  # set by reset()
+            n = self.num_envs
+            self._level = LevelInfo(np.zeros(n), *(np.zeros(n, dtype=bool) for _ in range(3)))
+        else:
+            zeros = np.zeros(self.num_envs, dtype=np.int64)
+            self._level = source.levels(zeros, zeros)[2]
         # Named objects of procedural levels by (seed, episode), built on first decode.
         self._objects = ObjectsCache(size=max(256, 4 * self.num_envs))
 
@@ -153,8 +181,9 @@ class RGWVectorEnv(VectorEnv):
         else:
             self._episodes = self._episodes + 1
         if self._ring is not None:
-            cells, starts = self._ring.take(np.arange(n), self._seeds, self._episodes)
+            cells, starts, level = self._ring.take(np.arange(n), self._seeds, self._episodes)
             self._batch.set_levels(np.arange(n), cells, starts)
+            self._level = level
         self._batch.reset_rows(None)
         self._pending = None
         info = self._info(np.zeros(n, dtype=np.uint16), np.zeros(n, dtype=bool))
@@ -173,8 +202,13 @@ class RGWVectorEnv(VectorEnv):
             self._episodes = self._episodes.copy()
             self._episodes[rows] += 1
             if self._ring is not None:
-                cells, starts = self._ring.take(rows, self._seeds[rows], self._episodes[rows])
+                cells, starts, level = self._ring.take(
+                    rows, self._seeds[rows], self._episodes[rows]
+                )
                 b.set_levels(rows, cells, starts)
+                self._level = LevelInfo(*(a.copy() for a in self._level))
+                for mine, new in zip(self._level, level, strict=True):
+                    mine[rows] = new
             b.reset_rows(rows)
             res.reward[rows] = 0.0
             res.terminated[rows] = False
@@ -203,6 +237,7 @@ class RGWVectorEnv(VectorEnv):
             "truncated": truncated,
             "removed": b.removed,
             "episode_id": self._episodes,
+            **self._level._asdict(),
         }
         if self.source.per_episode:
             info["seed"] = self._seeds
@@ -221,6 +256,7 @@ class RGWVectorEnv(VectorEnv):
             "objects": objects.with_agent(pos, int(info["removed"][i])),
             "events": rules.EVENT_TUPLES[int(info["events"][i])],
             "outcome": rules.outcome_name(int(info["events"][i]), bool(info["truncated"][i])),
+            **LevelInfo(*(info[k] for k in LEVEL_KEYS)).row(i),
         }
 
     def _level_objects(self, i: int, seed: int, episode: int) -> LevelObjects:
@@ -239,6 +275,29 @@ class RGWVectorEnv(VectorEnv):
         return objects
 
     # -- symbolic views and rendering ----------------------------------------
+
+    @property
+    def rules(self) -> Rules:
+        """The rule options the levels are played and searched by (rgw_solver.Rules)."""
+        return self.source.rules
+
+    def current_levels(self) -> tuple[np.ndarray, np.ndarray]:
+        """(n, H * W) uint8 initial cells and (n,) start cells of each sub-env's level.
+
+        For searches over the levels being played (rgw_solver), e.g. what a
+        route without the sword earns in evaluation.
+        """
+        b = self._batch
+        slots = b.slot
+        return b.level_cells[slots].copy(), b.level_start[slots].copy()
+
+    def agent_states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(n,) agent cells, (n,) removed-objects bitmasks and (n,) steps taken this episode.
+
+        With :meth:`current_levels`, the state a search needs (rgw_solver.Planner).
+        """
+        b = self._batch
+        return b.pos.copy(), b.removed.copy(), b.t.copy()
 
     def entity_grid(self) -> np.ndarray:
         """(n, H, W) entity codes of the current states; names in ``entity_names``."""
@@ -269,12 +328,15 @@ class RGWRandomVectorEnv(RGWVectorEnv):
         obs_mode: str = "onehot",
         max_steps: int | None = 100,
         render_mode: str | None = None,
+        enemy: str | None = None,
         copy: bool = True,
         **level_kwargs: Any,
     ) -> None:
         self.level_config = config_from_kwargs(level_kwargs)
+        enemy = random_enemy(enemy, classic)
+        check_options(obs_mode, max_steps, render_mode, enemy, classic)
         self._setup(
-            RandomLevels(self.level_config),
+            RandomLevels(self.level_config, Rules(bool(classic), enemy, max_steps)),
             num_envs,
             seed,
             classic,
@@ -282,4 +344,5 @@ class RGWRandomVectorEnv(RGWVectorEnv):
             max_steps,
             render_mode,
             copy,
+            enemy,
         )

@@ -4,6 +4,7 @@
 * :mod:`~neurosym.export.recording` -- the Recording tables and their Parquet round trip
 * :mod:`~neurosym.export.thresholds` -- ``abs:X``, ``quantile:Q``, ``z:K`` per relation
 * :mod:`~neurosym.export.facts` -- ``extract_facts(recording, threshold)`` -> FactSet
+* :mod:`~neurosym.export.heads` -- ``head_summary(recording)``: which heads relate two objects
 * :mod:`~neurosym.export.prolog_writer` -- pandas tables -> Prolog fact file (.pl, .qlf)
 * :mod:`~neurosym.export.cli_extract` -- the ``neurosym extract`` command
 

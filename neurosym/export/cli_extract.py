@@ -1,6 +1,6 @@
 """``neurosym extract``: record episodes, extract the R-vector facts, write the KB, print answers.
 
-    neurosym extract --checkpoint ckpt.pt [--env rgw2] [--episodes 20] [--seed 0]
+    neurosym extract --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--episodes 20] [--seed 0]
         [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
         [--format pl,parquet] [--qlf]
 
@@ -13,8 +13,9 @@ Writes into ``--out`` (default ``kb_out/<env>``):
 
 Everything is computed in memory first and then moved into place, each file
 or folder by one rename, so a failed run writes nothing and a reader never
-sees half a KB. A checkpoint that cannot be read, or that was trained on
-another env, is refused before anything is recorded.
+sees half a KB. A checkpoint that cannot be read, or that cannot play
+``--env`` (another env family or observation shape), is refused before
+anything is recorded; any env of its family with its shape is fine.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from neurosym.cli import add_action_mode
+from neurosym.cli import add_action_mode, add_env_options, map_option
 from neurosym.errors import ConfigError, OutputError
 
 FORMATS = ("pl", "parquet")
@@ -36,11 +37,7 @@ FORMATS = ("pl", "parquet")
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the extract options."""
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment to record, e.g. rgw2; must be the checkpoint's (default: it)",
-    )
+    add_env_options(parser)
     parser.add_argument(
         "--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)"
     )
@@ -111,16 +108,13 @@ def run(args: argparse.Namespace) -> int:
     if args.top_keys < 1:
         raise ConfigError(f"--top-keys must be at least 1, got {args.top_keys}")
 
-    from neurosym.envs import canonical_name
-
-    env = canonical_name(args.env) if args.env else None
-
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.checkpoint import env_for, load_agent
     from neurosym.export.facts import extract_facts
     from neurosym.export.recorder import record
 
-    agent = load_agent(args.checkpoint, env=env)
-    env = env or canonical_name(agent.env_name)
+    agent = load_agent(args.checkpoint)
+    env, overrides = map_option(args.env, args.map, agent.env_name)
+    env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once: the default folder needs the checkpoint's env
     out = Path(args.out) if args.out else Path("kb_out") / env
     if out.exists() and not out.is_dir():
@@ -135,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
         batch=args.batch,
         progress=show and _tty(),
         top_keys=args.top_keys,
+        env_kwargs=env_kwargs,
     )
     facts = extract_facts(rec, threshold=threshold)
     written = write_outputs(out, rec, facts, formats, qlf=args.qlf)

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from neurosym.errors import CheckpointError, ConfigError
+from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
 
 DEFAULT_BATCH = 64
@@ -35,7 +35,9 @@ DEFAULT_BATCH = 64
 _BACKGROUND = ("empty", "wall")
 
 
-def _meta(agent: Any, env_name: str, seed: int, greedy: bool) -> dict[str, Any]:
+def _meta(
+    agent: Any, env_name: str, seed: int, greedy: bool, env_kwargs: dict[str, Any]
+) -> dict[str, Any]:
     from neurosym import __version__
 
     config = agent.config
@@ -43,7 +45,7 @@ def _meta(agent: Any, env_name: str, seed: int, greedy: bool) -> dict[str, Any]:
         "checkpoint": str(getattr(agent, "path", "") or ""),
         "env": env_name,
         # Options the env was built with (a custom map, obs mode): plots redraw the grid from them.
-        "env_kwargs": dict(getattr(agent, "env_kwargs", {}) or {}),
+        "env_kwargs": dict(env_kwargs),
         "module": config.module,
         "heads": int(config.heads),
         "relations": int(config.relations) if config.module == "predinet" else 0,
@@ -141,23 +143,17 @@ class _Trace:
         return _by_episode(positions), _by_episode(holding), _by_episode(events_df)
 
 
-def _resolve_env(agent: Any, env: Any) -> str:
-    from neurosym.envs import canonical_name
+def _resolve_env(
+    agent: Any, env: Any, env_kwargs: dict[str, Any] | None = None
+) -> tuple[str, dict[str, Any]]:
+    """(short name, options) of the env to record on; any env of the agent's family and shape."""
+    from neurosym.agent.checkpoint import env_for
 
-    trained = canonical_name(agent.env_name)
-    if env is None:
-        return trained
-    if not isinstance(env, str):
+    if env is not None and not isinstance(env, str):
         raise ConfigError(
-            f"env must be an environment name such as {trained!r}, got {type(env).__name__}"
+            f"env must be an environment name such as {agent.env_name!r}, got {type(env).__name__}"
         )
-    name = canonical_name(env)
-    if name != trained:
-        where = getattr(agent, "path", None) or "the agent"
-        raise CheckpointError(
-            f"{where} was trained on {trained}, not {name}; record it on --env {trained}"
-        )
-    return name
+    return env_for(agent, env, env_kwargs)
 
 
 def record(
@@ -172,8 +168,13 @@ def record(
     top_keys: int = 1,
     max_steps: int = 100_000,
     threads: int | None = 1,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> Recording:
     """Play ``episodes`` episodes of ``agent`` on ``env`` (default: the env it was trained on).
+
+    ``env`` may be any env of the agent's family with its observation shape
+    (an rgw-random agent on rgw2, say); ``env_kwargs`` adds env options such
+    as ``{"map": "my_map.txt"}``.
 
     Returns a :class:`Recording` with the trace (episodes, steps, positions,
     holding, events) and what the relational module showed at every state the
@@ -198,7 +199,7 @@ def record(
         raise ConfigError(f"batch must be a positive integer, got {batch!r}")
     if top_keys < 1:
         raise ConfigError(f"top_keys must be at least 1, got {top_keys}")
-    name = _resolve_env(agent, env)
+    name, kwargs = _resolve_env(agent, env, env_kwargs)
     waves = -(-episodes // (batch or DEFAULT_BATCH))
     n = -(-episodes // waves)  # equal waves: 100 episodes at batch 64 run as 2 x 50
     if threads is not None and (
@@ -208,7 +209,7 @@ def record(
     import torch
 
     saved_threads = torch.get_num_threads()
-    venv = make_batched(name, n, seed=seed, **dict(getattr(agent, "env_kwargs", {}) or {}))
+    venv = make_batched(name, n, seed=seed, **kwargs)
     try:
         if threads is not None:
             torch.set_num_threads(threads)
@@ -217,7 +218,7 @@ def record(
     finally:
         torch.set_num_threads(saved_threads)
         venv.close()
-    rec.meta.update(_meta(agent, name, seed, greedy))
+    rec.meta.update(_meta(agent, name, seed, greedy, kwargs))
     return rec
 
 

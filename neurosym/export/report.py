@@ -1,4 +1,4 @@
-"""What ``neurosym extract`` prints: episodes and returns, facts, strongest relations, rule answers.
+"""What ``neurosym extract`` prints: episodes, facts, heads worth reading, relations, rule answers.
 
 The rule answers come from the written KB loaded with the rule files for the
 env's family (``rules/rgw.pl`` or ``rules/boxworld.pl``, plus
@@ -94,6 +94,34 @@ def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
     return head if len(values) == 1 else f"{head}  ({len(values)})"
 
 
+def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
+    """The per-head table of :func:`neurosym.export.heads.head_summary` (PrediNet only)."""
+    from neurosym.export.heads import head_summary
+
+    heads = head_summary(rec)
+    if heads.empty:
+        return
+    table = table_type(
+        title="heads: two arguments on two different objects",
+        show_edge=False,
+    )
+    for col in ("head", "states", "two objects", "top pairs (share of states)"):
+        table.add_column(col, justify="left" if col.startswith("top") else "right")
+    for row in heads.to_dict("records"):
+        pairs = [
+            f"{row[f'pair_{k}']} {100 * row[f'share_{k}']:.0f} %"
+            for k in (1, 2, 3)
+            if row.get(f"pair_{k}") is not None
+        ]
+        table.add_row(
+            str(row["head"]),
+            str(row["states"]),
+            f"{100 * row['two_objects']:.0f} %",
+            escape(", ".join(pairs) or "none"),
+        )
+    say(table)
+
+
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
     """Print the summary of an extract run with rich (plain text when not a terminal).
 
@@ -142,6 +170,8 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             f"thresholds ({facts.threshold}): "
             + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
         )
+
+    _print_heads(rec, say, escape, Table)
 
     strongest = facts.strongest_relations(5)
     if len(strongest):

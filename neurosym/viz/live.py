@@ -192,16 +192,16 @@ def _open_env(
 ) -> tuple[gymnasium.Env, str, bool]:
     """(env, short name, whether we made it): a fresh env unless the caller passed one.
 
-    A named env other than the checkpoint's is made without the checkpoint's
-    env options (they belong to the other env); the observation shape is checked.
+    A named env may be any of the checkpoint's family with its observation
+    shape (``checkpoint.env_for`` checks and picks its options); an env object
+    passed in is checked for its shape when the episode starts.
     """
+    from neurosym.agent.checkpoint import env_for
     from neurosym.envs import canonical_name
 
     if env is None or isinstance(env, str):
-        name = env or agent.env_name
-        short = canonical_name(name)
-        same = short == canonical_name(agent.env_name)
-        return make(short, **(dict(agent.env_kwargs or {}) if same else {})), short, True
+        short, kwargs = env_for(agent, env)
+        return make(short, **kwargs), short, True
     spec = getattr(env, "spec", None)
     name = canonical_name(spec.id) if spec is not None else type(env.unwrapped).__name__
     return env, name, False
