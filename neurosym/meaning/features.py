@@ -124,11 +124,12 @@ def mhdpa_head_outputs(module: nn.Module, x: torch.Tensor) -> torch.Tensor:
     """
     B, N, F = x.shape
     H = module.heads
-    w_qk, w_vo = module.folded_weights()
-    xq = (x @ w_qk).view(B, N, H, F).transpose(1, 2)  # (B, H, N, F)
-    xv = (x @ w_vo).view(B, N, H, F).transpose(1, 2)  # (B, H, N, F)
-    att = torch.softmax(xq @ x.unsqueeze(1).transpose(-1, -2), dim=-1)  # (B, H, N, N)
-    return att @ xv  # (B, H, N, F)
+    with torch.no_grad():  # analysis only: never part of a training graph
+        w_qk, w_vo = module.folded_weights()
+        xq = (x @ w_qk).view(B, N, H, F).transpose(1, 2)  # (B, H, N, F)
+        xv = (x @ w_vo).view(B, N, H, F).transpose(1, 2)  # (B, H, N, F)
+        att = torch.softmax(xq @ x.unsqueeze(1).transpose(-1, -2), dim=-1)  # (B, H, N, N)
+        return att @ xv  # (B, H, N, F)
 
 
 @contextmanager

@@ -418,7 +418,8 @@ def probe_recording(
     saved = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
-        obs = replay_observations(recording, env, agent.env_kwargs)
+        kwargs = recording.meta.get("env_kwargs", agent.env_kwargs)  # what it was played with
+        obs = replay_observations(recording, env, kwargs)
         labels = state_labels(recording, family)
         feats, _ = head_vectors(agent.model, obs)
         base = None
