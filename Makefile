@@ -36,6 +36,7 @@ bench: setup
 	$(PY) bench/kb.py
 	$(PY) bench/train.py
 	$(PY) bench/extract.py
+	$(PY) bench/meaning.py
 
 lint: setup
 	$(PY) -m ruff check neurosym tests bench examples

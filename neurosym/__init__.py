@@ -32,6 +32,8 @@ _LAZY = {
     "PrologError": "neurosym.errors",
     "CheckpointError": "neurosym.errors",
     "Term": "neurosym.terms",
+    "probe": "neurosym.meaning.probe",
+    "intervene": "neurosym.meaning.intervene",
 }
 
 __all__ = ["__version__", *_LAZY]

@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | extract | query | plot | envs.
+"""The `neurosym` command: train | eval | extract | probe | intervene | query | plot | envs.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -87,6 +87,14 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "extract": (
         "neurosym.export.cli_extract",
         "Record episodes and write the R-vector facts as a Prolog KB.",
+    ),
+    "probe": (
+        "neurosym.meaning.cli_probe",
+        "Fit linear probes: which predicates each head's relations encode.",
+    ),
+    "intervene": (
+        "neurosym.meaning.cli_intervene",
+        "Controlled experiments: change the level or ablate heads, measure the effects.",
     ),
     "query": (
         "neurosym.prolog.cli_query",

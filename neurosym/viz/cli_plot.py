@@ -23,6 +23,7 @@ _SUBCOMMANDS = {
     "rvectors": "PrediNet: the R vector of every head at every step of an episode, as a heat map.",
     "relations": "PrediNet: each relation's distribution of values, its threshold marked.",
     "episode": "An episode as a strip of states (PNG/SVG) or an animated GIF, with route and head arrows.",
+    "probes": "Probe selectivity (accuracy - control), heads x predicates, from `neurosym probe`.",
 }
 
 
@@ -31,6 +32,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="plot", metavar="PLOT", required=True)
     for name, help_text in _SUBCOMMANDS.items():
         cmd = sub.add_parser(name, help=help_text, description=help_text)
+        if name == "probes":
+            _probes_options(cmd)
+            continue
         _source_options(cmd, gif=name == "episode")
         if name in ("mhdpa", "predinet"):
             cmd.add_argument("--step", type=int, default=0, help="state to show (default: 0)")
@@ -91,6 +95,22 @@ def configure(parser: argparse.ArgumentParser) -> None:
             )
 
 
+def _probes_options(cmd: argparse.ArgumentParser) -> None:
+    cmd.add_argument(
+        "--probes", required=True, metavar="DIR", help="a `neurosym probe` output folder"
+    )
+    cmd.add_argument(
+        "--relation",
+        default="all",
+        help="relation to show: all (the whole vector), 0, 1, ... or best (default: all)",
+    )
+    cmd.add_argument("--top", type=int, default=25, help="predicates shown at most (default: 25)")
+    cmd.add_argument("--out", required=True, metavar="FILE", help="image to write (.png or .svg)")
+    cmd.add_argument(
+        "--dpi", type=float, default=100.0, help="resolution of PNG output (default: 100)"
+    )
+
+
 def _source_options(cmd: argparse.ArgumentParser, *, gif: bool) -> None:
     source = cmd.add_mutually_exclusive_group(required=True)
     source.add_argument("--checkpoint", metavar="FILE", help="play this checkpoint (greedy)")
@@ -136,6 +156,16 @@ def run(args: argparse.Namespace) -> int:
     fmt = image_format(args.out, allowed)
     if args.dpi <= 0:
         raise ConfigError(f"--dpi must be positive, got {args.dpi:g}")
+    if args.plot == "probes":
+        from neurosym.viz.output import save_figure
+        from neurosym.viz.probes import load_probe_table, probes_figure
+
+        if args.top < 1:
+            raise ConfigError(f"--top must be at least 1, got {args.top}")
+        fig = probes_figure(load_probe_table(args.probes), args.relation, args.top)
+        path = save_figure(fig, args.out, dpi=args.dpi)
+        print(f"wrote {args.out} ({_pixels(path) if fmt == 'png' else 'svg'})")
+        return 0
     source = _load_source(args)
     written = _draw(args, source, fmt)
     print(f"wrote {args.out} ({written})")

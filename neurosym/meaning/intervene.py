@@ -1,0 +1,554 @@
+"""Controlled experiments: play the unchanged level and changed ones with the same seeds.
+
+An experiment changes one thing and says which (``experiment(X, Kind,
+Detail)``):
+
+=============================  =================================================
+``baseline``                   the unchanged level
+``remove(sword)``              the sword's cell emptied
+``remove(enemy)``              the enemy's cell emptied
+``move(enemy, R, C)``          the enemy off the route: the free cell nearest to
+                               it that no baseline episode stood on
+``move(sword, R, C)``          the sword behind the enemy: the free cell off the
+                               routes nearest to the enemy and farther from the
+                               start (Detail says ``near`` when none is farther)
+``swap(sword, enemy)``         the two cells exchanged
+``ablate(head(H))``            head H's R vector (MHDPA: its output) replaced by
+                               its mean over the baseline episodes' states
+``ablate(heads)``              every head at once: what the policy does with no
+                               state-dependent relational input
+=============================  =================================================
+
+Level changes need a fixed RGW map (rgw1, rgw2, a map given as an env
+option); on procedural levels and Box-World only the ablations run (the
+others are listed as ``experiment_skipped(Kind, Reason)``). Every experiment
+plays the same episodes: episode k from ``reset(seed=seed + k)`` and, when
+sampling, the same torch generator seed, so the baseline and a change differ
+only by the change.
+
+Measures (``measure(X, M, V)``, absolute, per experiment): ``return``,
+``success``, ``steps``; RGW also ``sword_picked``, ``enemy_met``,
+``enemy_unarmed`` (met without the sword), ``enemy_defeated`` and
+``sword_before_enemy`` (shares of episodes). ``effect(X, M, V)`` is measure
+minus the baseline's, plus, at the baseline's own states (the same agent cell
+and holding, the changed cells redrawn as the changed level shows them; for
+ablations the same observations): ``kl`` (mean KL(baseline || experiment) of
+the action distributions), ``relation_shift(H, J)`` (PrediNet: mean |change|
+of D^h_j) or ``head_shift(H)`` (MHDPA: mean L2 change of the head's pooled
+output). ``relates(H, A, B, Share)``: in the baseline, the share of states at
+which head H relates A and B (PrediNet: attends the pair; MHDPA: one's
+strongest key is the other), which rules/causal.pl uses to tell whether an
+ablated head related sword and enemy.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from neurosym.errors import ConfigError
+from neurosym.terms import Term
+
+DEFAULT_EPISODES = 100
+"""episodes per experiment by default (sampled actions, seeds S..S+99)"""
+
+TRACE_TABLES = ("episodes", "steps", "positions", "holding", "events")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One experiment: its id, what it changes, and how."""
+
+    id: str
+    """atom naming it in the facts: baseline, remove_sword, ablate_head_2, ..."""
+    kind: Any
+    """Term (or the atom ``baseline``) for experiment/3's Kind"""
+    detail: Any
+    """Term or atom for experiment/3's Detail"""
+    map_text: str | None = None
+    """the changed map (None: the baseline's level)"""
+    ablate: tuple[int, ...] = ()
+    """heads replaced by their baseline mean"""
+
+
+@dataclass
+class InterventionReport:
+    """What the experiments did: the experiments, their measures and effects, their episodes."""
+
+    experiments: list[Experiment]
+    measures: pd.DataFrame
+    """``experiment, measure, value`` (measure as Prolog text)"""
+    effects: pd.DataFrame
+    """``experiment, measure, value``: change against the baseline"""
+    relates: pd.DataFrame
+    """``head, a, b, share``"""
+    recordings: dict[str, Any]
+    """experiment id -> its Recording (episode ids already offset)"""
+    skipped: list[tuple[str, str]] = field(default_factory=list)
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def episode_offset(self, experiment: str) -> int:
+        return int(self.meta["episode_stride"]) * [e.id for e in self.experiments].index(experiment)
+
+    def facts(self) -> dict[str, pd.DataFrame]:
+        """Tables for the Prolog writer (see :meth:`to_prolog`)."""
+        from neurosym.export.facts import extract_facts
+        from neurosym.export.recording import Recording
+
+        merged = Recording(
+            **{
+                name: pd.concat(
+                    [getattr(r, name) for r in self.recordings.values()], ignore_index=True
+                )
+                for name in TRACE_TABLES
+            },
+            meta=self.recordings["baseline"].meta,
+        )
+        trace = extract_facts(merged).prolog_tables()
+        for name in ("attends", "relation", "holds", "threshold", "attention"):
+            trace.pop(name, None)
+        meta = trace.pop("kb_meta")
+        meta = meta[meta["key"] != "threshold"]
+        extra = pd.DataFrame(
+            {
+                "key": list(self.meta),
+                "value": pd.Series([self.meta[k] for k in self.meta], dtype=object),
+            }
+        )
+        meta = pd.concat([meta[~meta["key"].isin(extra["key"])], extra], ignore_index=True)
+        ep_rows = [
+            (e.id, int(ep))
+            for e in self.experiments
+            for ep in self.recordings[e.id].episodes["episode"].tolist()
+        ]
+        return {
+            "kb_meta": meta,
+            **trace,
+            "experiment": pd.DataFrame(
+                {
+                    "x": [e.id for e in self.experiments],
+                    "kind": pd.Series([e.kind for e in self.experiments], dtype=object),
+                    "detail": pd.Series([e.detail for e in self.experiments], dtype=object),
+                }
+            ),
+            "experiment_episode": pd.DataFrame(ep_rows, columns=["x", "episode"]),
+            "experiment_skipped": pd.DataFrame(
+                {
+                    "kind": pd.Series([_term_of(k) for k, _ in self.skipped], dtype=object),
+                    "reason": [r for _, r in self.skipped],
+                }
+            ),
+            "measure": self.measures.assign(
+                measure=pd.Series([_term_of(m) for m in self.measures["measure"]], dtype=object)
+            ),
+            "effect": self.effects.assign(
+                measure=pd.Series([_term_of(m) for m in self.effects["measure"]], dtype=object)
+            ),
+            "relates": self.relates.loc[:, ["head", "a", "b", "share"]],
+        }
+
+    def to_prolog(self, path: str | os.PathLike[str]) -> Path:
+        """Write the KB: trace facts of every experiment's episodes plus the experiment facts."""
+        from neurosym.export.facts import TERM_COLUMNS, predicate_indicators
+        from neurosym.export.prolog_writer import write_prolog
+
+        tables = self.facts()
+        term_columns = {k: v for k, v in TERM_COLUMNS.items() if k in tables}
+        term_columns["relates"] = ("a", "b")
+        header = (
+            "neurosym experiments: the unchanged level and changed ones, same seeds"
+            " (neurosym intervene).\n"
+            + ", ".join(f"{k}={v}" for k, v in self.meta.items())
+            + "\nexperiment(X, Kind, Detail), experiment_episode(X, E), experiment_skipped(Kind,"
+            " Reason),\nmeasure(X, Measure, Value), effect(X, Measure, Change), relates(Head, A,"
+            " B, Share),\nand the trace facts (episode/4, step/4, at/5, holding/3, event/3) of"
+            " every experiment."
+        )
+        dynamic = predicate_indicators(
+            ["kb_meta", "object", "episode", "step", "at", "holding", "event"]
+        ) + [
+            "experiment/3",
+            "experiment_episode/2",
+            "experiment_skipped/2",
+            "measure/3",
+            "effect/3",
+            "relates/4",
+            "holds/5",
+            "attention/6",
+            "relation/7",
+            "attends/8",
+        ]
+        return write_prolog(
+            Path(path), tables, header=header, dynamic=dynamic, term_columns=term_columns
+        )
+
+
+def _term_of(text: Any) -> Any:
+    """Measure/kind text -> Term (atoms stay str)."""
+    from neurosym.terms import parse_term
+
+    return parse_term(text) if isinstance(text, str) else text
+
+
+# ------------------------------------------------------------------ experiments
+
+
+def _cells_term(changes: tuple[Any, ...]) -> Term:
+    return Term("cells", (tuple(Term("cell", (c.row, c.col, c.before, c.after)) for c in changes),))
+
+
+def level_experiments(grid_map: Any, route: np.ndarray) -> tuple[list[Experiment], list]:
+    """The level changes for a fixed map (module docstring); (experiments, skipped)."""
+    from neurosym.meaning import levels
+
+    out: list[Experiment] = []
+    skipped: list[tuple[str, str]] = []
+
+    def add(ident: str, kind: Any, level: Any, how: str | None = None) -> None:
+        detail = _cells_term(level.changes)
+        if how is not None:
+            detail = Term(how, (detail,))
+        out.append(Experiment(ident, kind, detail, level.text))
+
+    has = {o: _count(grid_map, o) == 1 for o in ("sword", "enemy")}
+    for obj in ("sword", "enemy"):
+        if has[obj]:
+            add(f"remove_{obj}", Term("remove", (obj,)), levels.remove(grid_map, obj))
+        else:
+            skipped.append((f"remove({obj})", f"the map has {_count(grid_map, obj)} {obj} cells"))
+    if has["enemy"]:
+        cell = off_route_enemy = levels.off_route_cell(
+            grid_map, levels.cell_of(grid_map, "enemy"), route
+        )
+        if cell is not None:
+            add(
+                "move_enemy",
+                Term("move", ("enemy", *off_route_enemy)),
+                levels.move(grid_map, "enemy", *cell),
+                "off_route",
+            )
+        else:
+            skipped.append(("move(enemy)", "every free cell is on a baseline route"))
+    if has["sword"] and has["enemy"]:
+        found = levels.behind_cell(grid_map, "enemy", route)
+        if found is not None:
+            (r, c), how = found
+            add(
+                "move_sword",
+                Term("move", ("sword", r, c)),
+                levels.move(grid_map, "sword", r, c),
+                f"{how}_enemy",
+            )
+        else:
+            skipped.append(("move(sword)", "no free cell off the baseline routes"))
+        add(
+            "swap_sword_enemy",
+            Term("swap", ("sword", "enemy")),
+            levels.swap(grid_map, "sword", "enemy"),
+        )
+    else:
+        skipped.append(("swap(sword,enemy)", "the map lacks a single sword and enemy"))
+    return out, skipped
+
+
+def _count(grid_map: Any, obj: str) -> int:
+    from neurosym.meaning.levels import SYMBOL_OF
+
+    return int(("".join(grid_map.text().splitlines())).count(SYMBOL_OF[obj]))
+
+
+def ablation_experiments(heads: int, module: str) -> list[Experiment]:
+    """Each head ablated in turn, then all of them."""
+    what = "r_vector" if module == "predinet" else "head_output"
+    detail = Term("replaced", (what, Term("mean_over", ("baseline",))))
+    out = [
+        Experiment(f"ablate_head_{h}", Term("ablate", (Term("head", (h,)),)), detail, ablate=(h,))
+        for h in range(heads)
+    ]
+    out.append(
+        Experiment("ablate_heads", Term("ablate", ("heads",)), detail, ablate=tuple(range(heads)))
+    )
+    return out
+
+
+# ------------------------------------------------------------------ measures
+
+
+def behaviour(recording: Any, family: str) -> dict[str, float]:
+    """Absolute measures of one experiment's episodes (module docstring)."""
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES
+
+    eps = recording.episodes
+    n = max(len(eps), 1)
+    out = {
+        "return": float(eps["return"].mean()),
+        "success": float(eps["outcome"].isin(SUCCESS_OUTCOMES).sum() / n),
+        "steps": float(eps["steps"].mean()),
+    }
+    if family != "rgw":
+        return out
+    ev = recording.events
+    first = ev.groupby(["episode", "event"])["t"].min().unstack()  # (episodes, events)
+    first = first.reindex(eps["episode"])
+
+    def col(name: str) -> np.ndarray:
+        if name in first:
+            return first[name].to_numpy(dtype=np.float64)
+        return np.full(len(first), np.nan)
+
+    picked = col("picked(sword)")
+    met = np.fmin(col("defeated(enemy)"), col("hurt_by(enemy)"))
+    out.update(
+        sword_picked=float(np.isfinite(picked).sum() / n),
+        enemy_met=float(np.isfinite(met).sum() / n),
+        enemy_unarmed=float(np.isfinite(col("hurt_by(enemy)")).sum() / n),
+        enemy_defeated=float(np.isfinite(col("defeated(enemy)")).sum() / n),
+        sword_before_enemy=float(
+            (np.isfinite(picked) & np.isfinite(met) & (picked < met)).sum() / n
+        ),
+    )
+    return out
+
+
+def relates_table(recording: Any, module: str) -> pd.DataFrame:
+    """``head, a, b, share``: share of the baseline's states at which head H relates A and B.
+
+    Unordered pairs of different entities, a before b alphabetically, shares > 0.
+    """
+    states = max(int(recording.episodes["steps"].sum()), 1)
+    if module == "predinet":
+        att = recording.attends
+        wide = att.pivot_table(
+            index=["episode", "t", "head"], columns="arg", values="entity", aggfunc="first"
+        ).reset_index()
+        if wide.empty:
+            return pd.DataFrame(columns=["head", "a", "b", "share"])
+        a = wide[1].astype(str).to_numpy()
+        b = wide[2].astype(str).to_numpy()
+        pairs = pd.DataFrame(
+            {"head": wide["head"].to_numpy(), "a": np.minimum(a, b), "b": np.maximum(a, b)}
+        )
+        pairs["episode"], pairs["t"] = wide["episode"].to_numpy(), wide["t"].to_numpy()
+    else:
+        att = recording.attention
+        q = att["query"].astype(str).to_numpy()
+        k = att["key"].astype(str).to_numpy()
+        pairs = pd.DataFrame({"head": att["head"].to_numpy(), "a": np.minimum(q, k), "b": np.maximum(q, k),
+                              "episode": att["episode"].to_numpy(), "t": att["t"].to_numpy()})  # fmt: skip
+    pairs = pairs[pairs["a"] != pairs["b"]].drop_duplicates(["episode", "t", "head", "a", "b"])
+    table = pairs.groupby(["head", "a", "b"]).size().rename("count").reset_index()
+    table["share"] = table["count"] / states
+    return (
+        table.loc[:, ["head", "a", "b", "share"]]
+        .sort_values(["head", "a", "b"])
+        .reset_index(drop=True)
+    )
+
+
+def matched_observations(
+    obs: np.ndarray, base_text: str, changed_text: str, env: str, env_kwargs: dict[str, Any]
+) -> np.ndarray:
+    """The baseline's states as the changed level shows them: the same agent cell and holding.
+
+    A cell the level change touched is redrawn as the changed level's first
+    observation shows it, where the state still shows it as the baseline's
+    first observation did (the agent is not on it and the baseline episode has
+    not taken its object yet); every other cell is kept.
+    """
+    from neurosym.envs import make
+
+    firsts = []
+    for text in (base_text, changed_text):
+        env_ = make(env, **{**env_kwargs, "map": text})
+        firsts.append(env_.reset(seed=0)[0])
+        env_.close()
+    first_base, first_changed = firsts  # (C, H, W)
+    differs = (first_base != first_changed).any(axis=0)  # (H, W) the changed cells
+    out = obs.copy()
+    rows, cols = np.nonzero(differs)
+    for r, c in zip(rows.tolist(), cols.tolist(), strict=True):  # a handful of cells
+        as_before = (obs[:, :, r, c] == first_base[:, r, c]).all(axis=1)  # (S,)
+        out[as_before, :, r, c] = first_changed[:, r, c]
+    return out
+
+
+def _kl(p: np.ndarray, q: np.ndarray) -> float:
+    eps = 1e-12
+    return float(np.mean(np.sum(p * (np.log(p + eps) - np.log(q + eps)), axis=1)))
+
+
+# ------------------------------------------------------------------ running
+
+
+def intervene(
+    agent: Any,
+    env: str | None = None,
+    episodes: int = DEFAULT_EPISODES,
+    seed: int = 0,
+    greedy: bool = False,
+    *,
+    levels: bool = True,
+    ablations: bool = True,
+    batch: int | None = None,
+    progress: bool = False,
+) -> InterventionReport:
+    """Play the baseline and every experiment on the batched env; measure what changed."""
+    import torch
+
+    from neurosym.envs import canonical_name, env_family
+    from neurosym.envs.rgw_maps import load_map
+    from neurosym.export.recorder import _resolve_env, record
+    from neurosym.meaning.features import (
+        ablate_heads,
+        head_means,
+        head_vectors,
+        replay_observations,
+    )
+
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
+    name = _resolve_env(agent, env)
+    family = env_family(name)
+    module = agent.config.module
+    env_kwargs = dict(agent.env_kwargs or {})
+    stride = 10 ** len(str(episodes - 1))
+    # one wave per experiment where it fits: waves of the recorder's default 64 leave
+    # the model running on small batches (the cost here is the forward pass per step)
+    batch = batch or min(episodes, 256)
+
+    def play(exp: Experiment, index: int, base_means: dict | None) -> Any:
+        who = agent
+        if exp.map_text is not None:
+            who = dataclasses.replace(agent, env_kwargs={**env_kwargs, "map": exp.map_text})
+        if exp.ablate:
+            with ablate_heads(agent.model, {h: base_means[h] for h in exp.ablate}):
+                rec = record(who, name, episodes=episodes, seed=seed, greedy=greedy, batch=batch)
+        else:
+            rec = record(who, name, episodes=episodes, seed=seed, greedy=greedy, batch=batch)
+        offset = index * stride
+        for table in TRACE_TABLES:
+            df = getattr(rec, table)
+            df["episode"] = df["episode"] + offset
+        return rec
+
+    baseline = Experiment("baseline", "baseline", "unchanged")
+    experiments = [baseline]
+    recs = {"baseline": play(baseline, 0, None)}
+    base_rec = recs["baseline"]
+    saved = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        base_obs = replay_observations(_shifted(base_rec, 0), name, env_kwargs)
+        base_vec, base_p = head_vectors(agent.model, base_obs)
+        means = head_means(agent.model, base_obs)
+    finally:
+        torch.set_num_threads(saved)
+    skipped: list[tuple[str, str]] = []
+    fixed_map = family == "rgw" and name != "rgw-random"
+    base_text = None
+    if levels and fixed_map:
+        grid_map = load_map(env_kwargs.get("map", name))
+        base_text = grid_map.text()
+        route = np.zeros(grid_map.height * grid_map.width, dtype=bool)
+        agent_pos = base_rec.positions[base_rec.positions["object"] == "agent"]
+        route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
+        found, skipped = level_experiments(grid_map, route)
+        experiments += found
+    elif levels:
+        why = (
+            "procedural levels change every episode"
+            if family == "rgw"
+            else "Box-World levels are generated"
+        )
+        for kind in (
+            "remove(sword)",
+            "remove(enemy)",
+            "move(enemy)",
+            "move(sword)",
+            "swap(sword,enemy)",
+        ):
+            if family == "rgw":
+                skipped.append((kind, f"level changes need a fixed map; {why}"))
+        if family != "rgw":
+            skipped.append(("level_changes", f"level changes are RGW-only; {why}"))
+    if ablations:
+        experiments += ablation_experiments(int(agent.config.heads), module)
+    for index, exp in enumerate(experiments[1:], start=1):
+        recs[exp.id] = play(exp, index, means)
+
+    # measures and effects
+    m_rows, e_rows = [], []
+    base_m = behaviour(base_rec, family)
+    for exp in experiments:
+        m = behaviour(recs[exp.id], family)
+        for key, value in m.items():
+            m_rows.append((exp.id, key, value))
+            if exp.id != "baseline":
+                e_rows.append((exp.id, key, value - base_m[key]))
+        if exp.id == "baseline":
+            continue
+        torch.set_num_threads(1)
+        try:
+            if exp.ablate:
+                with ablate_heads(agent.model, {h: means[h] for h in exp.ablate}):
+                    vec, p = head_vectors(agent.model, base_obs)
+            else:
+                obs = matched_observations(base_obs, base_text, exp.map_text, name, env_kwargs)
+                vec, p = head_vectors(agent.model, obs)
+        finally:
+            torch.set_num_threads(saved)
+        e_rows.append((exp.id, "kl", _kl(base_p, p)))
+        diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
+        if module == "predinet":
+            J = int(agent.config.relations)
+            shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
+            for h in range(shift.shape[0]):
+                for j in range(J):
+                    e_rows.append((exp.id, f"relation_shift({h},{j})", float(shift[h, j])))
+        else:
+            shift = np.linalg.norm(diff, axis=2).mean(axis=0)  # (H,)
+            for h in range(len(shift)):
+                e_rows.append((exp.id, f"head_shift({h})", float(shift[h])))
+    from neurosym import __version__
+
+    meta = {
+        "checkpoint": str(getattr(agent, "path", "") or ""),
+        "env": canonical_name(name),
+        "module": module,
+        "heads": int(agent.config.heads),
+        "relations": int(agent.config.relations) if module == "predinet" else 0,
+        "episodes": int(episodes),
+        "seed": int(seed),
+        "greedy": bool(greedy),
+        "episode_stride": int(stride),
+        "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
+        "version": __version__,
+    }
+    return InterventionReport(
+        experiments=experiments,
+        measures=pd.DataFrame(m_rows, columns=["experiment", "measure", "value"]),
+        effects=pd.DataFrame(e_rows, columns=["experiment", "measure", "value"]),
+        relates=relates_table(base_rec, module),
+        recordings=recs,
+        skipped=skipped,
+        meta=meta,
+    )
+
+
+def _shifted(rec: Any, offset: int) -> Any:
+    """The recording with its episode ids moved back by ``offset`` (for replay)."""
+    if offset == 0:
+        return rec
+    out = dataclasses.replace(rec)
+    for table in TRACE_TABLES:
+        df = getattr(rec, table).copy()
+        df["episode"] -= offset
+        setattr(out, table, df)
+    return out

@@ -1,0 +1,122 @@
+"""``neurosym probe``, ``neurosym intervene`` and ``neurosym plot probes`` run for real on shipped agents."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+RULES = REPO / "rules"
+
+
+def loads(swipl: Path, *files: Path) -> None:
+    """Real SWI-Prolog loads the files without a word."""
+    proc = subprocess.run(
+        [swipl, "-q", "-g", "halt", *files], capture_output=True, text=True, timeout=120
+    )
+    assert (proc.returncode, proc.stdout, proc.stderr) == (0, "", ""), proc.stderr
+
+
+def test_probe_writes_a_kb_the_table_and_json(run_neurosym, tmp_path: Path, swipl: Path) -> None:
+    out = tmp_path / "probe"
+    proc = run_neurosym(
+        "probe", "--checkpoint", REPO / "checkpoints" / "rgw1-predinet.pt",
+        "--episodes", 6, "--seed", 3, "--out", out, "--json",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.splitlines()]
+    assert rows, "no probes"
+    for key in ("head", "relation", "predicate", "accuracy", "control", "selectivity"):
+        assert key in rows[0]
+    table = pd.read_parquet(out / "probes.parquet")
+    assert len(table) == len(rows)
+    assert set(table["relation"]) == {*map(str, range(8)), "all"}
+    skipped = pd.read_parquet(out / "probes_skipped.parquet")
+    assert not set(skipped["predicate"]) & set(table["predicate"])
+    text = (out / "kb.pl").read_text()
+    assert text.count("\nprobe(") == len(table)
+    assert "probe_skipped(" in text
+    loads(swipl, out / "kb.pl", RULES / "meaning.pl")
+
+    picture = tmp_path / "probes.png"
+    drawn = run_neurosym("plot", "probes", "--probes", out, "--out", picture)
+    assert drawn.returncode == 0, drawn.stderr
+    assert picture.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_intervene_writes_experiments_effects_and_the_causal_answer(
+    run_neurosym, tmp_path: Path, swipl: Path
+) -> None:
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    out = tmp_path / "intervene"
+    proc = run_neurosym(
+        "intervene", "--checkpoint", REPO / "checkpoints" / "rgw2-predinet.pt",
+        "--episodes", 3, "--out", out,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "sword_enemy_cause: " in proc.stdout
+    kb_path = out / "kb.pl"
+    loads(swipl, kb_path, RULES / "causal.pl")
+    with KnowledgeBase(kb_path, rules=[RULES / "causal.pl"]) as kb:
+        found = kb.query("experiment(X, K, _), format(atom(T), '~q', [K])")
+        ids, kinds = [r["X"] for r in found], [str(r["T"]) for r in found]
+        assert kinds[0] == "baseline"
+        for kind in ("remove(sword)", "remove(enemy)", "swap(sword,enemy)"):
+            assert kind in kinds
+        assert sum(k.startswith("move(enemy,") for k in kinds) == 1
+        assert sum(k.startswith("move(sword,") for k in kinds) == 1
+        assert "ablate(head(0))" in kinds and "ablate(heads)" in kinds
+        pairs = kb.query("experiment_episode(X, E)")
+        episodes = [r["E"] for r in pairs]
+        assert len(episodes) == len(set(episodes)) == 3 * len(kinds)
+        assert kb.count("episode(_, _, _, _)") == len(episodes)
+        assert {r["E"] for r in pairs if r["X"] == "baseline"} == {0, 1, 2}
+        assert kb.count("effect(remove_sword, kl, _)") == 1
+        assert kb.count("effect(ablate_head_1, relation_shift(1, _), _)") == 8
+        answer = kb.query("sword_enemy_cause(A)")
+        assert len(answer) == 1
+    effects = pd.read_parquet(out / "effects.parquet")
+    assert set(effects["experiment"]) == set(ids) - {"baseline"}
+    # ablating a head changes only that head's vector at the baseline's states
+    shift = effects[effects["measure"].str.startswith("relation_shift(")]
+    ab0 = shift[shift["experiment"] == "ablate_head_0"]
+    others = ab0[~ab0["measure"].str.startswith("relation_shift(0,")]
+    assert (others["value"] == 0).all() and (ab0["value"] > 0).any()
+
+
+def test_intervene_ablates_mhdpa_heads(run_neurosym, tmp_path: Path, swipl: Path) -> None:
+    out = tmp_path / "mhdpa"
+    proc = run_neurosym(
+        "intervene", "--checkpoint", REPO / "checkpoints" / "rgw1-mhdpa.pt",
+        "--episodes", 2, "--no-levels", "--out", out, "--json",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.splitlines()]
+    shifts = {
+        (r["experiment"], r["measure"]): r["value"] for r in rows if "head_shift" in r["measure"]
+    }
+    assert shifts[("ablate_head_2", "head_shift(2)")] > 0
+    assert shifts[("ablate_head_2", "head_shift(0)")] == 0
+    loads(swipl, out / "kb.pl", RULES / "causal.pl")
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["probe", "--episodes", "1"], "--episodes must be at least 2"),
+        (["intervene", "--episodes", "0"], "--episodes must be at least 1"),
+    ],
+)
+def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], message: str) -> None:
+    out = tmp_path / "x"
+    proc = run_neurosym(*args[:1], "--checkpoint", REPO / "checkpoints" / "rgw2-predinet.pt",
+                        *args[1:], "--out", out)  # fmt: skip
+    assert proc.returncode == 1
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], proc.stderr
+    assert not out.exists()
