@@ -414,10 +414,10 @@ def intervene(
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
-    name = _resolve_env(agent, env)
+    name, env_kwargs = _resolve_env(agent, env)
+    env_kwargs = dict(env_kwargs)
     family = env_family(name)
     module = agent.config.module
-    env_kwargs = dict(agent.env_kwargs or {})
     stride = 10 ** len(str(episodes - 1))
     # one wave per experiment where it fits: waves of the recorder's default 64 leave
     # the model running on small batches (the cost here is the forward pass per step)
