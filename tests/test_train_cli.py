@@ -147,7 +147,7 @@ def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path:
     events = EventAccumulator(str(out / "tensorboard"))
     events.Reload()
     tags = set(events.Tags()["scalars"])
-    assert {"charts/episodic_return", "charts/fps", "losses/policy_loss"} <= tags
+    assert {"charts/fps", "losses/entropy", "losses/policy_loss"} <= tags  # no episode ends in 256 frames
     steps = [e.step for e in events.Scalars("losses/policy_loss")]
     assert steps and steps == sorted(steps) and steps[-1] <= agent.meta["frames"]
 
