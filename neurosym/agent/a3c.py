@@ -48,7 +48,31 @@ from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
 from neurosym.agent.sil import EpisodeMemory, SILBatch, sil_loss
 
 
-class SharedAdam(torch.optim.Adam):
+class _SharedState:
+    """Optimiser statistics created up front (torch makes them lazily, per process) so that
+    :meth:`share_memory` can move them to shared memory before the workers start."""
+
+    STATE_KEYS: tuple[str, ...] = ()
+    """the per-parameter statistics besides ``step``"""
+
+    def _init_state(self) -> None:
+        for group in self.param_groups:  # type: ignore[attr-defined]
+            for p in group["params"]:
+                state = self.state[p]  # type: ignore[attr-defined]
+                if not state:
+                    state["step"] = torch.zeros(())
+                    for key in self.STATE_KEYS:
+                        state[key] = torch.zeros_like(p, memory_format=torch.preserve_format)
+
+    def share_memory(self):  # returns self, for chaining
+        """Move the statistics to shared memory (call again after load_state_dict)."""
+        for state in self.state.values():  # type: ignore[attr-defined]
+            for value in state.values():
+                value.share_memory_()
+        return self
+
+
+class SharedAdam(_SharedState, torch.optim.Adam):
     """Adam whose moment estimates are created eagerly and can live in shared memory.
 
     The usual optimiser of A3C implementations (e.g. ikostrikov's pytorch-a3c):
@@ -57,38 +81,26 @@ class SharedAdam(torch.optim.Adam):
     fast as the policy head (bench/diagnose.py measured the sizes).
     """
 
+    STATE_KEYS = ("exp_avg", "exp_avg_sq")
+
     def __init__(self, params: Iterable[torch.nn.Parameter], lr: float, eps: float) -> None:
         super().__init__(params, lr=lr, eps=eps, foreach=False)
         self._init_state()
-
-    def _init_state(self) -> None:
-        for group in self.param_groups:
-            for p in group["params"]:
-                state = self.state[p]
-                if not state:
-                    state["step"] = torch.zeros(())
-                    state["exp_avg"] = torch.zeros_like(p, memory_format=torch.preserve_format)
-                    state["exp_avg_sq"] = torch.zeros_like(p, memory_format=torch.preserve_format)
-
-    def share_memory(self) -> SharedAdam:
-        """Move the statistics to shared memory (call again after load_state_dict)."""
-        for state in self.state.values():
-            for value in state.values():
-                value.share_memory_()
-        return self
 
     def set_hyperparameters(self, lr: float, eps: float) -> None:
         for group in self.param_groups:
             group.update(lr=lr, eps=eps)
 
 
-class SharedRMSprop(torch.optim.RMSprop):
+class SharedRMSprop(_SharedState, torch.optim.RMSprop):
     """RMSprop without momentum whose statistics are created eagerly and can live in shared memory.
 
     torch's RMSprop creates its state lazily on the first step, inside each
     process; here the state exists up front so that :meth:`share_memory`
     can move it to shared memory before the workers start.
     """
+
+    STATE_KEYS = ("square_avg",)
 
     def __init__(
         self, params: Iterable[torch.nn.Parameter], lr: float, alpha: float, eps: float
@@ -97,21 +109,6 @@ class SharedRMSprop(torch.optim.RMSprop):
             params, lr=lr, alpha=alpha, eps=eps, momentum=0.0, centered=False, foreach=False
         )
         self._init_state()
-
-    def _init_state(self) -> None:
-        for group in self.param_groups:
-            for p in group["params"]:
-                state = self.state[p]
-                if not state:
-                    state["step"] = torch.zeros(())
-                    state["square_avg"] = torch.zeros_like(p, memory_format=torch.preserve_format)
-
-    def share_memory(self) -> SharedRMSprop:
-        """Move the statistics to shared memory (call again after load_state_dict)."""
-        for state in self.state.values():
-            for value in state.values():
-                value.share_memory_()
-        return self
 
     def set_hyperparameters(self, lr: float, alpha: float, eps: float) -> None:
         """Apply settings after loading a state dict (which carries the old ones)."""
