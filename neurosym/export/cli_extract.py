@@ -21,15 +21,11 @@ anything is recorded; any env of its family with its shape is fine.
 from __future__ import annotations
 
 import argparse
-import ctypes
-import os
-import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
 from neurosym.cli import add_action_mode, add_env_options, map_option
-from neurosym.errors import ConfigError, OutputError
+from neurosym.errors import ConfigError
 
 FORMATS = ("pl", "parquet")
 
@@ -146,100 +142,22 @@ def _tty() -> bool:
     return sys.stderr.isatty()
 
 
-STAGE_PREFIX = ".extract-"
-
-
 def write_outputs(
     out: Path, rec: Any, facts: Any, formats: tuple[str, ...], qlf: bool = False
 ) -> dict[str, Path]:
-    """Write into a staging folder inside ``out``, then move each product into place by rename.
+    """Write the products into ``out`` through :func:`neurosym.publish.publish`.
 
-    Only neurosym's own names (kb.pl, kb.qlf, kb.qlf.sig, facts/, recording/) are replaced in
-    ``out``; anything else there is left alone. A run killed part-way (``kill -9``)
-    leaves the previous products as they were: everything is written in the
-    staging folder first, a file replaces its old version in one rename, and a
-    folder is swapped with its old version in one ``renameat2(RENAME_EXCHANGE)``
-    where Linux offers it. What a killed run left (its staging folder, a folder
-    half-swapped by the fallback) is cleaned up or put back by the next run.
-    Returns name -> final path.
+    Only neurosym's own names (kb.pl, kb.qlf, kb.qlf.sig, facts/, recording/)
+    are replaced in ``out``; a killed run leaves the previous products as they
+    were. Returns name -> final path.
     """
-    created = not out.exists()
-    out.mkdir(parents=True, exist_ok=True)
-    _recover(out)
-    stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=out))
-    ok = False
-    try:
+    from neurosym.publish import publish
+
+    def write(stage: Path) -> None:
         if "pl" in formats:
             facts.to_prolog(stage / "kb.pl", qlf=qlf)
         if "parquet" in formats:
             facts.to_parquet(stage / "facts")
         rec.save(stage / "recording")
-        names = sorted(p.name for p in stage.iterdir() if not p.name.startswith("."))
-        written: dict[str, Path] = {}
-        for name in names:
-            _move_into_place(stage / name, out / name)
-            written[name] = out / name
-        ok = True
-        return written
-    except OSError as exc:
-        raise OutputError(f"cannot write into {out}: {exc.strerror or exc}") from None
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
-        if created and not ok:
-            shutil.rmtree(out, ignore_errors=True)
 
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def _recover(out: Path) -> None:
-    """Undo what a killed run left in ``out``: its staging folder, a folder it had moved aside."""
-    for entry in out.iterdir():
-        name = entry.name
-        if name.startswith(STAGE_PREFIX):
-            pid = name[len(STAGE_PREFIX) :].split("-", 1)[0]
-            if pid.isdigit() and not _alive(int(pid)):
-                shutil.rmtree(entry, ignore_errors=True)
-        elif name.startswith(".") and ".old-" in name:
-            product, _, pid = name[1:].rpartition(".old-")
-            if product in ("facts", "recording") and pid.isdigit() and not _alive(int(pid)):
-                if (out / product).exists():
-                    shutil.rmtree(entry, ignore_errors=True)
-                else:  # killed between moving the old folder aside and the new one in
-                    os.replace(entry, out / product)
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap two paths in one step (Linux renameat2 RENAME_EXCHANGE); False where unsupported."""
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        renameat2 = libc.renameat2
-    except (OSError, AttributeError):
-        return False
-    at_fdcwd, rename_exchange = -100, 2
-    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
-
-
-def _move_into_place(src: Path, dst: Path) -> None:
-    """Rename ``src`` onto ``dst``: a file in one os.replace, a folder by swapping it with the old one."""
-    if src.is_dir():
-        if dst.is_dir() and _exchange(src, dst):
-            shutil.rmtree(src, ignore_errors=True)  # src now holds the old folder
-            return
-        old = None
-        if dst.exists():
-            old = dst.with_name(f".{dst.name}.old-{os.getpid()}")
-            shutil.rmtree(old, ignore_errors=True)
-            os.replace(dst, old)
-        os.replace(src, dst)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.replace(src, dst)
+    return publish(out, write, folders=("facts", "recording"), prefix=".extract-")
