@@ -42,7 +42,12 @@ def test_thesis_preset_is_table_4() -> None:
 
 def test_default_preset_departures_and_algo() -> None:
     bw = TrainConfig.for_family("boxworld")
-    assert (bw.optimizer, bw.normalize_advantages, bw.reward_scale) == ("adam", True, 0.1)
+    assert (bw.optimizer, bw.normalize_advantages, bw.reward_scale, bw.sil) == (
+        "adam",
+        True,
+        0.1,
+        1.0,
+    )
     ppo = TrainConfig.for_family("boxworld", algo="ppo")
     assert (ppo.algo, ppo.workers, ppo.sil, ppo.explore) == ("ppo", 1, 0.0, 0.0)
     assert TrainConfig.for_family("rgw", lr=5e-4).lr == 5e-4

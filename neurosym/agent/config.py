@@ -82,8 +82,10 @@ _DEFAULT_TRAIN: dict[str, dict[str, Any]] = {
         "gae_lambda": 1.0,
     },
     # Adam, GAE, running-RMS advantages, rewards x 0.1: the +11 gem otherwise makes the
-    # critic's loss (and its pull on the shared layers) a hundred times the actor's
-    "boxworld": {"lr": 5e-4, "entropy": 0.01, "reward_scale": 0.1},
+    # critic's loss (and its pull on the shared layers) a hundred times the actor's.
+    # Self-imitation 1.0: without it A3C on bw1 stayed at 17-29 % success after 1.8 M
+    # frames; with it 75 % at 1.4 M and 93-100 % at 2.3-2.5 M (PrediNet, 2 workers)
+    "boxworld": {"lr": 5e-4, "entropy": 0.01, "reward_scale": 0.1, "sil": 1.0},
 }
 _PPO_TRAIN: dict[str, Any] = {
     "envs": 64,
