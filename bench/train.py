@@ -11,6 +11,12 @@ Parts (``--only`` takes a comma-separated list; default: all):
   module: the training success rate (last ``--window`` episodes) at each
   metrics row, and the final checkpoint's sampled success over 1000 episodes;
   first, the success of uniformly random actions over 1000 episodes.
+* ``distributed``: PPO frames per second under ``torchrun --standalone
+  --nproc_per_node R`` for R in ``--ranks`` (default 1,2), each rank with the
+  default 64 envs (weak scaling: the batch grows with the ranks), and the
+  figures behind the README's plan for N machines: parameters, all-reduce
+  bytes per update (DDP reduces every minibatch's gradient), frames per
+  update, and seconds per update at each R.
 
 Every part runs the real command (``python -m neurosym train``) in a
 subprocess, in a temporary directory. Thesis figures for comparison (Box-World,
@@ -18,6 +24,8 @@ success over the last 1000 training episodes): bw1 PrediNet 29.3 %, MHDPA
 36.5 %; bw2 22.5 %, 22.8 %; bw3 11.3 %, 8.8 %.
 
     python bench/train.py --only fps,solve
+    python bench/train.py --only fps --fps-env bw1 --fps-algos a3c,ppo
+    python bench/train.py --only distributed --modules predinet
 """
 
 from __future__ import annotations
@@ -106,32 +114,103 @@ def checkpoint_metrics(out: Path) -> dict:
     return torch.load(out / "checkpoint.pt", weights_only=True)["metrics"]
 
 
-def bench_fps(workers: int, seconds: float, modules: tuple[str, ...], env: str) -> None:
+def bench_fps(
+    workers: int,
+    seconds: float,
+    modules: tuple[str, ...],
+    env: str,
+    algos: tuple[str, ...] = ("a3c",),
+) -> None:
+    for algo in algos:
+        for module in modules:
+            # A3C: K envs per worker; PPO: one learner, K = its default 64 and Table 4's 32
+            for k in (1, 8, 32) if algo == "a3c" else (32, 64):
+                bench_fps_run(workers, seconds, module, env, algo, k)
+
+
+def bench_fps_run(workers: int, seconds: float, module: str, env: str, algo: str, k: int) -> None:
+    with run_dir(f"fps-{algo}-{module}-k{k}") as out:
+        proc = train(
+            env, module, out,
+            "--algo", algo, "--envs", str(k), "--minutes", str(seconds / 60),
+            "--eval-interval", "1000000",
+            *(("--workers", str(workers)) if algo == "a3c" else ()),
+            timeout=seconds + 120,
+        )  # fmt: skip
+        if failed(proc, bench="train_fps", module=module, envs=k, algo=algo):
+            return
+        frames, wall = steady_frames(out)
+        emit(
+            {
+                "bench": "train_fps",
+                "env": env,
+                "algo": algo,
+                "module": module,
+                "workers": workers if algo == "a3c" else 1,
+                "envs": k,
+                "frames": frames,
+                "seconds": round(wall, 2),
+                "fps": round(frames / wall, 1),
+                "cpus": os.cpu_count(),
+            }
+        )
+
+
+def steady_frames(out: Path) -> tuple[int, float]:
+    """(frames, seconds) between the first and the last metrics rows: start-up left out."""
+    table = rows(out)
+    first, last = table[0], table[-1]
+    return int(last["frames"]) - int(first["frames"]), float(last["wall_s"]) - float(
+        first["wall_s"]
+    )
+
+
+def bench_distributed(env: str, modules: tuple[str, ...], ranks: list[int], seconds: float) -> None:
+    """PPO frames/s under torchrun for each rank count, and the all-reduce volume per update."""
+    from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
+    from neurosym.agent.model import ActorCritic
+    from neurosym.agent.trainer import probe_env
+    from neurosym.envs import env_family
+
+    kwargs = preset_env_kwargs(env_family(env))
+    name, family, shape, scale = probe_env(env, kwargs)
+    config = TrainConfig.for_family(family, algo="ppo")
     for module in modules:
-        for k in (1, 8, 32):
-            with run_dir(f"fps-{module}-k{k}") as out:
-                proc = train(
-                    env, module, out,
-                    "--workers", str(workers), "--envs", str(k), "--minutes", str(seconds / 60),
-                    "--eval-interval", "1000000",
-                    timeout=seconds + 120,
+        params = sum(
+            p.numel()
+            for p in ActorCritic(ModelConfig.for_family(family, module, shape, scale)).parameters()
+        )
+        reductions = config.ppo_epochs * config.ppo_minibatches  # one gradient all-reduce each
+        for r in ranks:
+            with run_dir(f"distributed-{module}-r{r}") as out:
+                t0 = time.monotonic()
+                proc = subprocess.run(
+                    [sys.executable, "-m", "torch.distributed.run", "--standalone",
+                     "--nproc_per_node", str(r), "-m", "neurosym", "train", "--env", env,
+                     "--module", module, "--algo", "ppo", "--out", str(out), "--quiet",
+                     "--minutes", str(seconds / 60), "--eval-interval", "1000000"],
+                    cwd=ROOT, capture_output=True, text=True, timeout=seconds + 300,
+                    env={**os.environ, "PYTHONHASHSEED": "0"}, check=False,
                 )  # fmt: skip
-                if failed(proc, bench="train_fps", module=module, envs=k):
+                if failed(proc, bench="train_distributed", module=module, ranks=r):
                     continue
-                table = rows(out)
-                first, last = table[0], table[-1]  # the first row includes start-up: left out
-                frames = int(last["frames"]) - int(first["frames"])
-                wall = float(last["wall_s"]) - float(first["wall_s"])
+                frames, wall = steady_frames(out)
+                per_update = r * config.envs * config.n_steps
                 emit(
                     {
-                        "bench": "train_fps",
-                        "env": env,
+                        "bench": "train_distributed",
+                        "env": name,
                         "module": module,
-                        "workers": workers,
-                        "envs": k,
+                        "ranks": r,
+                        "envs_per_rank": config.envs,
+                        "frames_per_update": per_update,
+                        "parameters": params,
+                        "allreduce_bytes_per_update": params * 4 * reductions,
                         "frames": frames,
                         "seconds": round(wall, 2),
                         "fps": round(frames / wall, 1),
+                        "seconds_per_update": round(wall * per_update / max(frames, 1), 3),
+                        "launch_seconds": round(time.monotonic() - t0, 1),
                         "cpus": os.cpu_count(),
                     }
                 )
@@ -262,7 +341,18 @@ def bench_boxworld_run(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--only", default="fps,solve,boxworld", help="parts to run: fps, solve, boxworld"
+        "--only",
+        default="fps,solve,boxworld",
+        help="parts to run: fps, solve, boxworld, distributed (default: the first three)",
+    )
+    parser.add_argument("--fps-env", default="rgw2", help="env of the fps part (rgw2)")
+    parser.add_argument(
+        "--fps-algos", default="a3c", help="learners of the fps part: a3c, ppo (a3c)"
+    )
+    parser.add_argument("--ranks", default="1,2", help="rank counts of the distributed part (1,2)")
+    parser.add_argument("--dist-env", default="bw1", help="env of the distributed part (bw1)")
+    parser.add_argument(
+        "--dist-seconds", type=float, default=90.0, help="seconds per distributed run (90)"
     )
     parser.add_argument("--modules", default="predinet,mhdpa", help="modules (comma-separated)")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (2)")
@@ -290,14 +380,19 @@ def main(argv: list[str] | None = None) -> int:
     global KEEP
     KEEP = args.keep.resolve() if args.keep else None
     parts = {p.strip() for p in args.only.split(",") if p.strip()}
-    unknown = parts - {"fps", "solve", "boxworld"}
+    unknown = parts - {"fps", "solve", "boxworld", "distributed"}
     if unknown:
         parser.error(
-            f"unknown part(s) {', '.join(sorted(unknown))}; choose from fps, solve, boxworld"
+            f"unknown part(s) {', '.join(sorted(unknown))}; "
+            "choose from fps, solve, boxworld, distributed"
         )
     modules = tuple(m.strip() for m in args.modules.split(",") if m.strip())
     if "fps" in parts:
-        bench_fps(args.workers, args.fps_seconds, modules, "rgw2")
+        algos = tuple(a.strip() for a in args.fps_algos.split(",") if a.strip())
+        bench_fps(args.workers, args.fps_seconds, modules, args.fps_env, algos)
+    if "distributed" in parts:
+        ranks = [int(r) for r in args.ranks.split(",") if r.strip()]
+        bench_distributed(args.dist_env, modules, ranks, args.dist_seconds)
     if "solve" in parts:
         bench_solve(
             [int(s) for s in args.seeds.split(",")], modules, args.workers, args.solve_minutes

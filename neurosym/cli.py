@@ -79,7 +79,10 @@ def map_option(
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "train": ("neurosym.agent.cli_train", "Train a PrediNet or MHDPA agent with A3C."),
+    "train": (
+        "neurosym.agent.cli_train",
+        "Train a PrediNet or MHDPA agent with A3C or PPO (PPO also under torchrun).",
+    ),
     "eval": (
         "neurosym.agent.cli_eval",
         "Evaluate a checkpoint: mean return, success rate, outcomes.",

@@ -97,7 +97,8 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Pa
     assert resumed.meta["frames"] >= 6000 and resumed.meta["frames"] > agent.meta["frames"]
     assert resumed.meta["episodes"] >= agent.meta["episodes"]
     assert resumed.meta["train_config"]["workers"] == 1  # an override on resume
-    assert "--resume" in resumed.meta["command"]
+    first_command, _, resume_command = resumed.meta["command"].partition(" && ")
+    assert first_command == agent.meta["command"] and "--resume" in resume_command
     rows = metrics(out)
     assert rows[: len(first)] == first and len(rows) > len(first)
     walls = [float(r["wall_s"]) for r in rows]

@@ -44,7 +44,7 @@ import torch.nn.functional as F
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
-from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
+from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 from neurosym.agent.sil import EpisodeMemory, SILBatch, sil_loss
 
 
@@ -292,6 +292,21 @@ def apply_update(
     return float(norm)
 
 
+def report_update(queue: Any, rank: int, frames: int, finished: Finished, stats: LossStats) -> None:
+    """The ``("update", ...)`` message a learner sends the trainer after each update."""
+    queue.put(
+        (
+            "update",
+            rank,
+            frames,
+            finished.returns,
+            finished.lengths,
+            finished.outcomes,
+            tuple(stats),
+        )
+    )
+
+
 def worker(
     rank: int,
     shared: ActorCritic,
@@ -341,17 +356,8 @@ def worker(
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
             loss, stats = a3c_loss(local, rollout, train_config, batch, scale)
             norm = apply_update(local, shared, optimizer, loss, train_config.grad_clip)
-            frames = int(rollout.valid.sum())
-            queue.put(
-                (
-                    "update",
-                    rank,
-                    frames,
-                    finished.returns,
-                    finished.lengths,
-                    finished.outcomes,
-                    tuple(stats._replace(grad_norm=norm)),
-                )
+            report_update(
+                queue, rank, int(rollout.valid.sum()), finished, stats._replace(grad_norm=norm)
             )
     except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
         queue.put(("error", rank, traceback.format_exc()))

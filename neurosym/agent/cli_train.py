@@ -4,6 +4,8 @@ A thin wrapper over :func:`neurosym.agent.trainer.train`. Unset options take
 the preset's defaults for the env family (``neurosym.agent.config``;
 ``--preset thesis`` is Table 4 exactly); with ``--resume`` they take the
 checkpoint's settings. The command line is stored in the checkpoint.
+Under ``torchrun`` (``--algo ppo``) every rank runs this command and rank 0
+writes (:mod:`neurosym.agent.distributed`).
 """
 
 from __future__ import annotations
@@ -79,6 +81,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--tensorboard",
         action="store_true",
         help="also write TensorBoard event files to OUT/tensorboard",
+    )
+    parser.add_argument(
+        "--device",
+        choices=("cpu", "cuda", "auto"),
+        default="cpu",
+        help="where the PPO learner acts and learns: cpu (default), cuda (falls back to the CPU "
+        "with a warning when no GPU is visible) or auto (cuda when one is visible); A3C is CPU-only",
     )
     stop = parser.add_argument_group("stopping (any that is reached; none: run until Ctrl-C)")
     stop.add_argument(
@@ -218,7 +227,13 @@ def command_line(args: argparse.Namespace) -> str:
         parts.append("--slim")
     if args.tensorboard:
         parts.append("--tensorboard")
-    return shlex.join(parts)
+    if args.device != "cpu":
+        parts += ["--device", args.device]
+    command = shlex.join(parts)
+    world = os.environ.get("WORLD_SIZE")
+    if world and world != "1":  # the checkpoint says the run was distributed
+        command = f"torchrun (WORLD_SIZE={world}) -m {command}"
+    return command
 
 
 def run(args: argparse.Namespace) -> int:
@@ -240,6 +255,7 @@ def run(args: argparse.Namespace) -> int:
         slim=args.slim,
         progress=not args.quiet,
         tensorboard=args.tensorboard,
+        device=args.device,
     )
     result = train(
         args.env,

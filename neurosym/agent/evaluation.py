@@ -62,11 +62,14 @@ def play_scored(
     seed: int,
     batch: int = 64,
     max_steps: int = 100_000,
+    levels: bool = True,
 ) -> ScoredEpisodes:
     """Play ``episodes`` episodes; ``act(obs, venv)`` gives the actions of a batch.
 
     ``act`` gets the batched env as well, so that a scripted policy (such as
-    rgw_solver's planner in the tests) can read the state.
+    rgw_solver's planner in the tests) can read the state. ``levels=False``
+    skips the level-aware scoring (its no-sword search costs time at every
+    reset): returns, lengths and outcomes only, as the trainer's evaluation wants.
     """
     from neurosym.agent.rollout import outcome_of
 
@@ -76,7 +79,7 @@ def play_scored(
         n = min(batch, episodes - first)
         venv = venvs.setdefault(n, make_venv(n))
         obs, info = venv.reset(seed=[seed + first + i for i in range(n)])
-        rgw = "optimal_return" in info
+        rgw = levels and "optimal_return" in info
         ret = np.zeros(n)
         length = np.zeros(n, dtype=np.int64)
         outcome: list[str] = [""] * n

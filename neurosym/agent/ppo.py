@@ -5,7 +5,9 @@ steps with the current weights (the same :func:`collect_rollout` as the A3C
 workers, recording the behaviour policy's logits and values), computes GAE
 advantages (the same :func:`gae_advantages`), then makes ``ppo_epochs``
 passes over the rollout's valid transitions in ``ppo_minibatches`` shuffled
-minibatches, each a clipped-surrogate step (Schulman et al. 2017)::
+minibatches (exactly that many, so that every rank of a distributed run
+takes the same number of steps), each a clipped-surrogate step (Schulman et
+al. 2017)::
 
     ratio = pi(a|o) / pi_old(a|o)
     loss  = -mean(min(ratio A, clip(ratio, 1 - eps, 1 + eps) A))
@@ -15,12 +17,21 @@ with A normalised per minibatch when ``normalize_advantages``. It writes
 straight into the trainer's shared model with the trainer's optimiser and
 reports to the trainer through the same queue messages as an A3C worker, so
 evaluation, metrics, checkpoints, resume and stopping are one code path for
-both learners. It uses all the torch threads the machine has: one process
-does all the work.
+both learners. It uses all the torch threads the machine has (its share of
+them under torchrun): one process does all the work.
+
+The learner trains a private copy of the model on its device (``--device``)
+with its own optimiser, and after every update copies the weights and the
+optimiser's statistics into the trainer's shared ones, which the trainer
+evaluates and checkpoints: one code path for the CPU and a GPU. Under
+torchrun the copy is wrapped in ``DistributedDataParallel`` and the learners
+of all ranks form the process group (:mod:`neurosym.agent.distributed`).
 """
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import os
 import signal
 import traceback
@@ -29,50 +40,60 @@ from typing import Any
 import torch
 import torch.nn.functional as F
 
-from neurosym.agent.a3c import LossStats, gae_advantages
+from neurosym.agent import distributed
+from neurosym.agent.a3c import LossStats, gae_advantages, report_update, shared_optimizer
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
-from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
+from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 
 
 def ppo_update(
-    model: ActorCritic,
+    model: torch.nn.Module,
     optimizer: torch.optim.Optimizer,
     rollout: Rollout,
     config: TrainConfig,
     generator: torch.Generator,
 ) -> LossStats:
-    """Epochs of clipped-surrogate minibatch steps on one rollout; the mean loss parts."""
+    """Epochs of clipped-surrogate minibatch steps on one rollout; the mean loss parts.
+
+    ``model`` may be wrapped in DistributedDataParallel; the rollout's CPU
+    tensors are moved to the model's device.
+    """
     assert rollout.logits is not None and rollout.values is not None, "record the rollout"
+    core = getattr(model, "module", model)
+    device = next(core.parameters()).device
     with torch.no_grad():
-        _, last_value = model(rollout.last_obs)  # (K,)
-    values = rollout.values  # (T, K)
+        _, last_value = core(rollout.last_obs.to(device))  # (K,)
+    values = rollout.values.to(device)  # (T, K)
     next_values = torch.cat([values[1:], last_value.unsqueeze(0)])  # (T, K)
     advantages = gae_advantages(
-        rollout.rewards * config.reward_scale,
+        rollout.rewards.to(device) * config.reward_scale,
         values,
-        rollout.terminated,
-        rollout.truncated,
+        rollout.terminated.to(device),
+        rollout.truncated.to(device),
         next_values,
         config.gamma,
         config.gae_lambda,
     )  # (T, K)
-    valid = rollout.valid.flatten()  # (T * K,)
-    b_obs = rollout.obs.flatten(0, 1)[valid]  # (M, C, H, W)
-    b_actions = rollout.actions.flatten()[valid]  # (M,)
-    b_logp = F.log_softmax(rollout.logits, dim=-1).flatten(0, 1)[valid]  # (M, A)
+    valid = rollout.valid.flatten().to(device)  # (T * K,)
+    b_obs = rollout.obs.to(device).flatten(0, 1)[valid]  # (M, C, H, W)
+    b_actions = rollout.actions.to(device).flatten()[valid]  # (M,)
+    b_logp = F.log_softmax(rollout.logits.to(device), dim=-1).flatten(0, 1)[valid]  # (M, A)
     b_logp = b_logp.gather(-1, b_actions.unsqueeze(-1)).squeeze(-1)  # (M,)
     b_adv = advantages.flatten()[valid]  # (M,)
     b_returns = b_adv + values.flatten()[valid]  # (M,)
     M = b_obs.shape[0]
-    size = max(1, M // config.ppo_minibatches)
     totals = torch.zeros(4)
     steps = 0
     for _ in range(config.ppo_epochs):
-        order = torch.randperm(M, generator=generator)
-        for start in range(0, M - size + 1, size):
-            mb = order[start : start + size]
+        order = torch.randperm(M, generator=generator).to(device)
+        for mb in order.tensor_split(config.ppo_minibatches):
+            # an empty minibatch (fewer transitions than minibatches) still takes its step with
+            # weight 0, so that every rank of a distributed run makes the same collectives
+            weight = 1.0 if mb.numel() else 0.0
+            if not mb.numel():
+                mb = order[:1]
             logits, value = model(b_obs[mb])  # (m, A), (m,)
             logp_all = F.log_softmax(logits, dim=-1)
             logp = logp_all.gather(-1, b_actions[mb].unsqueeze(-1)).squeeze(-1)
@@ -86,15 +107,35 @@ def ppo_update(
             value_loss = 0.5 * (value - b_returns[mb]).pow(2).mean()
             loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy
             optimizer.zero_grad(set_to_none=True)
-            loss.backward()
+            (loss * weight).backward()
             norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
             optimizer.step()
             totals += torch.stack(
                 [policy_loss.detach(), value_loss.detach(), entropy.detach(), norm.detach()]
-            )
+            ).cpu()
             steps += 1
     mean = (totals / max(steps, 1)).tolist()
     return LossStats(*mean)
+
+
+@torch.no_grad()
+def copy_into_shared(
+    local: torch.nn.Module,
+    local_opt: torch.optim.Optimizer,
+    shared: torch.nn.Module,
+    shared_opt: torch.optim.Optimizer,
+) -> None:
+    """The learner's weights and optimiser statistics into the trainer's shared ones."""
+    for dst, src in zip(shared.parameters(), local.parameters(), strict=True):
+        dst.copy_(src)
+    for dst, src in zip(shared.buffers(), local.buffers(), strict=True):
+        dst.copy_(src)
+    for g_dst, g_src in zip(shared_opt.param_groups, local_opt.param_groups, strict=True):
+        for p_dst, p_src in zip(g_dst["params"], g_src["params"], strict=True):
+            s_dst, s_src = shared_opt.state[p_dst], local_opt.state[p_src]
+            for key, value in s_src.items():
+                if torch.is_tensor(value) and key in s_dst:
+                    s_dst[key].copy_(value)
 
 
 def ppo_learner(
@@ -108,39 +149,84 @@ def ppo_learner(
     env_seed: int,
     stop: Any,
     queue: Any,
+    device: str = "cpu",
 ) -> None:
-    """The PPO learner process: rollouts and updates on ``shared`` until ``stop`` is set.
+    """The PPO learner process: rollouts and updates until ``stop`` is set (here or on any rank).
 
-    Same signature and messages as :func:`neurosym.agent.a3c.worker`.
+    Same signature and messages as :func:`neurosym.agent.a3c.worker`, plus
+    ``("stopped", rank, digests)`` when it ends on a stop: ``digests`` are
+    every rank's parameter digest (rank 0; identical when the ranks agree).
+    Under torchrun only rank 0 sends ``update`` messages, with the frames and
+    episodes of every rank.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    torch.set_num_threads(max(1, len(os.sched_getaffinity(0))))
+    world = distributed.world_from_env()
+    threads = len(os.sched_getaffinity(0)) // max(world.local_size, 1)
+    torch.set_num_threads(max(1, threads))
     try:
         from neurosym.envs import make_batched
 
+        dev = distributed.learner_device(device, world)
         torch.manual_seed(env_seed)
         generator = torch.Generator().manual_seed(env_seed)
+        local = copy.deepcopy(shared).to(dev)
+        local_opt = shared_optimizer(local.parameters(), train_config)
+        local_opt.load_state_dict(optimizer.state_dict())
+        model: torch.nn.Module = local
+        if world.distributed:
+            from torch.nn.parallel import DistributedDataParallel
+
+            distributed.init_group(dev)
+            distributed.check_same_config(model_config, train_config, env_name, env_kwargs)
+            # DDP starts every rank from rank 0's weights; the statistics follow
+            model = DistributedDataParallel(
+                local, device_ids=[dev.index] if dev.type == "cuda" else None
+            )
+            distributed.broadcast_optimizer_state(local_opt)
+            copy_into_shared(local, local_opt, shared, optimizer)
         venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
         state = RolloutState(venv, env_seed)
         bonus = None
         if train_config.explore > 0:
             bonus = CountBonus(train_config.explore, half_life=train_config.explore_half_life)
         parent = os.getppid()
-        while not stop.is_set() and os.getppid() == parent:
+        while True:
+            halt = stop.is_set() or os.getppid() != parent
+            if world.distributed:
+                halt = distributed.any_rank(halt, dev)
+            if halt:
+                break
             rollout, finished = collect_rollout(
-                shared, state, train_config.n_steps, generator, bonus, record=True
+                local, state, train_config.n_steps, generator, bonus, record=True, device=dev
             )
-            stats = ppo_update(shared, optimizer, rollout, train_config, generator)
-            queue.put(
-                (
-                    "update",
-                    rank,
-                    int(rollout.valid.sum()),
-                    finished.returns,
-                    finished.lengths,
-                    finished.outcomes,
-                    tuple(stats),
+            stats = ppo_update(model, local_opt, rollout, train_config, generator)
+            copy_into_shared(local, local_opt, shared, optimizer)
+            frames = int(rollout.valid.sum())
+            if world.distributed:
+                every = distributed.gather_to_leader(
+                    (frames, finished.returns, finished.lengths, finished.outcomes)
                 )
-            )
+                if every is None:
+                    continue
+                frames = sum(e[0] for e in every)
+                finished = Finished.empty()
+                for _, returns, lengths, outcomes in every:
+                    finished.extend(Finished(returns, lengths, outcomes))
+            report_update(queue, rank, frames, finished, stats)
+        digests = [distributed.parameter_digest(local)]
+        if world.distributed:
+            digests = distributed.gather_to_leader(digests[0]) or digests
+        queue.put(("stopped", rank, digests))
     except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
         queue.put(("error", rank, traceback.format_exc()))
+    finally:
+        # the last message reaches the pipe before anything that could hang
+        # (leaving a gloo group whose peer has gone can block while holding the
+        # GIL, which starves the queue's feeder thread until the parent gives up)
+        with contextlib.suppress(Exception):
+            queue.close()
+            queue.join_thread()
+        try:
+            distributed.leave_group()
+        except Exception:  # noqa: BLE001 - a peer that died leaves nothing to say goodbye to
+            pass

@@ -136,6 +136,7 @@ def collect_rollout(
     memory: Any | None = None,
     keep_graph: bool = False,
     record: bool = False,
+    device: torch.device | None = None,
 ) -> tuple[Rollout, Finished]:
     """Act ``n_steps`` steps in every sub-env with sampled actions.
 
@@ -150,6 +151,9 @@ def collect_rollout(
     are the environment's own. ``memory`` (an ``sil.EpisodeMemory``) is fed
     every transition, with the environment's rewards. ``record`` keeps the
     acting logits and values without a graph (PPO's behaviour policy).
+    ``device``: where the model lives (observations go there, actions are
+    drawn on the CPU so that the generator's stream is the same on any device);
+    the recorded logits and values stay there, the rest of the rollout is on the CPU.
     """
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
@@ -157,11 +161,13 @@ def collect_rollout(
     finished = Finished.empty()
     for _ in range(n_steps):
         with torch.set_grad_enabled(keep_graph):
-            logits, value = model(torch.from_numpy(state.obs))  # (K, A), (K,)
+            obs_in = torch.from_numpy(state.obs)
+            logits, value = model(obs_in if device is None else obs_in.to(device))  # (K, A), (K,)
         if keep_graph or record:
             logits_t.append(logits)
             values_t.append(value)
-        actions = select_actions(logits, greedy=False, generator=generator).numpy()
+        acting = logits if device is None else logits.detach().cpu()
+        actions = select_actions(acting, greedy=False, generator=generator).numpy()
         obs, reward, terminated, truncated, info = venv.step(actions)
         valid, done = tracker.step(venv, reward, terminated, truncated, info)
         finished.extend(done)
@@ -202,34 +208,12 @@ def play_episodes(
 
     Episode k is played from ``reset(seed=seed + k)``. ``act`` maps a batch of
     observations to actions; ``make_venv(n)`` builds a batched env of n.
-    Results are in episode order.
+    Results are in episode order. The loop is
+    :func:`neurosym.agent.evaluation.play_scored`'s, without its level scores.
     """
-    out = Finished.empty()
-    venvs: dict[int, Any] = {}
-    for start in range(0, episodes, batch):
-        n = min(batch, episodes - start)
-        venv = venvs.setdefault(n, make_venv(n))
-        obs, _ = venv.reset(seed=[seed + start + i for i in range(n)])
-        ret = np.zeros(n)
-        length = np.zeros(n, dtype=np.int64)
-        outcome: list[str | None] = [None] * n
-        live = np.ones(n, dtype=bool)
-        for _ in range(max_steps):
-            actions = np.asarray(act(obs), dtype=np.int64)
-            obs, reward, terminated, truncated, info = venv.step(actions)
-            ret += np.where(live, reward, 0.0)
-            length += live
-            ended = live & (terminated | truncated)
-            for i in np.flatnonzero(ended).tolist():
-                outcome[i] = outcome_of(venv, info, i, bool(truncated[i]))
-            live &= ~ended
-            if not live.any():
-                break
-        else:
-            raise RuntimeError(
-                f"an episode ran {max_steps} steps without ending; the env has no time limit"
-            )
-        out.returns += ret.tolist()
-        out.lengths += length.tolist()
-        out.outcomes += [str(o) for o in outcome]
-    return out
+    from neurosym.agent.evaluation import play_scored
+
+    done = play_scored(
+        lambda obs, _venv: act(obs), make_venv, episodes, seed, batch, max_steps, levels=False
+    )
+    return Finished(done.returns, done.lengths, done.outcomes)

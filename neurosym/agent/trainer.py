@@ -15,6 +15,10 @@ the final checkpoint holds (the workers keep changing the shared weights).
 Stops on: a frame budget (total frames, counting those before a resume), a
 time budget (this session), the greedy return reaching ``target_return``, or
 Ctrl-C (the workers ignore SIGINT; the parent stops them and checkpoints).
+
+Under torchrun (PPO only) every rank runs this function; rank 0 alone
+evaluates and writes, the others only run their learner and stop when it
+does (:mod:`neurosym.agent.distributed` says how the ranks agree).
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ import numpy as np
 import torch
 import torch.multiprocessing as mp
 
+from neurosym.agent import distributed
 from neurosym.agent.a3c import set_optimizer_hyperparameters, shared_optimizer, worker
 from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
@@ -79,6 +84,8 @@ class RunOptions:
     """stop when the greedy policy's mean return reaches this"""
     eval_interval: float = 2.0
     """seconds between greedy evaluations (more when one takes over 5 % of that)"""
+    device: str = "cpu"
+    """the PPO learner's device: cpu, cuda or auto (cuda when one is visible)"""
     eval_episodes: int = 8
     """episodes per greedy evaluation (played side by side)"""
     checkpoint_interval: float = 60.0
@@ -115,7 +122,7 @@ class TrainResult:
     episodes: int
     wall_s: float
     stop_reason: str
-    """frames, time, target, interrupted"""
+    """frames, time, target, interrupted, peer (another rank stopped the run)"""
     greedy_return: float | None
     solved_frames: int | None = None
     solved_wall_s: float | None = None
@@ -350,6 +357,9 @@ def train(
     and episode counts, its metrics rows.
     """
     options = options or RunOptions()
+    world = distributed.world_from_env()
+    if not world.leader:  # rank 0 alone shows progress and writes
+        options = RunOptions(**{**options.__dict__, "progress": False, "tensorboard": False})
     out = Path(out)
     ckpt_path = out / CHECKPOINT_NAME
     train_overrides = {k: v for k, v in (train_overrides or {}).items() if v is not None}
@@ -358,6 +368,11 @@ def train(
 
     payload: dict[str, Any] | None = None
     if resume:
+        if world.distributed and not ckpt_path.exists():
+            raise CheckpointError(
+                f"rank {world.rank}: {ckpt_path} is not there; --resume under torchrun needs the "
+                "run directory on every node (a shared file system)"
+            )
         payload = read_checkpoint(ckpt_path, env=env)
         env_name = payload["env"]
         kwargs = dict(payload["env_kwargs"]) if env_kwargs is None else dict(env_kwargs)
@@ -382,11 +397,14 @@ def train(
                 f"{ckpt_path} was trained with --algo {train_config.algo}; resume it with that"
             )
         frames0, episodes0 = int(payload["frames"]), int(payload["episodes"])
+        # the checkpoint records every command that made it, in order
+        if payload.get("command") and command:
+            command = f"{payload['command']} && {command}"
         wall0 = float(payload["metrics"].get("wall_s", 0.0))
     else:
         if env is None or module is None:
             raise ConfigError("--env and --module are needed unless --resume continues a run")
-        if ckpt_path.exists():
+        if ckpt_path.exists() and world.leader:
             raise ConfigError(
                 f"{ckpt_path} already exists; pass --resume to continue it or choose another --out"
             )
@@ -404,6 +422,15 @@ def train(
             raise ConfigError("--sil is A3C's self-imitation; PPO has none (use --sil 0)")
         frames0 = episodes0 = 0
         wall0 = 0.0
+    if world.distributed and train_config.algo != "ppo":
+        raise ConfigError(
+            "torchrun trains the synchronous learner: pass --algo ppo "
+            "(A3C's workers share one machine's memory)"
+        )
+    say = print_fn or (lambda text: print(text, file=sys.stderr))
+    device = distributed.resolve_device(
+        options.device, train_config.algo, say if world.leader else None
+    )
     if options.frames is not None and options.frames <= frames0:
         raise ConfigError(
             f"--frames {options.frames} is not above the {frames0} frames already trained"
@@ -426,13 +453,16 @@ def train(
         set_optimizer_hyperparameters(optimizer, train_config)
     optimizer.share_memory()
 
-    _remove_stale_temporaries(out)
+    if world.leader:
+        _remove_stale_temporaries(out)
     rows: list[dict[str, Any]] = []
     if resume:  # rows written after the checkpoint describe training that a kill lost
         rows = [r for r in _read_rows(out / METRICS_NAME) if _frames(r) <= frames0]
     board = _TensorBoard(out / "tensorboard") if options.tensorboard else None
 
     def log_row(row: dict[str, Any]) -> None:
+        if not world.leader:
+            return
         rows.append(row)
         _write_rows(out / METRICS_NAME, rows)
         if board is not None:
@@ -444,7 +474,6 @@ def train(
     evaluate = greedy_evaluator(
         eval_model, name, kwargs, options.eval_episodes, seed=10_000 + train_config.seed
     )
-    say = print_fn or (lambda text: print(text, file=sys.stderr))
 
     def checkpoint(state_dict: dict[str, torch.Tensor] | None, extra: dict[str, Any]) -> None:
         metrics = {**(rows[-1] if rows else {}), **extra}
@@ -468,7 +497,9 @@ def train(
             state_dict=state_dict,
         )
 
-    ctx = mp.get_context("fork" if "fork" in _mp.get_all_start_methods() else "spawn")
+    # CUDA cannot be used in a forked child once the parent touched it: spawn for GPUs
+    fork = "fork" in _mp.get_all_start_methods() and device != "cuda"
+    ctx = mp.get_context("fork" if fork else "spawn")
     stop = ctx.Event()
     messages = ctx.Queue()
     procs = []
@@ -479,7 +510,8 @@ def train(
         learner = worker
     try:
         for rank in range(learners):
-            seed = _env_seed(train_config.seed, rank, frames0)
+            # under torchrun each rank's learner has its own seeds
+            seed = _env_seed(train_config.seed, rank + world.rank, frames0)
             args = (
                 rank,
                 shared,
@@ -491,7 +523,7 @@ def train(
                 seed,
                 stop,
                 messages,
-            )
+            ) + ((device,) if train_config.algo == "ppo" else ())
             proc = ctx.Process(
                 target=learner, args=args, daemon=True, name=f"neurosym-{train_config.algo}-{rank}"
             )
@@ -528,9 +560,11 @@ def train(
     solved_frames = solved_wall = None
     stop_reason = ""
     failure: str | None = None
+    learner_stopped = False
+    digests: list[str] = []
 
     def drain(block_s: float) -> None:
-        nonlocal failure
+        nonlocal failure, learner_stopped, digests
         deadline = time.monotonic() + block_s
         while True:
             timeout = max(0.0, deadline - time.monotonic())
@@ -541,8 +575,11 @@ def train(
             if msg[0] == "update":
                 _, _, frames, rets, lens, outs, losses = msg
                 stats.add(frames, rets, lens, outs, losses)
+            elif msg[0] == "stopped":
+                learner_stopped, digests = True, list(msg[2])
             elif msg[0] == "error" and failure is None:
-                failure = f"worker {msg[1]} failed:\n{msg[2]}"
+                where = f"rank {world.rank} " if world.distributed else ""
+                failure = f"{where}worker {msg[1]} failed:\n{msg[2]}"
 
     # Ctrl-C and SIGTERM (kill, a batch scheduler) stop the run: workers stopped, checkpoint written
     stop_signal = _StopSignal()
@@ -558,12 +595,15 @@ def train(
                 if failure:
                     stop_reason = "error"
                     break
+                if learner_stopped:  # a stop on another rank reached this one's learner
+                    stop_reason = "peer"
+                    break
                 if not any(p.is_alive() for p in procs):
                     failure = "all workers exited unexpectedly"
                     stop_reason = "error"
                     break
                 # evaluations take at most ~5 % of the parent's time (they share the cores)
-                if now - last_eval >= max(options.eval_interval, 20 * eval_cost):
+                if world.leader and now - last_eval >= max(options.eval_interval, 20 * eval_cost):
                     snapshot = {k: v.detach().clone() for k, v in shared.state_dict().items()}
                     eval_model.load_state_dict(snapshot)
                     done = evaluate()
@@ -597,6 +637,8 @@ def train(
                     )
                 if stop_reason:
                     break
+                if not world.leader:  # rank 0 decides (its counts are every rank's)
+                    continue
                 if options.frames is not None and stats.frames >= options.frames:
                     stop_reason = "frames"
                 elif options.minutes is not None and now - start >= options.minutes * 60:
@@ -611,6 +653,8 @@ def train(
         deadline = time.monotonic() + 30
         while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
             drain(0.05)
+            if learner_stopped:  # its last word is here: leaving the group may take no longer
+                deadline = min(deadline, time.monotonic() + 5)
             for p in procs:
                 p.join(timeout=0.01)
         cut = False
@@ -623,6 +667,9 @@ def train(
             drain(0.0)
         stop_signal.restore()
     wall = wall0 + time.monotonic() - start
+    if failure and world.distributed and world.leader:
+        # a rank that died or lost its peers: keep the last whole update, then report
+        checkpoint(None, {"wall_s": round(wall, 2), "stop_reason": "error"})
     if failure:
         raise RuntimeError(failure)
     if (
@@ -641,14 +688,19 @@ def train(
         "success_rate": stats.success_rate(),
         "solved_frames": solved_frames,
         "solved_wall_s": None if solved_wall is None else round(solved_wall, 2),
+        "device": device,
+        "ranks": world.size,
     }
+    if world.distributed and digests:
+        summary["ranks_identical"] = len(set(digests)) == 1
     if solved_frames is None and payload is not None:
         prior = payload["metrics"]
         summary["solved_frames"], summary["solved_wall_s"] = (
             prior.get("solved_frames"),
             prior.get("solved_wall_s"),
         )
-    checkpoint(best_state, summary)
+    if world.leader:
+        checkpoint(best_state, summary)
     result = TrainResult(
         checkpoint=ckpt_path,
         frames=stats.frames,
@@ -660,6 +712,8 @@ def train(
         solved_wall_s=summary["solved_wall_s"],
         metrics=summary,
     )
+    if not world.leader:
+        return result
     say(
         f"stopped ({stop_reason}) after {stats.frames:,} frames, {stats.episodes:,} episodes, {wall:.1f} s; "
         f"greedy return {_fmt(greedy, '.2f') or '-'}; checkpoint {ckpt_path}"
