@@ -41,6 +41,8 @@ _OVERRIDES = (
     ("--ppo-epochs", "ppo_epochs", "train"),
     ("--ppo-minibatches", "ppo_minibatches", "train"),
     ("--clip-range", "clip_range", "train"),
+    ("--dagger-beta-frames", "dagger_beta_frames", "train"),
+    ("--dagger-steps", "dagger_steps", "train"),
     ("--attention-gain", "attention_gain", "model"),
     ("--entity-norm", "entity_norm", "model"),
     ("--init", "init", "model"),
@@ -68,8 +70,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--algo",
-        choices=("a3c", "ppo"),
-        help="learner: a3c (asynchronous workers, default) or ppo (one synchronous learner)",
+        choices=("a3c", "ppo", "imitate"),
+        help="learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or "
+        "imitate (DAgger from the env's optimal planner; RGW only)",
     )
     parser.add_argument(
         "--preset",
@@ -116,6 +119,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     a3c.add_argument("--ppo-epochs", type=int, help="PPO passes over each rollout")
     a3c.add_argument("--ppo-minibatches", type=int, help="PPO minibatches per pass")
     a3c.add_argument("--clip-range", type=float, help="PPO probability-ratio clip")
+    a3c.add_argument(
+        "--dagger-beta-frames",
+        type=int,
+        help="imitate: frames over which following the planner falls from always to never",
+    )
+    a3c.add_argument("--dagger-steps", type=int, help="imitate: gradient steps per rollout")
     a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
     a3c.add_argument("--gamma", type=float, help="discount")
     a3c.add_argument("--n-steps", type=int, help="rollout length per update (Table 4: 40)")
@@ -242,7 +251,7 @@ def run(args: argparse.Namespace) -> int:
     overrides: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
     for _, dest, kind in _OVERRIDES:
         overrides[kind][dest] = getattr(args, dest)
-    if overrides["train"]["workers"] is None and not args.resume and args.algo != "ppo":
+    if overrides["train"]["workers"] is None and not args.resume and args.algo in (None, "a3c"):
         overrides["train"]["workers"] = os.cpu_count() or 1
     options = RunOptions(
         frames=args.frames,

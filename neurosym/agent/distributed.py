@@ -91,10 +91,11 @@ def resolve_device(requested: str, algo: str, say: Any = None) -> str:
         raise ConfigError(f"unknown device {requested!r}; expected one of {', '.join(DEVICES)}")
     if requested == "cpu":
         return "cpu"
-    if algo != "ppo":
+    if algo not in ("ppo", "imitate"):
         if requested == "cuda":
             raise ConfigError(
-                "--device cuda needs --algo ppo: A3C's workers update a model in shared CPU memory"
+                "--device cuda needs --algo ppo or imitate: A3C's workers update a model in "
+                "shared CPU memory"
             )
         return "cpu"
     available = torch.cuda.is_available()

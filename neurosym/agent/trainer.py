@@ -418,8 +418,10 @@ def train(
         train_config = TrainConfig.for_family(
             family, preset=preset, algo=algo or "a3c", **train_overrides
         )
-        if train_config.algo == "ppo" and train_config.sil > 0:
-            raise ConfigError("--sil is A3C's self-imitation; PPO has none (use --sil 0)")
+        if train_config.algo != "a3c" and train_config.sil > 0:
+            raise ConfigError(
+                f"--sil is A3C's self-imitation; {train_config.algo} has none (use --sil 0)"
+            )
         frames0 = episodes0 = 0
         wall0 = 0.0
     if world.distributed and train_config.algo != "ppo":
@@ -441,7 +443,7 @@ def train(
     shared = ActorCritic(model_config) if payload is None else build_model(payload, ckpt_path)
     shared.share_memory()
     optimizer = shared_optimizer(shared.parameters(), train_config)
-    learners = 1 if train_config.algo == "ppo" else train_config.workers
+    learners = 1 if train_config.algo in ("ppo", "imitate") else train_config.workers
     if payload is not None and payload.get("optimizer"):
         try:
             optimizer.load_state_dict(payload["optimizer"])
@@ -506,6 +508,8 @@ def train(
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # children start with Ctrl-C ignored
     if train_config.algo == "ppo":
         from neurosym.agent.ppo import ppo_learner as learner
+    elif train_config.algo == "imitate":
+        from neurosym.agent.imitation import imitation_learner as learner
     else:
         learner = worker
     try:
@@ -523,7 +527,13 @@ def train(
                 seed,
                 stop,
                 messages,
-            ) + ((device,) if train_config.algo == "ppo" else ())
+            ) + (
+                (device,)
+                if train_config.algo == "ppo"
+                else (device, frames0)
+                if train_config.algo == "imitate"
+                else ()
+            )
             proc = ctx.Process(
                 target=learner, args=args, daemon=True, name=f"neurosym-{train_config.algo}-{rank}"
             )

@@ -465,6 +465,20 @@ class Plan:
         earns the best value (the smallest horizon j <= remaining with
         V_j = V_remaining), so it does not dawdle; then the first of equals.
         """
+        return int(np.argmax(self._q(b, pos, removed, remaining)))
+
+    def action_set(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
+        """(4,) bool: every action :meth:`action` could have picked (all of the fastest plan's equals).
+
+        Imitation learns from this set, not from the first of equals: which
+        of two equally short routes the planner lists first is no property
+        of the level a network could see.
+        """
+        q = self._q(b, pos, removed, remaining)
+        return q == q.max()
+
+    def _q(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
+        """(4,) action values toward the best return, on the fewest-step plan that earns it."""
         s = self._state(b, pos, removed)
         last = len(self.layers) - 1  # V_i = V_last for every i >= last
 
@@ -475,8 +489,7 @@ class Plan:
         j = next(i for i in range(1, k + 1) if layer(i)[s] == layer(k)[s])
         v = layer(j - 1)
         g = self.graph
-        q = [int(g.reward[a, s]) + int(v[g.nxt[a, s]]) for a in range(4)]
-        return int(np.argmax(q))
+        return np.array([int(g.reward[a, s]) + int(v[g.nxt[a, s]]) for a in range(4)])
 
     def _state(self, b: int, pos: int, removed: int) -> int:
         return int(b * self.graph.states + int(removed) * self.cells_per_level + int(pos))
@@ -491,15 +504,33 @@ class Planner:
     checking evaluation figures; it looks at the state, not at the pixels.
     """
 
+    MAX_PLANS = 4096
+    """plans kept; training meets a new level every few dozen steps, so the cache starts over"""
+
     def __init__(self) -> None:
         self._plans: dict[tuple[bytes, int], Plan] = {}
 
     def __call__(self, obs: np.ndarray, venv: object) -> np.ndarray:
+        return np.array(
+            [plan.action(0, *state) for plan, state in self._states(venv)], dtype=np.int64
+        )
+
+    def action_sets(self, venv: object) -> tuple[np.ndarray, np.ndarray]:
+        """(n, 4) bool optimal actions per sub-env and (n,) the best return still to earn."""
+        sets, values = [], []
+        for plan, state in self._states(venv):
+            sets.append(plan.action_set(0, *state))
+            values.append(plan.value(0, *state))
+        return np.stack(sets), np.asarray(values, dtype=np.float32)
+
+    def _states(self, venv: object) -> list[tuple[Plan, tuple[int, int, int]]]:
         env = getattr(venv, "unwrapped", venv)
         cells, starts = env.current_levels()
         pos, removed, t = env.agent_states()
         limit = env.rules.max_steps
-        actions = np.zeros(len(cells), dtype=np.int64)
+        if len(self._plans) > self.MAX_PLANS:
+            self._plans.clear()
+        out = []
         for i in range(len(cells)):
             key = (cells[i].tobytes(), int(starts[i]))
             plan = self._plans.get(key)
@@ -507,5 +538,5 @@ class Planner:
                 plan = Plan(cells[i], starts[i], env.height, env.width, env.rules)
                 self._plans[key] = plan
             remaining = int(limit - t[i]) if limit is not None else len(plan.layers)
-            actions[i] = plan.action(0, int(pos[i]), int(removed[i]), max(remaining, 1))
-        return actions
+            out.append((plan, (int(pos[i]), int(removed[i]), max(remaining, 1))))
+        return out
