@@ -1,5 +1,6 @@
 """The trained agents shipped in checkpoints/: RGW agents take the optimal route, greedily, by the
-env's own events; Box-World agents solve levels they never trained on (reset seeds >= 2**31)."""
+env's own events; Box-World and rgw-random agents solve levels they never trained on (reset seeds
+>= 2**31), and the rgw-random PrediNet has a head that relates two different objects."""
 
 from __future__ import annotations
 
@@ -38,15 +39,25 @@ def play(path: Path, route: list[str]) -> tuple[float, list[str], int]:
 
 
 # The agents the project ships (checkpoints/README.md).
-EXPECTED = {"rgw1-predinet", "rgw1-mhdpa", "rgw2-predinet", "rgw2-mhdpa", "bw1-predinet"}
+EXPECTED = {
+    "rgw1-predinet",
+    "rgw1-mhdpa",
+    "rgw2-predinet",
+    "rgw2-mhdpa",
+    "bw1-predinet",
+    "rgw-random-predinet",
+}
 SHIPPED = sorted(p.stem for p in CHECKPOINTS.glob("*.pt"))
-RGW = [n for n in SHIPPED if n.startswith("rgw")]
+RGW = [n for n in SHIPPED if n.startswith(("rgw1-", "rgw2-"))]
+RANDOM = [n for n in SHIPPED if n.startswith("rgw-random-")]
 BOXWORLD = [n for n in SHIPPED if n.startswith("bw")]
 UNSEEN = 3_000_000_000
 """first reset seed of the Box-World checks: training seeds stay below 2**31"""
 # Success on 100 unseen levels that each Box-World agent must keep: a little under what
 # `neurosym eval --episodes 300 --seed 3000000000` measured (checkpoints/README.md)
 BOXWORLD_FLOOR = {"bw1-predinet": {"sample": 0.9, "greedy": 0.7}}
+# the same for rgw-random (300 unseen levels measured: sampled 65.7 %, greedy 30.7 %)
+RANDOM_FLOOR = {"rgw-random-predinet": {"sample": 0.55, "greedy": 0.2}}
 
 
 def test_all_shipped_agents_are_there() -> None:
@@ -66,6 +77,35 @@ def test_shipped_boxworld_agent_solves_unseen_levels(name: str) -> None:
     for mode, floor in BOXWORLD_FLOOR[name].items():
         report = evaluate(agent, episodes=100, greedy=mode == "greedy", seed=UNSEEN)
         assert report["success_rate"] >= floor, (mode, report)
+
+
+@pytest.mark.parametrize("name", RANDOM)
+def test_shipped_rgw_random_agent_solves_unseen_levels(name: str) -> None:
+    from neurosym.agent.cli_eval import evaluate
+
+    path = CHECKPOINTS / f"{name}.pt"
+    agent = load_agent(path)
+    module = name.removeprefix("rgw-random-")
+    assert agent.env_name == "rgw-random" and agent.config.module == module
+    assert agent.meta["command"].startswith(f"neurosym train --env rgw-random --module {module}")
+    assert path.stat().st_size < 8_000_000
+    for mode, floor in RANDOM_FLOOR[name].items():
+        report = evaluate(agent, episodes=100, greedy=mode == "greedy", seed=UNSEEN)
+        assert report["success_rate"] >= floor, (mode, report)
+        assert report["success_rate"] > 0.046 * 4  # uniformly random actions: 4.6 %
+
+
+def test_the_rgw_random_predinet_relates_two_objects() -> None:
+    """Unlike the fixed-map agents (agent-agent, agent-wall), one head compares two objects."""
+    from neurosym.export.heads import head_summary
+    from neurosym.export.recorder import record
+
+    agent = load_agent(CHECKPOINTS / "rgw-random-predinet.pt")
+    rec = record(agent, episodes=20, seed=UNSEEN, greedy=False)
+    heads = head_summary(rec)
+    best = heads.loc[heads["two_objects"].idxmax()]
+    assert best["two_objects"] > 0.5, heads
+    assert "agent" in best["pair_1"] and best["pair_1"] != "agent-agent"
 
 
 @pytest.mark.parametrize("name", RGW)

@@ -504,8 +504,9 @@ class Planner:
     checking evaluation figures; it looks at the state, not at the pixels.
     """
 
-    MAX_PLANS = 4096
-    """plans kept; training meets a new level every few dozen steps, so the cache starts over"""
+    MAX_PLANS = 512
+    """plans kept (each holds every layer of its search, up to a few MB): training meets a new
+    level every few dozen steps in each sub-env, so the cache simply starts over when full"""
 
     def __init__(self) -> None:
         self._plans: dict[tuple[bytes, int], Plan] = {}
