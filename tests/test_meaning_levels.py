@@ -89,3 +89,80 @@ def test_matched_observations_redraw_only_the_changed_cells() -> None:
     assert {tuple(x) for x in np.argwhere(changed[0])} == {(0, 6), (9, 1)}
     assert (out[:, 1, 0, 6] == 0).all() and (out[:, 2, 0, 6] == 1).all()  # enemy plane at (0, 6)
     assert (out[:, 0] == obs[:, 0]).all()  # the agent did not move
+
+
+# --- procedural levels: the same change made to every episode's own level -----------------
+
+
+@pytest.mark.parametrize(
+    ("edit", "changes"),
+    [
+        ("remove_sword", {("sword", "empty")}),
+        ("remove_enemy", {("enemy", "empty")}),
+        ("swap_sword_enemy", {("sword", "enemy"), ("enemy", "sword")}),
+    ],
+)
+def test_edited_rgw_random_levels_differ_only_by_the_edit(edit: str, changes: set) -> None:
+    from neurosym.envs import rgw_rules as rules
+    from neurosym.envs.rgw_random import RandomLevelConfig, generate_levels
+
+    names = {rules.SWORD: "sword", rules.ENEMY: "enemy", rules.EMPTY: "empty"}
+    seeds, episodes = np.arange(40), np.zeros(40, dtype=int)
+    base, starts, _ = generate_levels(RandomLevelConfig(), seeds, episodes)
+    cells, starts2, info = generate_levels(RandomLevelConfig(edit=edit), seeds, episodes)
+    assert (starts == starts2).all()
+    for b, c in zip(base, cells, strict=True):
+        where = np.flatnonzero(b != c)
+        assert len(where) == len(changes)
+        assert {(names[int(b[i])], names[int(c[i])]) for i in where} == changes
+    if edit == "remove_enemy":
+        assert not info.guarded.any()  # no enemy guards anything
+    if edit == "remove_sword":  # a guarded level cannot be solved without the sword
+        _, _, base_info = generate_levels(RandomLevelConfig(), seeds, episodes)
+        assert np.isnan(info.optimal_return[base_info.guarded]).all()
+        assert np.isfinite(info.optimal_return[~base_info.guarded]).all()
+
+
+def test_the_env_plays_the_edited_level_of_each_seed() -> None:
+    plain, edited = make("rgw-random"), make("rgw-random", edit="remove_sword")
+    for seed in (5, 6):
+        a, b = plain.reset(seed=seed)[0], edited.reset(seed=seed)[0]
+        differs = np.argwhere((a != b).any(axis=0))
+        assert len(differs) == 1 and a[1][tuple(differs[0])] == 1 and b[1][tuple(differs[0])] == 0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"edit": "remove_wall"}, "unknown edit 'remove_wall'; expected one of remove_sword"),
+        ({"edit": "swap_sword_enemy", "num_enemies": 2}, "swap_sword_enemy needs num_enemies=1"),
+    ],
+)
+def test_bad_edits_are_refused(kwargs: dict, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        make("rgw-random", **kwargs)
+
+
+def test_procedural_experiments_and_their_matched_observations() -> None:
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from neurosym.meaning.intervene import matched_procedural_observations, procedural_experiments
+
+    exps, skipped = procedural_experiments({})
+    assert [e.id for e in exps] == ["remove_sword", "remove_enemy", "swap_sword_enemy"]
+    assert [str(e.kind) for e in exps] == ["remove(sword)", "remove(enemy)", "swap(sword,enemy)"]
+    assert {k for k, _ in skipped} == {"move(enemy)", "move(sword)"}
+    exps, skipped = procedural_experiments({"num_enemies": 2})
+    assert "swap_sword_enemy" not in [e.id for e in exps] and "swap(sword,enemy)" in dict(skipped)
+    # two episodes of one state each: the first observation of seeds 5 and 6
+    env = make("rgw-random")
+    obs = np.stack([env.reset(seed=s)[0] for s in (5, 6)])
+    rec = SimpleNamespace(
+        episodes=pd.DataFrame({"episode": [0, 1], "seed": [5, 6], "steps": [1, 1]})
+    )
+    out = matched_procedural_observations(obs, rec, "remove_sword", "rgw-random", {})
+    for i, seed in enumerate((5, 6)):
+        expected = make("rgw-random", edit="remove_sword").reset(seed=seed)[0]
+        assert (out[i] == expected).all()

@@ -63,6 +63,9 @@ SHARES = ("guarded_share", "teleport_share", "hazard_share")
 RANDOM_RULES = Rules(enemy="block")
 """rgw-random's default rules: a blocking enemy, 100 steps"""
 
+EDITS = ("remove_sword", "remove_enemy", "swap_sword_enemy")
+"""the controlled changes RandomLevelConfig.edit makes to generated levels"""
+
 MAX_ENEMIES = 3
 """enemies per level at most: the optimal-return search tracks which are left (2**(1 + E) masks)"""
 
@@ -95,9 +98,20 @@ class RandomLevelConfig:
     """shortest start-to-terminal route must be at least this many steps"""
     max_attempts: int = 500
     """candidates tried per level before giving up with an error"""
+    edit: str | None = None
+    """a controlled change made to every generated level after it was drawn, so that level
+    (seed, k) is the unedited level (seed, k) but for that one change (``neurosym
+    intervene``): "remove_sword", "remove_enemy" (every enemy) or "swap_sword_enemy" (one
+    enemy only); the level's info is then the edited level's own (it may be unsolvable)"""
 
     def __post_init__(self) -> None:
+        if self.edit is not None and self.edit not in EDITS:
+            raise ConfigError(f"unknown edit {self.edit!r}; expected one of {', '.join(EDITS)}")
+        if self.edit == "swap_sword_enemy" and self.num_enemies != 1:
+            raise ConfigError("edit swap_sword_enemy needs num_enemies=1 (which enemy to swap?)")
         for f in fields(self):
+            if f.name == "edit":
+                continue
             value = getattr(self, f.name)
             if f.name in SHARES:
                 if not isinstance(value, int | float) or not 0.0 <= float(value) <= 1.0:
@@ -313,11 +327,41 @@ def generate_levels(
         cells[done], starts[done], kinds[done], best[done] = c[ok], s[ok], k[ok], best_ok
         pending = pending[~ok]
         if not len(pending):
+            if cfg.edit is not None:
+                return edited_levels(cfg, cells, starts, rules_)
             info = LevelInfo(best, kinds[:, 0], kinds[:, 1], kinds[:, 2])
             return cells, starts, info
     raise ConfigError(
         f"no solvable level found in {cfg.max_attempts} attempts for {len(pending)} of {B} keys "
         f"with {asdict(cfg)}; use fewer walls, pits or enemies"
+    )
+
+
+def edit_cells(cells: np.ndarray, edit: str) -> np.ndarray:
+    """A copy of (B, N) level cells with ``edit`` (one of EDITS) made to every level."""
+    out = cells.copy()
+    sword, enemy = cells == rules.SWORD, cells == rules.ENEMY
+    if edit in ("remove_sword", "remove_enemy"):
+        out[sword if edit == "remove_sword" else enemy] = rules.EMPTY
+    elif edit == "swap_sword_enemy":
+        out[sword], out[enemy] = rules.ENEMY, rules.SWORD
+    else:
+        raise ConfigError(f"unknown edit {edit!r}; expected one of {', '.join(EDITS)}")
+    return out
+
+
+def edited_levels(
+    cfg: RandomLevelConfig, cells: np.ndarray, starts: np.ndarray, rules_: Rules
+) -> tuple[np.ndarray, np.ndarray, LevelInfo]:
+    """The accepted levels with ``cfg.edit`` made, and the edited levels' own info."""
+    cells = edit_cells(cells, str(cfg.edit))
+    kinds, _ = kinds_and_route(cells, starts, cfg.height, cfg.width)
+    sol = solve_levels(cells, starts, cfg.height, cfg.width, rules_)
+    best = np.where(sol.solvable, sol.optimal_return, np.nan)
+    return (
+        cells,
+        starts,
+        LevelInfo(best, kinds.guarded, kinds.needs_teleport, kinds.hazard_on_route),
     )
 
 

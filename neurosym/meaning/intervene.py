@@ -19,9 +19,12 @@ Detail)``):
                                state-dependent relational input
 =============================  =================================================
 
-Level changes need a fixed RGW map (rgw1, rgw2, a map given as an env
-option); on procedural levels and Box-World only the ablations run (the
-others are listed as ``experiment_skipped(Kind, Reason)``). Every experiment
+Level changes are made to a fixed RGW map (rgw1, rgw2, a map given as an
+env option) or, on rgw-random, to every episode's own level (env option
+``edit``: ``remove(sword)``, ``remove(enemy)``, ``swap(sword, enemy)``, with
+Detail ``every_level(Edit)``; the moves need one map's routes and are
+skipped); on Box-World only the ablations run (what is skipped is listed as
+``experiment_skipped(Kind, Reason)``). Every experiment
 plays the same episodes: episode k from ``reset(seed=seed + k)`` and, when
 sampling, the same torch generator seed, so the baseline and a change differ
 only by the change.
@@ -76,6 +79,8 @@ class Experiment:
     """the changed map (None: the baseline's level)"""
     ablate: tuple[int, ...] = ()
     """heads replaced by their baseline mean"""
+    edit: str | None = None
+    """procedural levels: the change made to every level (RandomLevelConfig.edit)"""
 
 
 @dataclass
@@ -258,6 +263,43 @@ def level_experiments(grid_map: Any, route: np.ndarray) -> tuple[list[Experiment
     return out, skipped
 
 
+def procedural_experiments(env_kwargs: dict[str, Any]) -> tuple[list[Experiment], list]:
+    """The level changes for rgw-random: each made to every episode's own level; (experiments, skipped).
+
+    Episode k plays level (seed + k, 0) with the one change, so it differs
+    from the baseline's episode k only by it. Moving an object needs routes
+    on one map, so the moves are skipped.
+    """
+    from neurosym.envs.rgw_random import config_from_kwargs
+
+    cfg = config_from_kwargs({k: v for k, v in env_kwargs.items() if k in _LEVEL_KEYS})
+    out: list[Experiment] = []
+    for edit, kind in (
+        ("remove_sword", Term("remove", ("sword",))),
+        ("remove_enemy", Term("remove", ("enemy",))),
+        ("swap_sword_enemy", Term("swap", ("sword", "enemy"))),
+    ):
+        if edit == "swap_sword_enemy" and cfg.num_enemies != 1:
+            continue
+        out.append(Experiment(edit, kind, Term("every_level", (edit,)), edit=edit))
+    skipped = [
+        (kind, "moving an object needs the baseline's routes on one fixed map")
+        for kind in ("move(enemy)", "move(sword)")
+    ]
+    if cfg.num_enemies != 1:
+        skipped.append(("swap(sword,enemy)", f"the levels have {cfg.num_enemies} enemies"))
+    return out, skipped
+
+
+_LEVEL_KEYS = frozenset(
+    (
+        "height width num_enemies guarded_share teleport_share hazard_share wall_segments "
+        "max_wall_length num_mountains num_pits min_route_length max_attempts"
+    ).split()
+)
+"""rgw-random's level options (RandomLevelConfig) among its env options"""
+
+
 def _count(grid_map: Any, obj: str) -> int:
     from neurosym.meaning.levels import SYMBOL_OF
 
@@ -362,21 +404,50 @@ def matched_observations(
     first observation did (the agent is not on it and the baseline episode has
     not taken its object yet); every other cell is kept.
     """
+    first_base = _first_observation(env, {**env_kwargs, "map": base_text}, 0)
+    first_changed = _first_observation(env, {**env_kwargs, "map": changed_text}, 0)
+    out = obs.copy()
+    _redraw(out, np.arange(len(obs)), first_base, first_changed)
+    return out
+
+
+def matched_procedural_observations(
+    obs: np.ndarray, recording: Any, edit: str, env: str, env_kwargs: dict[str, Any]
+) -> np.ndarray:
+    """As :func:`matched_observations`, episode by episode: each baseline state gets its own
+    level's change (the level of the episode's seed, with and without ``edit``)."""
+    from neurosym.meaning.predicates import acted_states
+
+    eps = recording.episodes
+    of_state = acted_states(eps)["episode"].to_numpy()
+    out = obs.copy()
+    for episode, seed in zip(eps["episode"].tolist(), eps["seed"].tolist(), strict=True):
+        first_base = _first_observation(env, env_kwargs, int(seed))
+        first_changed = _first_observation(env, {**env_kwargs, "edit": edit}, int(seed))
+        _redraw(out, np.flatnonzero(of_state == episode), first_base, first_changed)
+    return out
+
+
+def _first_observation(env: str, env_kwargs: dict[str, Any], seed: int) -> np.ndarray:
     from neurosym.envs import make
 
-    firsts = []
-    for text in (base_text, changed_text):
-        env_ = make(env, **{**env_kwargs, "map": text})
-        firsts.append(env_.reset(seed=0)[0])
+    env_ = make(env, **env_kwargs)
+    try:
+        return env_.reset(seed=seed)[0]
+    finally:
         env_.close()
-    first_base, first_changed = firsts  # (C, H, W)
+
+
+def _redraw(
+    out: np.ndarray, states: np.ndarray, first_base: np.ndarray, first_changed: np.ndarray
+) -> None:
+    """Cells that differ between the two first observations, redrawn at ``states`` that still show
+    them as the baseline's first observation did (the agent not on them, the object not taken)."""
     differs = (first_base != first_changed).any(axis=0)  # (H, W) the changed cells
-    out = obs.copy()
     rows, cols = np.nonzero(differs)
     for r, c in zip(rows.tolist(), cols.tolist(), strict=True):  # a handful of cells
-        as_before = (obs[:, :, r, c] == first_base[:, r, c]).all(axis=1)  # (S,)
-        out[as_before, :, r, c] = first_changed[:, r, c]
-    return out
+        as_before = (out[states, :, r, c] == first_base[:, r, c]).all(axis=1)  # (s,)
+        out[states[as_before], :, r, c] = first_changed[:, r, c]
 
 
 def _kl(p: np.ndarray, q: np.ndarray) -> float:
@@ -427,6 +498,8 @@ def intervene(
         who = agent
         if exp.map_text is not None:
             who = dataclasses.replace(agent, env_kwargs={**env_kwargs, "map": exp.map_text})
+        elif exp.edit is not None:
+            who = dataclasses.replace(agent, env_kwargs={**env_kwargs, "edit": exp.edit})
         if exp.ablate:
             with ablate_heads(agent.model, {h: base_means[h] for h in exp.ablate}):
                 rec = record(who, name, episodes=episodes, seed=seed, greedy=greedy, batch=batch)
@@ -461,23 +534,13 @@ def intervene(
         route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
         found, skipped = level_experiments(grid_map, route)
         experiments += found
+    elif levels and family == "rgw":  # rgw-random: each episode's own level, changed
+        found, skipped = procedural_experiments(env_kwargs)
+        experiments += found
     elif levels:
-        why = (
-            "procedural levels change every episode"
-            if family == "rgw"
-            else "Box-World levels are generated"
+        skipped.append(
+            ("level_changes", "level changes are RGW-only; Box-World levels are generated")
         )
-        for kind in (
-            "remove(sword)",
-            "remove(enemy)",
-            "move(enemy)",
-            "move(sword)",
-            "swap(sword,enemy)",
-        ):
-            if family == "rgw":
-                skipped.append((kind, f"level changes need a fixed map; {why}"))
-        if family != "rgw":
-            skipped.append(("level_changes", f"level changes are RGW-only; {why}"))
     if ablations:
         experiments += ablation_experiments(int(agent.config.heads), module)
     for index, exp in enumerate(experiments[1:], start=1):
@@ -500,7 +563,12 @@ def intervene(
                 with ablate_heads(agent.model, {h: means[h] for h in exp.ablate}):
                     vec, p = head_vectors(agent.model, base_obs)
             else:
-                obs = matched_observations(base_obs, base_text, exp.map_text, name, env_kwargs)
+                if exp.edit is not None:
+                    obs = matched_procedural_observations(
+                        base_obs, _shifted(base_rec, 0), exp.edit, name, env_kwargs
+                    )
+                else:
+                    obs = matched_observations(base_obs, base_text, exp.map_text, name, env_kwargs)
                 vec, p = head_vectors(agent.model, obs)
         finally:
             torch.set_num_threads(saved)
