@@ -53,7 +53,7 @@ def test_default_preset_departures_and_algo() -> None:
     assert TrainConfig.for_family("rgw", lr=5e-4).lr == 5e-4
     with pytest.raises(ConfigError, match="unknown preset 'fast'"):
         TrainConfig.for_family("rgw", preset="fast")
-    with pytest.raises(ConfigError, match="no PPO settings"):
+    with pytest.raises(ConfigError, match="no --algo ppo settings"):
         TrainConfig.for_family("rgw", preset="thesis", algo="ppo")
     with pytest.raises(ConfigError, match="unknown optimizer 'sgd'"):
         TrainConfig(optimizer="sgd")

@@ -391,7 +391,9 @@ class TrainConfig:
             )
         if preset == "thesis":
             if algo != "a3c":
-                raise ConfigError(f"--preset thesis is A3C (Table 4); it has no {algo} settings")
+                raise ConfigError(
+                    f"--preset thesis is A3C (Table 4); it has no --algo {algo} settings"
+                )
             base = {**_THESIS_COMMON, **_THESIS_TRAIN[family]}
         else:
             base = dict(_DEFAULT_TRAIN[family])

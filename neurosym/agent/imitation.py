@@ -25,7 +25,6 @@ process, RGW only (Box-World has no planner here), no torchrun.
 from __future__ import annotations
 
 import contextlib
-import copy
 import os
 import signal
 import traceback
@@ -35,10 +34,10 @@ import numpy as np
 import torch
 
 from neurosym.agent import distributed
-from neurosym.agent.a3c import LossStats, report_update, shared_optimizer
+from neurosym.agent.a3c import LossStats, report_update
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.model import ActorCritic
-from neurosym.agent.ppo import copy_into_shared
+from neurosym.agent.ppo import copy_into_shared, private_copy
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
 
@@ -139,9 +138,7 @@ def imitation_learner(
         torch.manual_seed(env_seed)
         generator = torch.Generator().manual_seed(env_seed)
         rng = np.random.default_rng(env_seed)
-        local = copy.deepcopy(shared).to(dev)
-        local_opt = shared_optimizer(local.parameters(), train_config)
-        local_opt.load_state_dict(optimizer.state_dict())
+        local, local_opt = private_copy(shared, optimizer, train_config, dev)
         venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
         obs, _ = venv.reset(seed=env_seed)
         planner = Planner()

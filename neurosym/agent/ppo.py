@@ -138,6 +138,23 @@ def copy_into_shared(
                     s_dst[key].copy_(value)
 
 
+def private_copy(
+    shared: ActorCritic,
+    optimizer: torch.optim.Optimizer,
+    train_config: TrainConfig,
+    device: torch.device,
+) -> tuple[ActorCritic, torch.optim.Optimizer]:
+    """A synchronous learner's own model and optimiser on ``device``, from the shared ones.
+
+    It trains these and copies them back (:func:`copy_into_shared`) after
+    each update, so that the trainer's evaluation and checkpoints see them.
+    """
+    local = copy.deepcopy(shared).to(device)
+    local_opt = shared_optimizer(local.parameters(), train_config)
+    local_opt.load_state_dict(optimizer.state_dict())
+    return local, local_opt
+
+
 def ppo_learner(
     rank: int,
     shared: ActorCritic,
@@ -169,9 +186,7 @@ def ppo_learner(
         dev = distributed.learner_device(device, world)
         torch.manual_seed(env_seed)
         generator = torch.Generator().manual_seed(env_seed)
-        local = copy.deepcopy(shared).to(dev)
-        local_opt = shared_optimizer(local.parameters(), train_config)
-        local_opt.load_state_dict(optimizer.state_dict())
+        local, local_opt = private_copy(shared, optimizer, train_config, dev)
         model: torch.nn.Module = local
         if world.distributed:
             from torch.nn.parallel import DistributedDataParallel
