@@ -199,7 +199,7 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
         (("--module", "predinet"), "--env and --module are needed unless --resume"),
         (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
         (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
-        (("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"), "PPO has none"),
+        (("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"), "ppo has none"),
         (
             ("--env", "bw1", "--module", "mhdpa", "--preset", "thesis", "--algo", "ppo"),
             "--preset thesis is A3C",
