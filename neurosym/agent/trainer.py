@@ -660,7 +660,10 @@ def train(
         stop_reason = "interrupted"
     finally:
         stop.set()
-        deadline = time.monotonic() + 30
+        # a learner blocked in a collective whose peer died never ends by itself, and torchrun
+        # kills the survivors 30 s after its SIGTERM: leave time to write the checkpoint
+        grace = 5 if world.distributed and stop_reason in ("interrupted", "error") else 30
+        deadline = time.monotonic() + grace
         while any(p.is_alive() for p in procs) and time.monotonic() < deadline:
             drain(0.05)
             if learner_stopped:  # its last word is here: leaving the group may take no longer
