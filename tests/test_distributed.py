@@ -291,7 +291,10 @@ def test_a_killed_rank_stops_the_run_with_a_checkpoint(tmp_path: Path) -> None:
     assert proc.returncode != 0  # torchrun reports the failed rank
     payload = read_checkpoint(out / "checkpoint.pt")  # rank 0 still wrote a whole checkpoint
     assert payload["frames"] > 0
-    assert payload["metrics"]["stop_reason"] in ("interrupted", "error"), err[-2000:]
+    # torchrun's SIGTERM (interrupted), the learner's lost peer (error), or the killed rank's
+    # orphaned learner noticing its parent is gone and ending the run on every rank (peer)
+    reason = payload["metrics"]["stop_reason"]
+    assert reason in ("interrupted", "error", "peer"), (reason, err[-2000:])
     load_agent(out / "checkpoint.pt", env="rgw2")
 
 

@@ -659,6 +659,11 @@ def train(
     except KeyboardInterrupt:  # a Ctrl-C that came before the handler was in place
         stop_reason = "interrupted"
     finally:
+        if world.distributed and world.leader and stop_reason in ("interrupted", "error"):
+            # torchrun may kill this rank within seconds of its SIGTERM (a peer died): keep the
+            # last whole update now; the learners copy into the shared model only between updates
+            checkpoint(None, {"wall_s": round(wall0 + time.monotonic() - start, 2),
+                              "stop_reason": stop_reason})  # fmt: skip
         stop.set()
         # a learner blocked in a collective whose peer died never ends by itself, and torchrun
         # kills the survivors 30 s after its SIGTERM: leave time to write the checkpoint
