@@ -289,6 +289,7 @@ def test_a_killed_rank_stops_the_run_with_a_checkpoint(tmp_path: Path) -> None:
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(victim, signal.SIGKILL)  # the killed rank's orphaned learner
     assert proc.returncode != 0  # torchrun reports the failed rank
+    assert (out / "checkpoint.pt").exists(), err[-4000:]
     payload = read_checkpoint(out / "checkpoint.pt")  # rank 0 still wrote a whole checkpoint
     assert payload["frames"] > 0
     # torchrun's SIGTERM (interrupted), the learner's lost peer (error), or the killed rank's

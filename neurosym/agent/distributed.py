@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import signal
 import sys
 from dataclasses import dataclass
 from datetime import timedelta
@@ -199,6 +200,23 @@ def parameter_digest(model: torch.nn.Module) -> str:
         h.update(name.encode())
         h.update(p.detach().to("cpu").contiguous().numpy().tobytes())
     return h.hexdigest()
+
+
+def die_with_parent() -> None:
+    """Linux: this learner process gets SIGKILL when its trainer dies (even by SIGKILL).
+
+    Otherwise a learner whose trainer was killed lingers, under torchrun blocked in a
+    collective until the timeout, holding the launcher's output pipes open.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except OSError:
+        pass
 
 
 def leave_group() -> None:

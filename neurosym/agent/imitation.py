@@ -129,6 +129,7 @@ def imitation_learner(
     ``frames0``: frames trained before (a resumed run), so that beta goes on from there.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    distributed.die_with_parent()
     torch.set_num_threads(max(1, len(os.sched_getaffinity(0))))
     try:
         from neurosym.envs import make_batched

@@ -177,6 +177,7 @@ def ppo_learner(
     episodes of every rank.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    distributed.die_with_parent()
     world = distributed.world_from_env()
     threads = len(os.sched_getaffinity(0)) // max(world.local_size, 1)
     torch.set_num_threads(max(1, threads))
