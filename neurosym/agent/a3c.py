@@ -32,10 +32,11 @@ on a batch of M remembered transitions is added, scaled to T transitions.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import traceback
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any, NamedTuple
 
 import torch
@@ -307,6 +308,37 @@ def report_update(queue: Any, rank: int, frames: int, finished: Finished, stats:
     )
 
 
+@contextlib.contextmanager
+def learner_process(
+    queue: Any, rank: int, cleanup: Callable[[], None] | None = None
+) -> Iterator[None]:
+    """What every learner process does around its work (A3C worker, PPO, imitation).
+
+    Ctrl-C is the parent's business (SIGINT ignored); the process dies with
+    its trainer (:func:`distributed.die_with_parent`); any exception becomes
+    an ``("error", rank, traceback)`` message; the queue is flushed before
+    ``cleanup`` runs (leaving a gloo group whose peer has gone can block while
+    holding the GIL, which would starve the queue's feeder thread).
+    """
+    from neurosym.agent import distributed
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    distributed.die_with_parent()
+    try:
+        yield
+    except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
+        queue.put(("error", rank, traceback.format_exc()))
+    finally:
+        with contextlib.suppress(Exception):
+            queue.close()
+            queue.join_thread()
+        if cleanup is not None:
+            with contextlib.suppress(
+                Exception
+            ):  # a peer that died leaves nothing to say goodbye to
+                cleanup()
+
+
 def worker(
     rank: int,
     shared: ActorCritic,
@@ -325,9 +357,8 @@ def worker(
     per update, ``("error", rank, traceback text)`` if anything fails.
     Ctrl-C is the parent's business: the worker ignores SIGINT.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
     torch.set_num_threads(1)
-    try:
+    with learner_process(queue, rank):
         from neurosym.envs import make_batched
 
         torch.manual_seed(env_seed)
@@ -359,5 +390,3 @@ def worker(
             report_update(
                 queue, rank, int(rollout.valid.sum()), finished, stats._replace(grad_norm=norm)
             )
-    except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
-        queue.put(("error", rank, traceback.format_exc()))

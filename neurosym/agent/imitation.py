@@ -24,17 +24,14 @@ process, RGW only (Box-World has no planner here), no torchrun.
 
 from __future__ import annotations
 
-import contextlib
 import os
-import signal
-import traceback
 from typing import Any
 
 import numpy as np
 import torch
 
 from neurosym.agent import distributed
-from neurosym.agent.a3c import LossStats, report_update
+from neurosym.agent.a3c import LossStats, learner_process, report_update
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.ppo import copy_into_shared, private_copy
@@ -128,10 +125,8 @@ def imitation_learner(
 
     ``frames0``: frames trained before (a resumed run), so that beta goes on from there.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    distributed.die_with_parent()
     torch.set_num_threads(max(1, len(os.sched_getaffinity(0))))
-    try:
+    with learner_process(queue, rank):
         from neurosym.envs import make_batched
         from neurosym.envs.rgw_solver import Planner
 
@@ -171,10 +166,4 @@ def imitation_learner(
             copy_into_shared(local, local_opt, shared, optimizer)
             frames += steps
             report_update(queue, rank, steps, finished, stats)
-        queue.put(("stopped", rank, [distributed.parameter_digest(local)]))
-    except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
-        queue.put(("error", rank, traceback.format_exc()))
-    finally:
-        with contextlib.suppress(Exception):
-            queue.close()
-            queue.join_thread()
+        queue.put(("stopped", rank, []))  # one process: no ranks to compare

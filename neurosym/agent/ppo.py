@@ -30,18 +30,21 @@ of all ranks form the process group (:mod:`neurosym.agent.distributed`).
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import os
-import signal
-import traceback
 from typing import Any
 
 import torch
 import torch.nn.functional as F
 
 from neurosym.agent import distributed
-from neurosym.agent.a3c import LossStats, gae_advantages, report_update, shared_optimizer
+from neurosym.agent.a3c import (
+    LossStats,
+    gae_advantages,
+    learner_process,
+    report_update,
+    shared_optimizer,
+)
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
@@ -176,12 +179,10 @@ def ppo_learner(
     Under torchrun only rank 0 sends ``update`` messages, with the frames and
     episodes of every rank.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    distributed.die_with_parent()
     world = distributed.world_from_env()
     threads = len(os.sched_getaffinity(0)) // max(world.local_size, 1)
     torch.set_num_threads(max(1, threads))
-    try:
+    with learner_process(queue, rank, cleanup=distributed.leave_group):
         from neurosym.envs import make_batched
 
         dev = distributed.learner_device(device, world)
@@ -233,16 +234,3 @@ def ppo_learner(
         if world.distributed:
             digests = distributed.gather_to_leader(digests[0]) or digests
         queue.put(("stopped", rank, digests))
-    except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
-        queue.put(("error", rank, traceback.format_exc()))
-    finally:
-        # the last message reaches the pipe before anything that could hang
-        # (leaving a gloo group whose peer has gone can block while holding the
-        # GIL, which starves the queue's feeder thread until the parent gives up)
-        with contextlib.suppress(Exception):
-            queue.close()
-            queue.join_thread()
-        try:
-            distributed.leave_group()
-        except Exception:  # noqa: BLE001 - a peer that died leaves nothing to say goodbye to
-            pass

@@ -685,8 +685,14 @@ def train(
             drain(0.0)
         stop_signal.restore()
     wall = wall0 + time.monotonic() - start
-    if failure and world.distributed and world.leader:
-        # a rank that died or lost its peers: keep the last whole update, then report
+    if (
+        failure
+        and world.distributed
+        and world.leader
+        and stop_reason not in ("interrupted", "error")
+    ):
+        # a learner that failed after another stop: keep the last whole update, then report
+        # (an interrupted or failed run wrote it already, before stopping its learner)
         checkpoint(None, {"wall_s": round(wall, 2), "stop_reason": "error"})
     if failure:
         raise RuntimeError(failure)

@@ -270,9 +270,10 @@ def procedural_experiments(env_kwargs: dict[str, Any]) -> tuple[list[Experiment]
     from the baseline's episode k only by it. Moving an object needs routes
     on one map, so the moves are skipped.
     """
-    from neurosym.envs.rgw_random import config_from_kwargs
+    from neurosym.envs.rgw_random import RandomLevelConfig, config_from_kwargs
 
-    cfg = config_from_kwargs({k: v for k, v in env_kwargs.items() if k in _LEVEL_KEYS})
+    level_keys = {f.name for f in dataclasses.fields(RandomLevelConfig)}
+    cfg = config_from_kwargs({k: v for k, v in env_kwargs.items() if k in level_keys})
     out: list[Experiment] = []
     for edit, kind in (
         ("remove_sword", Term("remove", ("sword",))),
@@ -289,15 +290,6 @@ def procedural_experiments(env_kwargs: dict[str, Any]) -> tuple[list[Experiment]
     if cfg.num_enemies != 1:
         skipped.append(("swap(sword,enemy)", f"the levels have {cfg.num_enemies} enemies"))
     return out, skipped
-
-
-_LEVEL_KEYS = frozenset(
-    (
-        "height width num_enemies guarded_share teleport_share hazard_share wall_segments "
-        "max_wall_length num_mountains num_pits min_route_length max_attempts"
-    ).split()
-)
-"""rgw-random's level options (RandomLevelConfig) among its env options"""
 
 
 def _count(grid_map: Any, obj: str) -> int:
