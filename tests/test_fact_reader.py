@@ -21,8 +21,10 @@ def chunk_bytes(request: pytest.FixtureRequest):
     size = 64 if request.param == "chunked" else 1 << 40
     janus = _janus()
     janus.query_once("neurosym_facts:set_chunk_bytes(B)", {"B": size})
+    janus.query_once("neurosym_facts:set_reader_threads(T)", {"T": 3})  # on any machine
     yield request.param
     janus.query_once("neurosym_facts:set_chunk_bytes(8388608)")
+    janus.query_once("neurosym_facts:set_reader_threads(auto)")
 
 
 def _tricky(n: int) -> tuple[str, list[tuple[int, str]]]:

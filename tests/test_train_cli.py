@@ -118,12 +118,16 @@ def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     proc = neurosym(
         "train", "--env", "rgw1", "--module", "mhdpa", "--out", str(out), "--workers", "1", "--envs", "1",
         "--frames", "600", "--quiet", "--slim", "--heads", "2", "--sil", "0",
+        "--conv-channels", "8,8,16", "--kernel-size", "3",
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     agent = load_agent(out / "checkpoint.pt")
     assert agent.meta["train_config"]["sil"] == 0.0  # the RGW default is 1.0
     assert "--sil 0" in agent.meta["command"]
+    assert "--conv-channels 8,8,16 --kernel-size 3" in agent.meta["command"]
     assert agent.config.module == "mhdpa" and agent.config.heads == 2 and agent.env_name == "rgw1"
+    assert agent.config.conv_channels == (8, 8, 16) and agent.config.kernel_size == 3
+    assert len(agent.model.encoder.convs) == 3
     assert torch.load(out / "checkpoint.pt", weights_only=True)["optimizer"] is None
 
 
@@ -221,6 +225,20 @@ def test_train_bad_input_is_one_line(
     assert proc.returncode == 1, proc.stderr
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert not (tmp_path / "run" / "checkpoint.pt").exists()
+
+
+@pytest.mark.parametrize("value", ["12,x", "0,24", ""])
+def test_train_bad_conv_channels(neurosym, tmp_path: Path, value: str) -> None:
+    proc = neurosym(
+        "train", "--env", "rgw2", "--module", "predinet", "--out", str(tmp_path / "run"),
+        "--conv-channels", value,
+    )  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines()[-1] == (
+        "neurosym train: error: argument --conv-channels: want comma-separated positive"
+        f" channel counts such as 12,24, got {value!r}"
+    )
+    assert not (tmp_path / "run").exists()
 
 
 def test_resume_without_checkpoint(neurosym, tmp_path: Path) -> None:

@@ -50,7 +50,22 @@ _OVERRIDES = (
     ("--key-size", "key_size", "model"),
     ("--relations", "relations", "model"),
     ("--value-size", "value_size", "model"),
+    ("--conv-channels", "conv_channels", "model"),
+    ("--kernel-size", "kernel_size", "model"),
 )
+
+
+def _channels(text: str) -> tuple[int, ...]:
+    """'16,16,24' -> (16, 16, 24): the encoder's conv layers, one positive width each."""
+    try:
+        widths = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        widths = ()
+    if not widths or min(widths) < 1:
+        raise argparse.ArgumentTypeError(
+            f"want comma-separated positive channel counts such as 12,24, got {text!r}"
+        )
+    return widths
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -142,6 +157,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
     model.add_argument("--relations", type=int, help="PrediNet relations per head (8)")
     model.add_argument("--value-size", type=int, help="MHDPA value size (64)")
     model.add_argument(
+        "--conv-channels",
+        type=_channels,
+        metavar="C1,C2,...",
+        help="encoder conv layers' output channels (Table 4: 12,24)",
+    )
+    model.add_argument(
+        "--kernel-size", type=int, help="encoder conv kernel, stride 1, grid shape kept (2)"
+    )
+    model.add_argument(
         "--attention-gain", type=float, help="factor on the attention logits (default 8; thesis 1)"
     )
     model.add_argument(
@@ -220,6 +244,8 @@ def command_line(args: argparse.Namespace) -> str:
         value = getattr(args, dest)
         if isinstance(value, bool):
             parts.append(flag if value else "--no-" + flag[2:])
+        elif isinstance(value, tuple):
+            parts += [flag, ",".join(map(str, value))]
         elif value is not None:
             parts += [flag, str(value)]
     for item in args.env_option:

@@ -21,11 +21,16 @@ and what was found. Clauses are added with ``assertz/1`` as they are read;
 a refusal further down erases what this file added, so a refused file
 leaves the KB as it was. With mode ``check`` nothing is asserted (used
 before compiling a source to ``.qlf``). Reading is the cost (``read_term``
-takes about 2.5 us a fact here, consult about 20), so files of 8 MB and more
-are cut at line starts and read by one helper thread per core (up to 4) in
-small checked batches, added in file order; a cut is used only when the
-chunk before it ends exactly there, so results, order and error lines are
-those of a front-to-back read.
+takes about 1.5 us a fact here, consult about 10), so on a machine with 4
+cores or more, files of 8 MB and more are cut at line starts and read by one
+helper thread per core (up to 4 threads in all) in small checked batches,
+added in file order; a cut is used only when the chunk before it ends exactly
+there, so results, order and error lines are those of a front-to-back read.
+On 2 cores the chunked read was slower than one thread (1 M facts: 2.5-2.6 s
+against 2.1-2.2 s, bench/kb.py on quiet cores: the main thread still adds
+every fact and copies each helper's batches out of its queue), so there a
+file is read front to back; ``set_reader_threads/1`` overrides the choice
+(tests use it to run the chunked path on any machine).
 """
 
 from __future__ import annotations
@@ -33,13 +38,32 @@ from __future__ import annotations
 MODULE = "neurosym_facts"
 
 SOURCE = r"""
-:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1]).
+:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1, set_reader_threads/1]).
 :- use_module(library(lists), [member/2, append/3]).
 :- use_module(library(apply), [exclude/3]).
+:- use_module(library(error), [must_be/2]).
 
 :- thread_local touched_/3.   % touched_(Name, Arity, ClausesBefore | new)
 :- dynamic chunk_bytes_/1.    % files this large are read in parallel chunks
 chunk_bytes_(8388608).
+:- dynamic reader_threads_/1. % set: threads that read a large file (1: front to back)
+
+%!  set_reader_threads(+Threads) is det.
+%   Threads reading a large file, 1 to 4; auto: the cores if 4 or more, else 1.
+set_reader_threads(Threads) :-
+    retractall(reader_threads_(_)),
+    (   Threads == auto
+    ->  true
+    ;   must_be(between(1, 4), Threads),
+        assertz(reader_threads_(Threads))
+    ).
+
+reader_threads(Threads) :-
+    (   reader_threads_(Threads)
+    ->  true
+    ;   current_prolog_flag(cpu_count, Cores),
+        ( Cores >= 4 -> Threads is min(Cores, 4) ; Threads = 1 )
+    ).
 
 %!  set_chunk_bytes(+Bytes) is det.
 %   Tests read small files in chunks with this.
@@ -80,8 +104,7 @@ load_(M, File, Mode, RuleFiles, Count) :-
 
 cuts_(File, Cuts) :-
     size_file(File, Size),
-    current_prolog_flag(cpu_count, Cores0),
-    Cores is min(Cores0, 4),
+    reader_threads(Cores),
     chunk_bytes_(Min),
     (   Size >= Min, Cores >= 2, current_prolog_flag(threads, true)
     ->  setup_call_cleanup(open(File, read, S, [type(binary)]),
