@@ -16,7 +16,7 @@ probability ``--follow`` (one of its optimal actions, uniformly) and is
 otherwise a uniformly random action, so that they cover the planner's routes
 and the detours a learner makes.
 
-    python bench/imitation_capacity.py                          # default variants
+    python bench/imitation_capacity.py                          # the README's table
     python bench/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
 
 ``cnn`` is a plain CNN reference (not a relational module).
@@ -38,12 +38,14 @@ from neurosym.agent.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
 
-VARIANTS = [
+VARIANTS = [  # the README's table (about 35 minutes on 2 cores)
     "predinet",
     "predinet:heads=8",
-    "predinet:heads=16",
     "predinet:output_size=64",
-    "mhdpa",
+    "predinet:kernel_size=3",
+    "predinet:conv_channels=32-64",
+    "predinet:conv_channels=16-16-16-16-16-24,kernel_size=3",
+    "cnn",
 ]
 
 
@@ -60,7 +62,9 @@ def labelled_states(env: str, n: int, seed: int, follow: float) -> tuple[np.ndar
         all_obs.append(obs[keep].copy())
         all_sets.append(optimal[keep])
         expert = (rng.random(optimal.shape) * optimal).argmax(axis=1)
-        actions = np.where(rng.random(len(expert)) < follow, expert, rng.integers(0, 4, len(expert)))
+        actions = np.where(
+            rng.random(len(expert)) < follow, expert, rng.integers(0, 4, len(expert))
+        )
         obs, _, terminated, truncated, _ = venv.step(actions)
         pending = terminated | truncated
     return np.concatenate(all_obs)[:n], np.concatenate(all_sets)[:n]
@@ -135,8 +139,14 @@ def fit(
         optimizer.step()
         if step % max(1, steps // 5) == 0 or step == steps:
             test_loss, test_hit = measure(model, *data["test"])
-            curve.append({"step": step, "batch_loss": round(loss.item(), 4),
-                          "test_loss": round(test_loss, 4), "test_optimal": round(test_hit, 4)})
+            curve.append(
+                {
+                    "step": step,
+                    "batch_loss": round(loss.item(), 4),
+                    "test_loss": round(test_loss, 4),
+                    "test_optimal": round(test_hit, 4),
+                }
+            )
     seconds = time.perf_counter() - t0
     train_loss, train_hit = measure(model, train_obs[:20000], train_sets[:20000])
     test_loss, test_hit = measure(model, *data["test"])
@@ -156,9 +166,13 @@ def fit(
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="rgw-random")
-    parser.add_argument("--variants", nargs="+", default=VARIANTS,
-                        help="module[:key=value,...] with ModelConfig fields, e.g. predinet:heads=8")
-    parser.add_argument("--train-states", type=int, default=100_000)
+    parser.add_argument(
+        "--variants",
+        nargs="+",
+        default=VARIANTS,
+        help="module[:key=value,...] with ModelConfig fields, e.g. predinet:heads=8",
+    )
+    parser.add_argument("--train-states", type=int, default=200_000)
     parser.add_argument("--test-states", type=int, default=20_000)
     parser.add_argument("--steps", type=int, default=2000, help="Adam steps per variant")
     parser.add_argument("--batch", type=int, default=512)
@@ -172,10 +186,19 @@ def main() -> None:
         "test": labelled_states(args.env, args.test_states, 3_000_000_000, args.follow),
     }
     sets = data["train"][1]
-    print(json.dumps({"env": args.env, "train_states": len(sets), "test_states": len(data["test"][1]),
-                      "label_seconds": round(time.perf_counter() - t0, 1),
-                      "mean_optimal_actions": round(float(sets.sum(1).mean()), 3),
-                      "uniform_loss": round(float(-np.log(sets.sum(1) / 4).mean()), 4)}), flush=True)
+    print(
+        json.dumps(
+            {
+                "env": args.env,
+                "train_states": len(sets),
+                "test_states": len(data["test"][1]),
+                "label_seconds": round(time.perf_counter() - t0, 1),
+                "mean_optimal_actions": round(float(sets.sum(1).mean()), 3),
+                "uniform_loss": round(float(-np.log(sets.sum(1) / 4).mean()), 4),
+            }
+        ),
+        flush=True,
+    )
     for variant in args.variants:
         print(json.dumps(fit(variant, data, args.steps, args.batch, args.seed)), flush=True)
 
