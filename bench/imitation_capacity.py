@@ -33,7 +33,7 @@ import numpy as np
 import torch
 
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.imitation import imitation_loss
+from neurosym.agent.imitation import imitation_loss, planner_choice
 from neurosym.agent.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
@@ -54,14 +54,15 @@ def labelled_states(env: str, n: int, seed: int, follow: float) -> tuple[np.ndar
     venv = make_batched(env, 64, seed=seed)
     obs, _ = venv.reset(seed=seed)
     planner, rng = Planner(), np.random.default_rng(seed)
-    all_obs, all_sets = [], []
+    all_obs, all_sets, count = [], [], 0
     pending = np.zeros(venv.num_envs, dtype=bool)
-    while sum(len(o) for o in all_obs) < n:
+    while count < n:
         optimal, _ = planner.action_sets(venv)
         keep = ~pending  # an autoreset step shows the last episode's end
         all_obs.append(obs[keep].copy())
         all_sets.append(optimal[keep])
-        expert = (rng.random(optimal.shape) * optimal).argmax(axis=1)
+        count += int(keep.sum())
+        expert = planner_choice(optimal, rng)
         actions = np.where(
             rng.random(len(expert)) < follow, expert, rng.integers(0, 4, len(expert))
         )
@@ -79,7 +80,7 @@ def parse_variant(text: str) -> tuple[str, dict[str, Any]]:
         if isinstance(default, tuple):  # conv_channels=32-64
             overrides[key] = tuple(int(v) for v in value.split("-"))
         else:
-            overrides[key] = type(default)(value) if key != "init" else value
+            overrides[key] = type(default)(value)
     return module, overrides
 
 

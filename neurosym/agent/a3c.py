@@ -333,9 +333,8 @@ def learner_process(
             queue.close()
             queue.join_thread()
         if cleanup is not None:
-            with contextlib.suppress(
-                Exception
-            ):  # a peer that died leaves nothing to say goodbye to
+            # a peer that died leaves nothing to say goodbye to
+            with contextlib.suppress(Exception):
                 cleanup()
 
 

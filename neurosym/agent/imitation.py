@@ -73,6 +73,11 @@ def imitation_loss(logits: torch.Tensor, optimal: torch.Tensor) -> torch.Tensor:
     return (torch.logsumexp(logits, dim=-1) - picked).mean()
 
 
+def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """(n,) one of each row's optimal actions (an (n, 4) bool set), drawn uniformly."""
+    return (rng.random(optimal.shape) * optimal).argmax(axis=1)
+
+
 def expert_share(frames: int, beta_frames: int) -> float:
     """DAgger's beta: the chance that a step follows the planner, 1 at the start, 0 after ``beta_frames``."""
     if beta_frames <= 0:
@@ -151,8 +156,7 @@ def imitation_learner(
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
-                # the planner's action: one of its optimal ones, drawn uniformly
-                expert = (rng.random(optimal.shape) * optimal).argmax(axis=1)
+                expert = planner_choice(optimal, rng)
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end

@@ -51,10 +51,10 @@ chunk_bytes_(8388608).
 %!  set_reader_threads(+Threads) is det.
 %   Threads reading a large file, 1 to 4; auto: the cores if 4 or more, else 1.
 set_reader_threads(Threads) :-
-    retractall(reader_threads_(_)),
     (   Threads == auto
-    ->  true
+    ->  retractall(reader_threads_(_))
     ;   must_be(between(1, 4), Threads),
+        retractall(reader_threads_(_)),
         assertz(reader_threads_(Threads))
     ).
 
@@ -104,12 +104,12 @@ load_(M, File, Mode, RuleFiles, Count) :-
 
 cuts_(File, Cuts) :-
     size_file(File, Size),
-    reader_threads(Cores),
+    reader_threads(Threads),
     chunk_bytes_(Min),
-    (   Size >= Min, Cores >= 2, current_prolog_flag(threads, true)
+    (   Size >= Min, Threads >= 2, current_prolog_flag(threads, true)
     ->  setup_call_cleanup(open(File, read, S, [type(binary)]),
-                           findall(Cut, ( between(1, Cores, I), I < Cores,
-                                          Guess is I * Size // Cores,
+                           findall(Cut, ( between(1, Threads, I), I < Threads,
+                                          Guess is I * Size // Threads,
                                           line_start_(S, Guess, Cut) ), Cuts0),
                            close(S)),
         sort(Cuts0, Cuts)
