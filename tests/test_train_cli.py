@@ -113,6 +113,25 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Pa
 
 
 @pytest.mark.expensive
+def test_train_stops_at_target_success(neurosym, tmp_path: Path) -> None:
+    # bw1's random policy solves ~20 % of levels: a full window of 10 reaches 10 % within seconds
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw1", "--module", "predinet", "--out", str(out), "--workers", "1",
+        "--target-success", "0.1", "--window", "10", "--frames", "500000", *TINY,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "stopped (target) after" in proc.stdout
+    agent = load_agent(out / "checkpoint.pt")
+    summary = agent.meta["metrics"]
+    assert summary["stop_reason"] == "target" and summary["success_rate"] >= 0.1
+    assert 0 < summary["solved_frames"] <= agent.meta["frames"] < 500_000
+    assert "--target-success 0.1 " in agent.meta["command"]
+    last = metrics(out)[-1]
+    assert float(last["success_rate"]) >= 0.1 and int(last["frames"]) == agent.meta["frames"]
+
+
+@pytest.mark.expensive
 def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
@@ -211,6 +230,10 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
         (
             ("--env", "rgw2", "--module", "predinet", "--frames", "0"),
             "--frames must be a positive integer",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--target-success", "90"),
+            "--target-success must be a rate in (0, 1], such as 0.9; got 90.0",
         ),
         (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),

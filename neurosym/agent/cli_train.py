@@ -115,6 +115,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
     stop.add_argument(
         "--target-return", type=float, help="stop when the greedy policy's mean return reaches this"
     )
+    stop.add_argument(
+        "--target-success",
+        type=float,
+        help="stop when the success rate over the last --window training episodes reaches this (0-1)",
+    )
     a3c = parser.add_argument_group(
         "learner (defaults: the preset's for the env family, see neurosym/agent/config.py)"
     )
@@ -237,6 +242,7 @@ def command_line(args: argparse.Namespace) -> str:
         ("--frames", "frames"),
         ("--minutes", "minutes"),
         ("--target-return", "target_return"),
+        ("--target-success", "target_success"),
     ):
         if getattr(args, dest) is not None:
             parts += [flag, str(getattr(args, dest))]
@@ -283,6 +289,7 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames,
         minutes=args.minutes,
         target_return=args.target_return,
+        target_success=args.target_success,
         eval_interval=args.eval_interval,
         eval_episodes=args.eval_episodes,
         checkpoint_interval=args.checkpoint_interval,

@@ -13,8 +13,9 @@ shared weights, and when that snapshot reaches the target it is exactly what
 the final checkpoint holds (the workers keep changing the shared weights).
 
 Stops on: a frame budget (total frames, counting those before a resume), a
-time budget (this session), the greedy return reaching ``target_return``, or
-Ctrl-C (the workers ignore SIGINT; the parent stops them and checkpoints).
+time budget (this session), the greedy return reaching ``target_return``, the
+success rate over the last ``window`` training episodes reaching
+``target_success``, or Ctrl-C (the workers ignore SIGINT; the parent stops them and checkpoints).
 
 Under torchrun (PPO only) every rank runs this function; rank 0 alone
 evaluates and writes, the others only run their learner and stop when it
@@ -82,6 +83,9 @@ class RunOptions:
     """stop after this many minutes of this session"""
     target_return: float | None = None
     """stop when the greedy policy's mean return reaches this"""
+    target_success: float | None = None
+    """stop when the success rate over the last ``window`` training episodes (a full window)
+    reaches this: the stop a learning-speed comparison wants (bench/peers.py)"""
     eval_interval: float = 2.0
     """seconds between greedy evaluations (more when one takes over 5 % of that)"""
     device: str = "cpu"
@@ -106,6 +110,10 @@ class RunOptions:
             raise ConfigError(f"--frames must be a positive integer, got {self.frames}")
         if self.minutes is not None and not self.minutes > 0:
             raise ConfigError(f"--minutes must be positive, got {self.minutes}")
+        if self.target_success is not None and not 0 < self.target_success <= 1:
+            raise ConfigError(
+                f"--target-success must be a rate in (0, 1], such as 0.9; got {self.target_success}"
+            )
         for name in ("eval_interval", "checkpoint_interval", "log_interval"):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
@@ -270,6 +278,9 @@ class _Stats:
 
     def success_rate(self) -> float | None:
         return float(np.mean(self.success)) if self.success else None
+
+    def window_full(self) -> bool:
+        return len(self.success) == self.success.maxlen
 
     def row(
         self, wall: float, fps: float, greedy: float | None, greedy_success: float | None
@@ -649,7 +660,14 @@ def train(
                     break
                 if not world.leader:  # rank 0 decides (its counts are every rank's)
                     continue
-                if options.frames is not None and stats.frames >= options.frames:
+                if (
+                    options.target_success is not None
+                    and stats.window_full()
+                    and (stats.success_rate() or 0.0) >= options.target_success
+                ):
+                    stop_reason = "target"
+                    solved_frames, solved_wall = stats.frames, wall0 + now - start
+                elif options.frames is not None and stats.frames >= options.frames:
                     stop_reason = "frames"
                 elif options.minutes is not None and now - start >= options.minutes * 60:
                     stop_reason = "time"
