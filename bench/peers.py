@@ -13,7 +13,10 @@ Side by side, one after the other on the same cores, the same frame budget:
 For each it prints one JSON line: the frames and wall seconds at which the
 success rate over the last ``--window`` training episodes first reached
 ``--target`` (null if never), the final success rate, and the total wall
-time. The SB3 policy is a plain CNN, not a relational module: it answers how
+time. Each run ends when it reaches the target (``neurosym train
+--target-success``; SB3 through its callback) or at the frame budget, so a
+fast learner costs the bench little; ``--no-stop-at-target`` plays every
+budget out. The SB3 policy is a plain CNN, not a relational module: it answers how
 fast this machine learns the task at all, and so how much neurosym's learners
 and relational modules cost or save::
 
@@ -43,10 +46,16 @@ def emit(record: dict) -> None:
     print(json.dumps(record), flush=True)
 
 
-def first_reaching(rows: list[dict[str, str]], target: float) -> tuple[int | None, float | None]:
-    """(frames, wall_s) of the first metrics row whose success_rate reached ``target``."""
+def first_reaching(
+    rows: list[dict[str, str]], target: float, window: int
+) -> tuple[int | None, float | None]:
+    """(frames, wall_s) of the first metrics row whose success_rate over a full window reached ``target``."""
     for row in rows:
-        if row["success_rate"] and float(row["success_rate"]) >= target:
+        if (
+            int(row["episodes"]) >= window
+            and row["success_rate"]
+            and float(row["success_rate"]) >= target
+        ):
             return int(row["frames"]), float(row["wall_s"])
     return None, None
 
@@ -59,6 +68,7 @@ def run_neurosym(algo: str, env: str, module: str, frames: int, args: argparse.N
             "train", "--env", env, "--module", module, "--algo", algo, "--out", str(out),
             "--frames", str(frames), "--seed", str(args.seed), "--window", str(args.window),
             "--eval-interval", "60", "--quiet",
+            *(("--target-success", str(args.target)) if args.stop_at_target else ()),
             timeout=24 * 3600,
         )  # fmt: skip
         wall = time.monotonic() - start
@@ -66,7 +76,7 @@ def run_neurosym(algo: str, env: str, module: str, frames: int, args: argparse.N
             return {"error": proc.stderr.strip()[-500:]}
         with (out / "metrics.csv").open(newline="") as fh:
             rows = list(csv.DictReader(fh))
-    hit_frames, hit_wall = first_reaching(rows, args.target)
+    hit_frames, hit_wall = first_reaching(rows, args.target, args.window)
     return {
         "frames_to_target": hit_frames,
         "wall_s_to_target": hit_wall,
@@ -121,7 +131,7 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
                 and sum(self.recent) / args.window >= args.target
             ):
                 self.hit = (self.num_timesteps, time.monotonic() - self.start)
-            return True
+            return self.hit is None or not args.stop_at_target
 
     def make_env() -> gym.Env:
         env = make(env_name, obs_mode="onehot")
@@ -158,6 +168,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--window", type=int, default=500, help="training episodes behind it")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--threads", type=int, default=2, help="torch threads for SB3 (2)")
+    parser.add_argument(
+        "--stop-at-target",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="end each run when it reaches --target (default) rather than at the frame budget",
+    )
     args = parser.parse_args(argv)
     runs = [r.strip() for r in args.runs.split(",") if r.strip()]
     unknown = sorted(set(runs) - set(RUNS))
