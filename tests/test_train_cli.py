@@ -34,6 +34,7 @@ def metrics(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+BW1 = ROOT / "checkpoints" / "bw1-predinet.pt"
 TINY = ("--envs", "4", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2")
 
 
@@ -129,6 +130,35 @@ def test_train_stops_at_target_success(neurosym, tmp_path: Path) -> None:
     assert "--target-success 0.1 " in agent.meta["command"]
     last = metrics(out)[-1]
     assert float(last["success_rate"]) >= 0.1 and int(last["frames"]) == agent.meta["frames"]
+
+
+@pytest.mark.expensive
+def test_train_init_from_starts_from_another_checkpoint(neurosym, tmp_path: Path) -> None:
+    # a curriculum step: the shipped bw1 agent's weights and model on bw2, learning rate ~0
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw2", "--init-from", str(BW1), "--out", str(out), "--workers", "1",
+        "--frames", "1000", "--lr", "1e-12", "--slim", *TINY,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    source, agent = load_agent(BW1), load_agent(out / "checkpoint.pt")
+    assert agent.env_name == "bw2" and agent.config == source.config
+    assert 1000 <= agent.meta["frames"] < source.meta["frames"]  # frames count afresh
+    before, after = source.model.state_dict(), agent.model.state_dict()
+    assert max(float((before[k] - after[k]).abs().max()) for k in before) < 1e-6
+    first, _, last = agent.meta["command"].rpartition(" && ")
+    assert first == source.meta["command"]
+    assert last.startswith("neurosym train --env bw2 --out ") and f"--init-from {BW1}" in last
+    metrics_ = agent.meta["metrics"]
+    assert metrics_["init_from"] == str(BW1) and metrics_["init_env"] == "bw1"
+    assert metrics_["init_frames"] == source.meta["frames"]
+    resumed = neurosym(
+        "train", "--out", str(out), "--resume", "--frames", "2000", "--lr", "1e-12", *TINY
+    )  # fmt: skip
+    assert resumed.returncode == 0, resumed.stderr
+    again = load_agent(out / "checkpoint.pt")
+    assert again.meta["metrics"]["init_frames"] == source.meta["frames"]  # kept on resume
+    assert again.meta["command"].startswith(agent.meta["command"] + " && ")
 
 
 @pytest.mark.expensive
@@ -235,6 +265,19 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
             ("--env", "bw1", "--module", "predinet", "--target-success", "90"),
             "--target-success must be a rate in (0, 1], such as 0.9; got 90.0",
         ),
+        (
+            ("--env", "rgw2", "--init-from", str(BW1)),
+            "rgw2 is a rgw environment: pick one of bw1, bw2, bw3, boxworld",
+        ),
+        (
+            ("--env", "bw2", "--module", "mhdpa", "--init-from", str(BW1)),
+            "has a different model config: module 'predinet' (asked for 'mhdpa')",
+        ),
+        (
+            ("--env", "bw2", "--init-from", str(BW1), "--env-option", "obs_mode=rgb"),
+            "expects observations (26, 14, 14), bw2 with these options gives (3, 14, 14)",
+        ),
+        (("--env", "bw2", "--init-from", str(BW1), "--resume"), "pass one of them"),
         (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),
             "--env-option wants KEY=VALUE",

@@ -75,13 +75,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--module",
         choices=("predinet", "mhdpa"),
-        help="relational module (required unless --resume)",
+        help="relational module (required unless --resume or --init-from)",
     )
     parser.add_argument(
         "--out", required=True, help="run directory: checkpoint.pt and metrics.csv go here"
     )
     parser.add_argument(
         "--resume", action="store_true", help="continue the run in --out from its checkpoint"
+    )
+    parser.add_argument(
+        "--init-from",
+        metavar="CHECKPOINT",
+        help="start a new run from this checkpoint's weights and model (a curriculum: e.g. a bw1 "
+        "agent on bw2); any env of its family with its observation shape; frames count afresh",
     )
     parser.add_argument(
         "--algo",
@@ -234,6 +240,8 @@ def command_line(args: argparse.Namespace) -> str:
             parts += [flag, str(getattr(args, dest))]
     if args.resume:
         parts.append("--resume")
+    if args.init_from is not None:
+        parts += ["--init-from", args.init_from]
     if args.algo is not None:
         parts += ["--algo", args.algo]
     if args.preset != "default":
@@ -308,6 +316,7 @@ def run(args: argparse.Namespace) -> int:
         env_kwargs=parse_env_options(args.env_option) if args.env_option else None,
         options=options,
         resume=args.resume,
+        init_from=args.init_from,
         command=command_line(args),
         print_fn=print,
         preset=args.preset,

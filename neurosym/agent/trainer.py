@@ -69,6 +69,8 @@ METRIC_COLUMNS = (
     "entropy",
     "grad_norm",
 )
+INIT_KEYS = ("init_from", "init_env", "init_frames", "init_wall_s")
+"""What a run started with --init-from records of its source, in its metrics (kept on resume)."""
 TARGET_TOLERANCE = 1e-6
 """A greedy mean return within this of the target counts as reaching it (10.7 is not exact in binary)."""
 
@@ -356,6 +358,7 @@ def train(
     print_fn: Callable[[str], None] | None = None,
     preset: str = "default",
     algo: str | None = None,
+    init_from: str | os.PathLike[str] | None = None,
 ) -> TrainResult:
     """Train an agent with A3C or PPO into ``out`` (``checkpoint.pt``, ``metrics.csv``).
 
@@ -365,7 +368,11 @@ def train(
     observation by default). ``algo``: "a3c" (default) or "ppo". With
     ``resume`` the run continues ``out/checkpoint.pt``: its model and settings,
     unless overridden (a model override that differs is an error), its frame
-    and episode counts, its metrics rows.
+    and episode counts, its metrics rows. ``init_from``: a new run that starts
+    from that checkpoint's weights and model config (a curriculum step; the
+    settings are the preset's for ``env``, frames count from 0, and the
+    checkpoint records the source's command before this one and its frames as
+    ``init_frames``).
     """
     options = options or RunOptions()
     world = distributed.world_from_env()
@@ -378,6 +385,12 @@ def train(
     torch.set_num_threads(1)
 
     payload: dict[str, Any] | None = None
+    init_payload: dict[str, Any] | None = None
+    init_meta: dict[str, Any] = {}
+    if resume and init_from is not None:
+        raise ConfigError(
+            "--init-from starts a new run and --resume continues one: pass one of them"
+        )
     if resume:
         if world.distributed and not ckpt_path.exists():
             raise CheckpointError(
@@ -412,8 +425,9 @@ def train(
         if payload.get("command") and command:
             command = f"{payload['command']} && {command}"
         wall0 = float(payload["metrics"].get("wall_s", 0.0))
+        init_meta = {k: payload["metrics"][k] for k in INIT_KEYS if k in payload["metrics"]}
     else:
-        if env is None or module is None:
+        if env is None or (module is None and init_from is None):
             raise ConfigError("--env and --module are needed unless --resume continues a run")
         if ckpt_path.exists() and world.leader:
             raise ConfigError(
@@ -423,9 +437,36 @@ def train(
 
         kwargs = {**preset_env_kwargs(env_family(env), preset), **(env_kwargs or {})}
         name, family, shape, scale = probe_env(env, kwargs)
-        model_config = ModelConfig.for_family(
-            family, module, shape, scale, preset=preset, **model_overrides
-        )
+        if init_from is None:
+            model_config = ModelConfig.for_family(
+                family, module, shape, scale, preset=preset, **model_overrides
+            )
+        else:
+            init_payload = read_checkpoint(init_from, env=name)
+            model_config = init_payload["model_config"]
+            wanted = {"module": module, **model_overrides} if module else dict(model_overrides)
+            diffs = [
+                f"{k} {getattr(model_config, k)!r} (asked for {v!r})"
+                for k, v in wanted.items()
+                if getattr(model_config, k) != v
+            ]
+            if diffs:
+                raise CheckpointError(
+                    f"{init_from} has a different model config: {'; '.join(diffs)}"
+                )
+            if model_config.obs_shape != shape:
+                raise CheckpointError(
+                    f"{init_from} expects observations {model_config.obs_shape}, "
+                    f"{name} with these options gives {shape}"
+                )
+            if init_payload.get("command") and command:
+                command = f"{init_payload['command']} && {command}"
+            init_meta = {
+                "init_from": str(init_from),
+                "init_env": init_payload["env"],
+                "init_frames": int(init_payload["frames"]),
+                "init_wall_s": float(init_payload["metrics"].get("wall_s", 0.0)),
+            }
         train_config = TrainConfig.for_family(
             family, preset=preset, algo=algo or "a3c", **train_overrides
         )
@@ -451,7 +492,12 @@ def train(
 
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(train_config.seed)
-    shared = ActorCritic(model_config) if payload is None else build_model(payload, ckpt_path)
+    if payload is not None:
+        shared = build_model(payload, ckpt_path)
+    elif init_payload is not None:
+        shared = build_model(init_payload, Path(init_from))  # type: ignore[arg-type]
+    else:
+        shared = ActorCritic(model_config)
     shared.share_memory()
     optimizer = shared_optimizer(shared.parameters(), train_config)
     learners = 1 if train_config.algo in ("ppo", "imitate") else train_config.workers
@@ -489,7 +535,7 @@ def train(
     )
 
     def checkpoint(state_dict: dict[str, torch.Tensor] | None, extra: dict[str, Any]) -> None:
-        metrics = {**(rows[-1] if rows else {}), **extra}
+        metrics = {**(rows[-1] if rows else {}), **init_meta, **extra}
         metrics = {
             k: (float(v) if isinstance(v, np.floating) else v)
             for k, v in metrics.items()
