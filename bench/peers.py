@@ -22,6 +22,7 @@ and relational modules cost or save::
 
     python bench/peers.py --env bw1 --frames 1500000            # all three, PrediNet
     python bench/peers.py --runs sb3-ppo --frames 500000
+    python bench/peers.py --frames 5000000 --minutes 15          # each run: 15 minutes at most
 """
 
 from __future__ import annotations
@@ -67,6 +68,7 @@ def run_neurosym(algo: str, env: str, module: str, frames: int, args: argparse.N
         proc = neurosym(
             "train", "--env", env, "--module", module, "--algo", algo, "--out", str(out),
             "--frames", str(frames), "--seed", str(args.seed), "--window", str(args.window),
+            *(("--minutes", str(args.minutes)) if args.minutes else ()),
             "--eval-interval", "60", "--quiet",
             *(("--target-success", str(args.target)) if args.stop_at_target else ()),
             timeout=24 * 3600,
@@ -131,6 +133,8 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
                 and sum(self.recent) / args.window >= args.target
             ):
                 self.hit = (self.num_timesteps, time.monotonic() - self.start)
+            if args.minutes and time.monotonic() - self.start >= 60 * args.minutes:
+                return False
             return self.hit is None or not args.stop_at_target
 
     def make_env() -> gym.Env:
@@ -163,6 +167,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--env", default="bw1", help="Box-World configuration (bw1)")
     parser.add_argument("--module", default="predinet", help="neurosym's relational module")
     parser.add_argument("--frames", type=int, default=1_500_000, help="frame budget per run")
+    parser.add_argument(
+        "--minutes", type=float, default=None, help="also a wall-clock budget per run (minutes)"
+    )
     parser.add_argument("--runs", default=",".join(RUNS), help=f"any of {', '.join(RUNS)}")
     parser.add_argument("--target", type=float, default=0.9, help="success rate to reach (0.9)")
     parser.add_argument("--window", type=int, default=500, help="training episodes behind it")
@@ -192,6 +199,7 @@ def main(argv: list[str] | None = None) -> int:
                 "module": None if run == "sb3-ppo" else args.module,
                 "target": args.target,
                 "budget_frames": args.frames,
+                "budget_minutes": args.minutes,
                 **result,
             }
         )
