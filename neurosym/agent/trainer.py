@@ -339,6 +339,29 @@ class _StopSignal:
             signal.signal(sig, handler)
 
 
+def _check_model_fits(
+    path: str | os.PathLike[str],
+    model_config: ModelConfig,
+    module: str | None,
+    model_overrides: dict[str, Any],
+    shape: tuple[int, int, int],
+    env_label: str,
+) -> None:
+    """Refuse a checkpoint's model that differs from what was asked for or from the env's shape."""
+    wanted = {"module": module, **model_overrides} if module else dict(model_overrides)
+    diffs = [
+        f"{k} {getattr(model_config, k)!r} (asked for {v!r})"
+        for k, v in wanted.items()
+        if getattr(model_config, k) != v
+    ]
+    if diffs:
+        raise CheckpointError(f"{path} has a different model config: {'; '.join(diffs)}")
+    if model_config.obs_shape != shape:
+        raise CheckpointError(
+            f"{path} expects observations {model_config.obs_shape}, {env_label} gives {shape}"
+        )
+
+
 def _env_seed(seed: int, rank: int, frames_before: int) -> int:
     """A distinct env/sampling seed per (run seed, worker, session start)."""
     return int((seed * 1_000_003 + rank * 7_919 + frames_before) % (2**31 - 1))
@@ -402,18 +425,7 @@ def train(
         kwargs = dict(payload["env_kwargs"]) if env_kwargs is None else dict(env_kwargs)
         name, family, shape, scale = probe_env(env_name, kwargs)
         model_config: ModelConfig = payload["model_config"]
-        wanted = {"module": module, **model_overrides} if module else dict(model_overrides)
-        diffs = [
-            f"{k} {getattr(model_config, k)!r} (asked for {v!r})"
-            for k, v in wanted.items()
-            if getattr(model_config, k) != v
-        ]
-        if diffs:
-            raise CheckpointError(f"{ckpt_path} has a different model config: {'; '.join(diffs)}")
-        if model_config.obs_shape != shape:
-            raise CheckpointError(
-                f"{ckpt_path} expects observations {model_config.obs_shape}, env gives {shape}"
-            )
+        _check_model_fits(ckpt_path, model_config, module, model_overrides, shape, "env")
         base = payload.get("train_config") or TrainConfig.for_family(family).to_dict()
         train_config = TrainConfig.from_dict(base).replace(**train_overrides)
         if algo is not None and algo != train_config.algo:
@@ -444,21 +456,10 @@ def train(
         else:
             init_payload = read_checkpoint(init_from, env=name)
             model_config = init_payload["model_config"]
-            wanted = {"module": module, **model_overrides} if module else dict(model_overrides)
-            diffs = [
-                f"{k} {getattr(model_config, k)!r} (asked for {v!r})"
-                for k, v in wanted.items()
-                if getattr(model_config, k) != v
-            ]
-            if diffs:
-                raise CheckpointError(
-                    f"{init_from} has a different model config: {'; '.join(diffs)}"
-                )
-            if model_config.obs_shape != shape:
-                raise CheckpointError(
-                    f"{init_from} expects observations {model_config.obs_shape}, "
-                    f"{name} with these options gives {shape}"
-                )
+            _check_model_fits(
+                init_from, model_config, module, model_overrides, shape,
+                f"{name} with these options",
+            )  # fmt: skip
             if init_payload.get("command") and command:
                 command = f"{init_payload['command']} && {command}"
             init_meta = {
