@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | extract | probe | intervene | query | plot | envs.
+"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | plot | envs.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -86,6 +86,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "eval": (
         "neurosym.agent.cli_eval",
         "Evaluate a checkpoint: mean return, success rate, outcomes.",
+    ),
+    "compact": (
+        "neurosym.agent.cli_compact",
+        "Store a checkpoint's weights in half precision: a smaller file to ship.",
     ),
     "extract": (
         "neurosym.export.cli_extract",
