@@ -249,7 +249,11 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
     ("args", "message"),
     [
         (("--env", "rgw9", "--module", "predinet"), "rgw9"),
-        (("--module", "predinet"), "--env and --module are needed unless --resume"),
+        (("--module", "predinet"), "--env is needed unless --resume"),
+        (
+            ("--env", "rgw2"),
+            "--module (predinet or mhdpa) is needed unless --resume continues a run or --init-from",
+        ),
         (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
         (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
         (("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"), "ppo has none"),

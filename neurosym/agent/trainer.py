@@ -439,8 +439,13 @@ def train(
         wall0 = float(payload["metrics"].get("wall_s", 0.0))
         init_meta = {k: payload["metrics"][k] for k in INIT_KEYS if k in payload["metrics"]}
     else:
-        if env is None or (module is None and init_from is None):
-            raise ConfigError("--env and --module are needed unless --resume continues a run")
+        if env is None:
+            raise ConfigError("--env is needed unless --resume continues a run (e.g. --env rgw2)")
+        if module is None and init_from is None:
+            raise ConfigError(
+                "--module (predinet or mhdpa) is needed unless --resume continues a run "
+                "or --init-from supplies the model"
+            )
         if ckpt_path.exists() and world.leader:
             raise ConfigError(
                 f"{ckpt_path} already exists; pass --resume to continue it or choose another --out"
