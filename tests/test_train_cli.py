@@ -132,6 +132,24 @@ def test_train_stops_at_target_success(neurosym, tmp_path: Path) -> None:
     assert float(last["success_rate"]) >= 0.1 and int(last["frames"]) == agent.meta["frames"]
 
 
+def test_train_keeps_snapshots(neurosym, tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "rgw2", "--module", "mhdpa", "--out", str(out), "--workers", "1",
+        "--frames", "20000", "--heads", "1", "--snapshot-every", "0.005", *TINY,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    snaps = sorted((out / "snapshots").iterdir())
+    assert len(snaps) >= 2, snaps
+    frames = [load_agent(p).meta["frames"] for p in snaps]
+    assert [p.name for p in snaps] == [f"frames-{f:012d}.pt" for f in frames]
+    assert (
+        frames == sorted(set(frames))
+        and frames[-1] <= load_agent(out / "checkpoint.pt").meta["frames"]
+    )
+    assert "--snapshot-every 0.005" in load_agent(out / "checkpoint.pt").meta["command"]
+
+
 @pytest.mark.expensive
 def test_train_init_from_starts_from_another_checkpoint(neurosym, tmp_path: Path) -> None:
     # a curriculum step: the shipped bw1 agent's weights and model on bw2, learning rate ~0
@@ -250,6 +268,10 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
     [
         (("--env", "rgw9", "--module", "predinet"), "rgw9"),
         (("--module", "predinet"), "--env is needed unless --resume"),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--snapshot-every", "0"),
+            "--snapshot-every must be positive minutes, got 0.0",
+        ),
         (
             ("--env", "rgw2"),
             "--module (predinet or mhdpa) is needed unless --resume continues a run or --init-from",

@@ -207,6 +207,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--checkpoint-interval", type=float, default=60.0, help="seconds between checkpoints (60)"
     )
     watch.add_argument(
+        "--snapshot-every",
+        type=float,
+        metavar="MINUTES",
+        help="also keep a copy of the checkpoint every MINUTES in OUT/snapshots/frames-N.pt "
+        "(for curves on held-out levels: bench/curve.py)",
+    )
+    watch.add_argument(
         "--window",
         type=int,
         default=100,
@@ -268,6 +275,7 @@ def command_line(args: argparse.Namespace) -> str:
         ("--eval-interval", "eval_interval", 2.0),
         ("--eval-episodes", "eval_episodes", 8),
         ("--checkpoint-interval", "checkpoint_interval", 60.0),
+        ("--snapshot-every", "snapshot_every", None),
         ("--window", "window", 100),
     ):
         if getattr(args, dest) != default:
@@ -301,6 +309,7 @@ def run(args: argparse.Namespace) -> int:
         eval_interval=args.eval_interval,
         eval_episodes=args.eval_episodes,
         checkpoint_interval=args.checkpoint_interval,
+        snapshot_every=args.snapshot_every,
         window=args.window,
         slim=args.slim,
         progress=not args.quiet,

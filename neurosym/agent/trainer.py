@@ -54,6 +54,7 @@ from neurosym.errors import CheckpointError, ConfigError
 
 CHECKPOINT_NAME = "checkpoint.pt"
 METRICS_NAME = "metrics.csv"
+SNAPSHOTS_DIR = "snapshots"
 METRIC_COLUMNS = (
     "wall_s",
     "frames",
@@ -96,6 +97,10 @@ class RunOptions:
     """episodes per greedy evaluation (played side by side)"""
     checkpoint_interval: float = 60.0
     """seconds between periodic checkpoints"""
+    snapshot_every: float | None = None
+    """minutes between copies of the checkpoint kept in ``out/snapshots/frames-N.pt``: the
+    checkpoint.pt of a run holds only its last weights, a curve on held-out levels needs
+    the earlier ones (bench/curve.py); None keeps none"""
     log_interval: float = 2.0
     """seconds between metrics rows"""
     window: int = 100
@@ -115,6 +120,10 @@ class RunOptions:
         if self.target_success is not None and not 0 < self.target_success <= 1:
             raise ConfigError(
                 f"--target-success must be a rate in (0, 1], such as 0.9; got {self.target_success}"
+            )
+        if self.snapshot_every is not None and not self.snapshot_every > 0:
+            raise ConfigError(
+                f"--snapshot-every must be positive minutes, got {self.snapshot_every}"
             )
         for name in ("eval_interval", "checkpoint_interval", "log_interval"):
             if not getattr(self, name) > 0:
@@ -191,6 +200,18 @@ def _remove_stale_temporaries(out: Path) -> None:
     for name in (CHECKPOINT_NAME, METRICS_NAME):
         for tmp in out.glob(f".{name}.*.tmp"):
             tmp.unlink(missing_ok=True)
+    for tmp in (out / SNAPSHOTS_DIR).glob(".frames-*.pt.*.tmp"):
+        tmp.unlink(missing_ok=True)
+
+
+def _keep_snapshot(checkpoint: Path, snapshot: Path) -> None:
+    snapshot.parent.mkdir(parents=True, exist_ok=True)
+    write_bytes_atomic(snapshot, checkpoint.read_bytes())
+
+
+def snapshot_path(out: Path, frames: int) -> Path:
+    """Where ``--snapshot-every`` keeps the checkpoint at ``frames`` (names sort by frames)."""
+    return out / SNAPSHOTS_DIR / f"frames-{frames:012d}.pt"
 
 
 def _write_rows(path: Path, rows: list[dict[str, Any]]) -> None:
@@ -624,7 +645,7 @@ def train(
     task = progress.add_task(f"{name} {model_config.module}", total=total, stats="starting workers")
 
     start = time.monotonic()
-    last_log = last_eval = last_ckpt = start
+    last_log = last_eval = last_ckpt = last_snapshot = start
     eval_cost = 0.0
     last_frames = stats.frames
     greedy: float | None = None
@@ -723,9 +744,18 @@ def train(
                     stop_reason = "frames"
                 elif options.minutes is not None and now - start >= options.minutes * 60:
                     stop_reason = "time"
-                elif now - last_ckpt >= options.checkpoint_interval:
+                elif now - last_ckpt >= options.checkpoint_interval or (
+                    options.snapshot_every is not None
+                    and now - last_snapshot >= options.snapshot_every * 60
+                ):
                     checkpoint(None, {"wall_s": wall0 + now - start, "stop_reason": "running"})
                     last_ckpt = now
+                    if (
+                        options.snapshot_every is not None
+                        and now - last_snapshot >= options.snapshot_every * 60
+                    ):
+                        _keep_snapshot(ckpt_path, snapshot_path(out, stats.frames))
+                        last_snapshot = now
     except KeyboardInterrupt:  # a Ctrl-C that came before the handler was in place
         stop_reason = "interrupted"
     finally:
