@@ -23,6 +23,7 @@ and relational modules cost or save::
     python bench/peers.py --env bw1 --frames 1500000            # all three, PrediNet
     python bench/peers.py --runs sb3-ppo --frames 500000
     python bench/peers.py --frames 5000000 --minutes 15          # each run: 15 minutes at most
+    python bench/peers.py --runs neurosym-a3c --a3c-args '--envs 32'   # other train flags
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ import argparse
 import collections
 import csv
 import json
+import shlex
 import sys
 import tempfile
 import time
@@ -69,7 +71,7 @@ def run_neurosym(algo: str, env: str, module: str, frames: int, args: argparse.N
             "train", "--env", env, "--module", module, "--algo", algo, "--out", str(out),
             "--frames", str(frames), "--seed", str(args.seed), "--window", str(args.window),
             *(("--minutes", str(args.minutes)) if args.minutes else ()),
-            "--eval-interval", "60", "--quiet",
+            "--eval-interval", "60", "--quiet", *shlex.split(getattr(args, f"{algo}_args")),
             *(("--target-success", str(args.target)) if args.stop_at_target else ()),
             timeout=24 * 3600,
         )  # fmt: skip
@@ -181,6 +183,13 @@ def main(argv: list[str] | None = None) -> int:
         default=True,
         help="end each run when it reaches --target (default) rather than at the frame budget",
     )
+    for algo in ("a3c", "ppo"):
+        parser.add_argument(
+            f"--{algo}-args",
+            default="",
+            metavar="FLAGS",
+            help=f"more `neurosym train` flags for neurosym-{algo}, e.g. '--envs 32' (none)",
+        )
     args = parser.parse_args(argv)
     runs = [r.strip() for r in args.runs.split(",") if r.strip()]
     unknown = sorted(set(runs) - set(RUNS))
@@ -200,6 +209,7 @@ def main(argv: list[str] | None = None) -> int:
                 "target": args.target,
                 "budget_frames": args.frames,
                 "budget_minutes": args.minutes,
+                "flags": None if run == "sb3-ppo" else getattr(args, f"{run.split('-')[1]}_args"),
                 **result,
             }
         )
