@@ -36,12 +36,10 @@ def checkpoints_of(run: Path) -> list[Path]:
     return snaps + ([final] if final.exists() else [])
 
 
-def held_out(path: Path, episodes: int, seed: int, env: str | None) -> dict[str, Any]:
+def held_out(agent: Any, path: Path, episodes: int, seed: int, env: str | None) -> dict[str, Any]:
     """One checkpoint's success on unseen levels, sampled and greedy."""
-    from neurosym.agent.checkpoint import load_agent
     from neurosym.agent.cli_eval import evaluate
 
-    agent = load_agent(path)
     row: dict[str, Any] = {
         "checkpoint": str(path),
         "frames": agent.meta["frames"],
@@ -99,13 +97,13 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(
             f"{args.run} holds no metrics.csv and checkpoint: a `neurosym train --out` folder?"
         )
-    points = []
-    for path in paths:
-        points.append(held_out(path, args.episodes, args.seed, args.env))
-        print(json.dumps(points[-1]), flush=True)
     from neurosym.agent.checkpoint import load_agent
 
-    final = load_agent(paths[-1])
+    points = []
+    for path in paths:
+        final = load_agent(path)  # the last one played is the run's final checkpoint
+        points.append(held_out(final, path, args.episodes, args.seed, args.env))
+        print(json.dumps(points[-1]), flush=True)
     env = args.env or final.env_name
     floor = random_success(env, 1000, args.seed)
     print(json.dumps({"random_actions": floor, "env": env, "episodes": 1000}), flush=True)

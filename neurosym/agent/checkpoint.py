@@ -135,6 +135,11 @@ def save_checkpoint(
         "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
         "command": command,
     }
+    return _write_payload(path, payload)
+
+
+def _write_payload(path: Path, payload: dict[str, Any]) -> Path:
+    """Check that ``payload`` holds only tensors and plain values, then write it atomically."""
     _check_plain(payload, "checkpoint")
     path.parent.mkdir(parents=True, exist_ok=True)
     # Serialised in memory first: torch reports a failed file write as a
@@ -305,11 +310,7 @@ def compact_checkpoint(
     out["weights_dtype"] = dtype
     step = shlex.join(["neurosym", "compact", str(src), "--out", str(dst), "--dtype", dtype])
     out["command"] = f"{payload['command']} && {step}" if payload.get("command") else step
-    _check_plain(out, "checkpoint")
-    buf = io.BytesIO()
-    torch.save(out, buf)
-    dst.parent.mkdir(parents=True, exist_ok=True)
-    write_bytes_atomic(dst, buf.getvalue())
+    _write_payload(dst, out)
     return {"bytes_before": before, "bytes_after": dst.stat().st_size, "max_change": largest}
 
 

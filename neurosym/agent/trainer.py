@@ -646,6 +646,11 @@ def train(
 
     start = time.monotonic()
     last_log = last_eval = last_ckpt = last_snapshot = start
+
+    def snapshot_due(now: float) -> bool:
+        every = options.snapshot_every
+        return every is not None and now - last_snapshot >= every * 60
+
     eval_cost = 0.0
     last_frames = stats.frames
     greedy: float | None = None
@@ -744,16 +749,10 @@ def train(
                     stop_reason = "frames"
                 elif options.minutes is not None and now - start >= options.minutes * 60:
                     stop_reason = "time"
-                elif now - last_ckpt >= options.checkpoint_interval or (
-                    options.snapshot_every is not None
-                    and now - last_snapshot >= options.snapshot_every * 60
-                ):
+                elif now - last_ckpt >= options.checkpoint_interval or snapshot_due(now):
                     checkpoint(None, {"wall_s": wall0 + now - start, "stop_reason": "running"})
                     last_ckpt = now
-                    if (
-                        options.snapshot_every is not None
-                        and now - last_snapshot >= options.snapshot_every * 60
-                    ):
+                    if snapshot_due(now):
                         _keep_snapshot(ckpt_path, snapshot_path(out, stats.frames))
                         last_snapshot = now
     except KeyboardInterrupt:  # a Ctrl-C that came before the handler was in place
