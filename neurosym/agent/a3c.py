@@ -42,6 +42,7 @@ from typing import Any, NamedTuple
 import torch
 import torch.nn.functional as F
 
+from neurosym.agent.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
@@ -314,7 +315,9 @@ def learner_process(
 ) -> Iterator[None]:
     """What every learner process does around its work (A3C worker, PPO, imitation).
 
-    Ctrl-C is the parent's business (SIGINT ignored); the process dies with
+    Freed memory stays in the process for the next update's tensors
+    (:mod:`neurosym.agent.allocator`: page faults cost a quarter of an update
+    otherwise); Ctrl-C is the parent's business (SIGINT ignored); the process dies with
     its trainer (:func:`distributed.die_with_parent`); any exception becomes
     an ``("error", rank, traceback)`` message; the queue is flushed before
     ``cleanup`` runs (leaving a gloo group whose peer has gone can block while
@@ -322,6 +325,7 @@ def learner_process(
     """
     from neurosym.agent import distributed
 
+    keep_freed_memory()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     distributed.die_with_parent()
     try:
