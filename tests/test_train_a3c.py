@@ -319,3 +319,42 @@ def test_kept_graph_gives_the_recomputed_loss() -> None:
     recomputed, _ = a3c_loss(model, ro._replace(logits=None, values=None), TrainConfig())
     torch.testing.assert_close(kept, recomputed, rtol=1e-5, atol=1e-5)
     kept.backward()
+
+
+def test_critic_warmup_update_moves_the_value_head_alone() -> None:
+    """critic_only + only_prefix: the value loss, and only value.* weights (and their Adam state) move."""
+    from neurosym.agent.a3c import SharedAdam
+
+    torch.manual_seed(0)
+    config = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
+    shared, local = ActorCritic(config), ActorCritic(config)
+    shared.share_memory()
+    opt = SharedAdam(shared.parameters(), lr=1e-3, eps=1e-5)
+    obs = torch.randint(0, 2, (1, 2, 9, 10, 10), dtype=torch.uint8)
+    ro = Rollout(
+        obs=obs,
+        last_obs=obs[0],
+        actions=torch.full((1, 2), 2),
+        rewards=torch.full((1, 2), 5.0),
+        terminated=torch.ones(1, 2, dtype=torch.bool),
+        truncated=torch.zeros(1, 2, dtype=torch.bool),
+        valid=torch.ones(1, 2, dtype=torch.bool),
+    )
+    cfg = TrainConfig(entropy=0.01, value_coef=0.5)
+    full, stats = a3c_loss(local, ro, cfg)
+    value_only, same = a3c_loss(local, ro, cfg, critic_only=True)
+    assert same == stats  # the parts are reported either way
+    assert value_only.item() == pytest.approx(0.5 * stats.value_loss)
+    assert full.item() != pytest.approx(value_only.item())
+    before = {k: v.clone() for k, v in shared.state_dict().items()}
+    v_before = shared(obs[0])[1].mean().item()
+    for _ in range(5):
+        local.load_state_dict(shared.state_dict())
+        loss, _ = a3c_loss(local, ro, cfg, critic_only=True)
+        apply_update(local, shared, opt, loss, clip=400.0, only_prefix="value.")
+    after = shared.state_dict()
+    moved = {k for k in before if not torch.equal(before[k], after[k])}
+    assert moved == {"value.weight", "value.bias"}
+    assert shared(obs[0])[1].mean().item() > v_before  # towards the return of 5
+    untouched = [p for n, p in shared.named_parameters() if not n.startswith("value.")]
+    assert all(float(opt.state[p]["exp_avg"].abs().max()) == 0 for p in untouched)

@@ -180,6 +180,23 @@ def test_train_init_from_starts_from_another_checkpoint(neurosym, tmp_path: Path
 
 
 @pytest.mark.expensive
+def test_train_critic_warmup_moves_the_value_head_alone(neurosym, tmp_path: Path) -> None:
+    # the whole run inside the warm-up, at a learning rate that moves every weight it touches
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw1", "--init-from", str(BW1), "--out", str(out), "--workers", "2",
+        "--frames", "2000", "--lr", "1e-3", "--critic-warmup", "1000000", "--slim", *TINY,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.meta["train_config"]["critic_warmup"] == 1_000_000
+    assert "--critic-warmup 1000000" in agent.meta["command"]
+    before, after = load_agent(BW1).model.state_dict(), agent.model.state_dict()
+    moved = {k for k in before if not torch.equal(before[k], after[k])}
+    assert moved == {"value.weight", "value.bias"}
+
+
+@pytest.mark.expensive
 def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
@@ -304,6 +321,14 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
             "expects observations (26, 14, 14), bw2 with these options gives (3, 14, 14)",
         ),
         (("--env", "bw2", "--init-from", str(BW1), "--resume"), "pass one of them"),
+        (
+            ("--env", "bw1", "--module", "predinet", "--critic-warmup", "-5"),
+            "critic_warmup must be >= 0 frames, got -5",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--critic-warmup", "100"),
+            "--critic-warmup is an A3C setting; --algo ppo does not use it",
+        ),
         (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),
             "--env-option wants KEY=VALUE",

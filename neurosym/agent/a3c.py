@@ -224,11 +224,14 @@ def a3c_loss(
     config: TrainConfig,
     sil_batch: SILBatch | None = None,
     scale: AdvantageScale | None = None,
+    critic_only: bool = False,
 ) -> tuple[torch.Tensor, LossStats]:
     """The scalar loss of one rollout (plus self-imitation on ``sil_batch``) and its parts.
 
     With ``config.normalize_advantages`` the advantages are divided by
     ``scale``'s running RMS (a worker keeps one; without it, this rollout's RMS).
+    ``critic_only`` (``config.critic_warmup``): the loss is the value loss
+    alone; the other parts are still reported.
 
     The model runs once over what it has not seen with a graph: the rollout's
     T * K observations (unless acting kept their graph), the last observation
@@ -267,8 +270,11 @@ def a3c_loss(
     policy_loss = -(logp_a * advantages * mask).sum() / K
     value_loss = 0.5 * ((returns - values).pow(2) * mask).sum() / K
     entropy_sum = (entropy * mask).sum() / K
-    loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
-    if sil_batch is not None:
+    if critic_only:
+        loss = config.value_coef * value_loss
+    else:
+        loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
+    if sil_batch is not None and not critic_only:
         M = sil_batch.actions.shape[0]
         scaled = sil_batch._replace(returns=sil_batch.returns * config.reward_scale)
         sil = sil_loss(logits_all[n + K :], values_all[n + K :], scaled, config.value_coef)
@@ -283,10 +289,20 @@ def apply_update(
     optimizer: torch.optim.Optimizer,
     loss: torch.Tensor,
     clip: float,
+    only_prefix: str | None = None,
 ) -> float:
-    """Backpropagate on the local model, hand its gradients to the shared one, step; the gradient norm."""
+    """Backpropagate on the local model, hand its gradients to the shared one, step; the gradient norm.
+
+    ``only_prefix`` (e.g. ``"value."``): only parameters whose names start with
+    it get a gradient; the optimiser leaves every other weight, and its
+    statistics, as they are.
+    """
     local.zero_grad(set_to_none=True)
     loss.backward()
+    if only_prefix is not None:
+        for name, p in local.named_parameters():
+            if not name.startswith(only_prefix):
+                p.grad = None
     norm = torch.nn.utils.clip_grad_norm_(local.parameters(), clip)
     for shared_p, local_p in zip(shared.parameters(), local.parameters(), strict=True):
         shared_p.grad = local_p.grad
@@ -353,8 +369,13 @@ def worker(
     env_seed: int,
     stop: Any,
     queue: Any,
+    frames0: int = 0,
 ) -> None:
     """One A3C worker: rollouts and updates until ``stop`` is set; reports to ``queue``.
+
+    ``frames0``: frames the run had trained before this session; the worker
+    does its share (1 / W) of what is left of ``train_config.critic_warmup``
+    with the value head alone.
 
     Messages: ``("update", rank, frames, returns, lengths, outcomes, LossStats tuple)``
     per update, ``("error", rank, traceback text)`` if anything fails.
@@ -381,6 +402,8 @@ def worker(
         # K <= 4 it lost (K = 1: 456 against 676 frames/s, one worker)
         keep_graph = model_config.module == "mhdpa" and train_config.envs >= 8
         scale = AdvantageScale()
+        warmup = -(-max(0, train_config.critic_warmup - frames0) // train_config.workers)
+        frames = 0
         parent = os.getppid()
         while not stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
@@ -388,8 +411,16 @@ def worker(
                 local, state, train_config.n_steps, generator, bonus, memory, keep_graph
             )
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
-            loss, stats = a3c_loss(local, rollout, train_config, batch, scale)
-            norm = apply_update(local, shared, optimizer, loss, train_config.grad_clip)
-            report_update(
-                queue, rank, int(rollout.valid.sum()), finished, stats._replace(grad_norm=norm)
+            warming = frames < warmup
+            loss, stats = a3c_loss(local, rollout, train_config, batch, scale, critic_only=warming)
+            norm = apply_update(
+                local,
+                shared,
+                optimizer,
+                loss,
+                train_config.grad_clip,
+                only_prefix="value." if warming else None,
             )
+            n = int(rollout.valid.sum())
+            frames += n
+            report_update(queue, rank, n, finished, stats._replace(grad_norm=norm))

@@ -41,6 +41,7 @@ _OVERRIDES = (
     ("--ppo-epochs", "ppo_epochs", "train"),
     ("--ppo-minibatches", "ppo_minibatches", "train"),
     ("--clip-range", "clip_range", "train"),
+    ("--critic-warmup", "critic_warmup", "train"),
     ("--dagger-beta-frames", "dagger_beta_frames", "train"),
     ("--dagger-steps", "dagger_steps", "train"),
     ("--attention-gain", "attention_gain", "model"),
@@ -151,6 +152,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="imitate: frames over which following the planner falls from always to never",
     )
     a3c.add_argument("--dagger-steps", type=int, help="imitate: gradient steps per rollout")
+    a3c.add_argument(
+        "--critic-warmup",
+        type=int,
+        metavar="FRAMES",
+        help="A3C: first frames of the run in which only the value head learns (0: none)",
+    )
     a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
     a3c.add_argument("--gamma", type=float, help="discount")
     a3c.add_argument("--n-steps", type=int, help="rollout length per update (Table 4: 40)")

@@ -337,6 +337,11 @@ class TrainConfig:
     """environments per worker K (1 = classic A3C with one env)"""
     seed: int = 0
     """base seed; worker w uses seed + 1000 * w"""
+    critic_warmup: int = 0
+    """A3C: frames (all workers) at the start of a run in which only the value head learns (its
+    loss alone; every other weight and the policy stay as they are). For fine-tuning a policy
+    whose critic never learned (``--init-from`` an imitation agent: the deep rgw-random DAgger
+    agent's values explain 1-4 % of its returns' variance), whose first advantages are noise"""
     dagger_beta_frames: int = 200_000
     """imitate: frames over which the chance of following the planner falls from 1 to 0"""
     dagger_buffer: int = 204_800
@@ -369,6 +374,12 @@ class TrainConfig:
             raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
         if not 0 <= self.gae_lambda <= 1:
             raise ConfigError(f"gae_lambda must be in [0, 1], got {self.gae_lambda}")
+        if self.critic_warmup < 0:
+            raise ConfigError(f"critic_warmup must be >= 0 frames, got {self.critic_warmup}")
+        if self.critic_warmup and self.algo != "a3c":
+            raise ConfigError(
+                f"--critic-warmup is an A3C setting; --algo {self.algo} does not use it"
+            )
         if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
             raise ConfigError("entropy, value_coef, explore and sil must be >= 0")
         if self.dagger_beta_frames < 0:

@@ -616,7 +616,7 @@ def train(
                 if train_config.algo == "ppo"
                 else (device, frames0)
                 if train_config.algo == "imitate"
-                else ()
+                else (frames0,)
             )
             proc = ctx.Process(
                 target=learner, args=args, daemon=True, name=f"neurosym-{train_config.algo}-{rank}"
