@@ -7,9 +7,10 @@ kernel (``munmap``, or trimming the heap's top), so the next allocation of the
 same size touches fresh pages, and every 4 KB page costs a page fault. On the
 virtual machines this project runs on, a fault is expensive: measured on the
 2-core development VM, one rgw2 update batch (1,352 observations, PrediNet)
-took 141 ms with 26 k page faults (38 ms of it in the kernel) and 105 ms with
-318 faults once freed memory was kept; a bw1 batch of 368, 69 ms and 58 ms
-(``python bench/allocator.py``). The PyTorch CPU performance guides recommend
+took 145 ms with 23 k page faults (36 ms of it in the kernel) and 107 ms with
+none once freed memory was kept; MHDPA's 717 ms with 79 k faults, 621 ms
+(``python bench/allocator.py``). Small batches gain little (a bw1 PrediNet
+batch of 368 faulted little either way). The PyTorch CPU performance guides recommend
 jemalloc or tcmalloc for the same reason; glibc's own ``mallopt`` switches
 give the same effect here with nothing to install.
 
