@@ -341,7 +341,8 @@ class TrainConfig:
     """A3C: frames (all workers) at the start of a run in which only the value head learns (its
     loss alone; every other weight and the policy stay as they are). For fine-tuning a policy
     whose critic never learned (``--init-from`` an imitation agent: the deep rgw-random DAgger
-    agent's values explain 1-4 % of its returns' variance), whose first advantages are noise"""
+    agent's values explain 1-4 % of its returns' variance, bench/critic_fit.py), whose first
+    advantages are noise"""
     dagger_beta_frames: int = 200_000
     """imitate: frames over which the chance of following the planner falls from 1 to 0"""
     dagger_buffer: int = 204_800
