@@ -358,3 +358,63 @@ def test_critic_warmup_update_moves_the_value_head_alone() -> None:
     assert shared(obs[0])[1].mean().item() > v_before  # towards the return of 5
     untouched = [p for n, p in shared.named_parameters() if not n.startswith("value.")]
     assert all(float(opt.state[p]["exp_avg"].abs().max()) == 0 for p in untouched)
+
+
+def test_optimal_set_nll_is_minus_log_of_the_sets_probability() -> None:
+    from neurosym.agent.planner_loss import optimal_set_nll
+
+    logits = torch.tensor([[1.0, 2.0, 3.0, 4.0], [0.0, 0.0, 0.0, 0.0], [5.0, -1.0, 0.0, 2.0]])
+    optimal = torch.tensor(
+        [[False, True, False, True], [True, False, False, False], [False, False, False, False]]
+    )
+    p = torch.softmax(logits, -1)
+    expected = [-torch.log(p[0, 1] + p[0, 3]).item(), -np.log(0.25), 0.0]  # empty set: 0
+    torch.testing.assert_close(optimal_set_nll(logits, optimal), torch.tensor(expected).float())
+
+
+def test_planner_coef_adds_the_masked_planner_loss() -> None:
+    from neurosym.agent.planner_loss import optimal_set_nll
+
+    torch.manual_seed(0)
+    model = Lookup()
+    ro = rollout_of(
+        ids=[[1, 2], [3, 4], [5, 6]],
+        rewards=[[0.0, 1.0], [0.0, 0.0], [1.0, 0.0]],
+        terminated=[[False, True], [False, False], [True, False]],
+        truncated=[[False, False], [False, False], [False, False]],
+        valid=[[True, True], [True, False], [True, True]],  # env 1's step 1 is an autoreset
+        last_ids=[7, 8],
+    )
+    optimal = torch.zeros(3, 2, 4, dtype=torch.bool)
+    optimal[..., 1] = True
+    optimal[0, 0, 2] = True
+    base, stats = a3c_loss(model, ro, TrainConfig())
+    with pytest.raises(ValueError, match="planner's labels"):
+        a3c_loss(model, ro, TrainConfig(planner_coef=0.5))
+    ro = ro._replace(optimal=optimal)
+    with_planner, same = a3c_loss(model, ro, TrainConfig(planner_coef=0.5))
+    assert same == stats
+    logits = model.logits[ro.obs.view(3, 2).long()]
+    nll = optimal_set_nll(logits, optimal) * ro.valid
+    torch.testing.assert_close(with_planner, base + 0.5 * nll.sum() / 2)
+    warm, _ = a3c_loss(model, ro, TrainConfig(planner_coef=0.5), critic_only=True)
+    assert warm.item() == pytest.approx(0.5 * stats.value_loss)  # the warm-up has no planner term
+
+
+def test_rollout_keeps_the_planners_optimal_actions() -> None:
+    from neurosym.agent.a3c import planner_labels
+    from neurosym.agent.rollout import RolloutState, collect_rollout
+    from neurosym.envs import make_batched
+    from neurosym.envs.rgw_solver import Planner
+
+    torch.manual_seed(0)
+    model = ActorCritic(ModelConfig.for_family("rgw", "predinet", (9, 10, 10)))
+    venv = make_batched("rgw-random", 3, seed=5)
+    state = RolloutState(venv, seed=5)
+    asked = Planner().action_sets(venv)[0]
+    ro, _ = collect_rollout(model, state, 6, torch.Generator().manual_seed(0), labels=planner_labels())
+    assert ro.optimal.shape == (6, 3, 4) and ro.optimal.dtype == torch.bool
+    assert np.array_equal(ro.optimal[0].numpy(), asked)  # asked before the step, in that state
+    assert bool(ro.optimal[ro.valid].any(-1).all())  # every real state has an optimal action
+    loss, _ = a3c_loss(model, ro, TrainConfig(planner_coef=1.0))
+    loss.backward()

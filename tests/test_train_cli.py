@@ -199,6 +199,39 @@ def test_train_critic_warmup_moves_the_value_head_alone(neurosym, tmp_path: Path
 
 
 @pytest.mark.expensive
+def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
+    neurosym, tmp_path: Path
+) -> None:
+    """The same A3C fine-tune of the DAgger agent at a high learning rate, without and with the
+    planner's loss beside it: with it, the policy's probability on the planner's optimal actions,
+    on the start states of levels neither run played, ends higher."""
+    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.envs import make_batched
+    from neurosym.envs.rgw_solver import Planner
+
+    source = ROOT / "checkpoints" / "rgw-random-predinet.pt"
+    nll = {}
+    venv = make_batched("rgw-random", 64, seed=3_000_000_000)
+    obs, _ = venv.reset(seed=3_000_000_000)
+    optimal = torch.from_numpy(Planner().action_sets(venv)[0])
+    for coef in ("0", "5"):
+        out = tmp_path / f"run-{coef}"
+        proc = neurosym(
+            "train", "--env", "rgw-random", "--init-from", str(source), "--out", str(out),
+            "--workers", "2", "--frames", "4000", "--lr", "1e-3", "--entropy", "0", "--value-coef", "0",
+            "--planner-coef", coef, "--slim", *TINY,
+        )  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        agent = load_agent(out / "checkpoint.pt")
+        assert agent.meta["train_config"]["planner_coef"] == float(coef)
+        assert f"--planner-coef {coef}" in agent.meta["command"]
+        with torch.no_grad():
+            logits = agent.model(torch.from_numpy(obs))[0]
+        nll[coef] = optimal_set_nll(logits, optimal).mean().item()
+    assert nll["5"] < nll["0"] - 0.05, nll
+
+
+@pytest.mark.expensive
 def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
@@ -330,6 +363,19 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
         (
             ("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--critic-warmup", "100"),
             "--critic-warmup is an A3C setting; --algo ppo does not use it",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--planner-coef", "1"),
+            "--planner-coef learns from the RGW planner; boxworld has none",
+        ),
+        (
+            ("--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
+             "--planner-coef", "1"),
+            "--planner-coef is an A3C setting; --algo imitate does not use it",
+        ),  # fmt: skip
+        (
+            ("--env", "rgw2", "--module", "predinet", "--planner-coef", "-1"),
+            "planner_coef must be >= 0, got -1.0",
         ),
         (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),

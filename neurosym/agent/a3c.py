@@ -28,6 +28,9 @@ A3C: A_t = G_t - V(o_t) with G_t the bootstrapped n-step return.
 Truncated episodes (time limit) bootstrap from V of their final observation.
 With ``config.sil > 0`` the self-imitation loss (:mod:`neurosym.agent.sil`)
 on a batch of M remembered transitions is added, scaled to T transitions.
+With ``config.planner_coef = c > 0`` (RGW), ``c * sum -log pi(optimal set|o_t)``
+over the rollout's valid transitions is added (per env, like the rest): the
+env planner's optimal actions in each visited state, as DAgger labels them.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from neurosym.agent.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
+from neurosym.agent.planner_loss import optimal_set_nll
 from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 from neurosym.agent.sil import EpisodeMemory, SILBatch, sil_loss
 
@@ -274,6 +278,11 @@ def a3c_loss(
         loss = config.value_coef * value_loss
     else:
         loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
+    if config.planner_coef > 0 and not critic_only:
+        if rollout.optimal is None:
+            raise ValueError("planner_coef > 0 needs a rollout collected with the planner's labels")
+        nll = optimal_set_nll(logits, rollout.optimal)  # (T, K)
+        loss = loss + config.planner_coef * (nll * mask).sum() / K
     if sil_batch is not None and not critic_only:
         M = sil_batch.actions.shape[0]
         scaled = sil_batch._replace(returns=sil_batch.returns * config.reward_scale)
@@ -358,6 +367,15 @@ def learner_process(
                 cleanup()
 
 
+def planner_labels() -> Callable[[Any], Any]:
+    """``venv -> (K, 4) bool``: the RGW planner's optimal actions in each sub-env's state
+    (plans cached per level, as DAgger's)."""
+    from neurosym.envs.rgw_solver import Planner
+
+    planner = Planner()
+    return lambda venv: planner.action_sets(venv)[0]
+
+
 def worker(
     rank: int,
     shared: ActorCritic,
@@ -401,6 +419,7 @@ def worker(
         # rollout by 45 % (one worker), at K = 8 it was 4 % ahead (W = 2), at
         # K <= 4 it lost (K = 1: 456 against 676 frames/s, one worker)
         keep_graph = model_config.module == "mhdpa" and train_config.envs >= 8
+        labels = planner_labels() if train_config.planner_coef > 0 else None
         scale = AdvantageScale()
         warmup = -(-max(0, train_config.critic_warmup - frames0) // train_config.workers)
         frames = 0
@@ -408,7 +427,8 @@ def worker(
         while not stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
             rollout, finished = collect_rollout(
-                local, state, train_config.n_steps, generator, bonus, memory, keep_graph
+                local, state, train_config.n_steps, generator, bonus, memory, keep_graph,
+                labels=labels,
             )
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
             warming = frames < warmup

@@ -42,6 +42,7 @@ _OVERRIDES = (
     ("--ppo-minibatches", "ppo_minibatches", "train"),
     ("--clip-range", "clip_range", "train"),
     ("--critic-warmup", "critic_warmup", "train"),
+    ("--planner-coef", "planner_coef", "train"),
     ("--dagger-beta-frames", "dagger_beta_frames", "train"),
     ("--dagger-steps", "dagger_steps", "train"),
     ("--attention-gain", "attention_gain", "model"),
@@ -157,6 +158,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         type=int,
         metavar="FRAMES",
         help="A3C: first frames of the run in which only the value head learns (0: none)",
+    )
+    a3c.add_argument(
+        "--planner-coef",
+        type=float,
+        metavar="C",
+        help="A3C on RGW: weight of the planner's imitation loss beside A3C's (0: none)",
     )
     a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
     a3c.add_argument("--gamma", type=float, help="discount")

@@ -343,6 +343,12 @@ class TrainConfig:
     whose critic never learned (``--init-from`` an imitation agent: the deep rgw-random DAgger
     agent's values explain 1-4 % of its returns' variance, bench/critic_fit.py), whose first
     advantages are noise"""
+    planner_coef: float = 0.0
+    """A3C on RGW: weight of the planner's imitation loss (``-log`` of the probability the policy
+    gives the env planner's optimal actions, on every state the rollout visits) beside the
+    actor-critic loss; 0 = none. Kickstarting (Schmitt et al. 2018) with the exact planner as
+    teacher: A3C fine-tuning of a DAgger agent finished more levels but lost the undiscounted
+    optimum (decoy enemy's +1 left, shortcuts), which the planner's labels keep asking for"""
     dagger_beta_frames: int = 200_000
     """imitate: frames over which the chance of following the planner falls from 1 to 0"""
     dagger_buffer: int = 204_800
@@ -380,6 +386,13 @@ class TrainConfig:
         if self.critic_warmup and self.algo != "a3c":
             raise ConfigError(
                 f"--critic-warmup is an A3C setting; --algo {self.algo} does not use it"
+            )
+        if self.planner_coef < 0:
+            raise ConfigError(f"planner_coef must be >= 0, got {self.planner_coef}")
+        if self.planner_coef and self.algo != "a3c":
+            raise ConfigError(
+                f"--planner-coef is an A3C setting; --algo {self.algo} does not use it"
+                + (" (DAgger learns from the planner alone)" if self.algo == "imitate" else "")
             )
         if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
             raise ConfigError("entropy, value_coef, explore and sil must be >= 0")

@@ -34,6 +34,7 @@ from neurosym.agent import distributed
 from neurosym.agent.a3c import LossStats, learner_process, report_update
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.model import ActorCritic
+from neurosym.agent.planner_loss import optimal_set_nll
 from neurosym.agent.ppo import copy_into_shared, private_copy
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
@@ -69,8 +70,7 @@ class LabelBuffer:
 
 def imitation_loss(logits: torch.Tensor, optimal: torch.Tensor) -> torch.Tensor:
     """Mean of ``-log sum_{a in optimal} softmax(logits)_a`` over the batch; (B, A) and (B, A) bool."""
-    picked = torch.logsumexp(logits.masked_fill(~optimal, float("-inf")), dim=-1)
-    return (torch.logsumexp(logits, dim=-1) - picked).mean()
+    return optimal_set_nll(logits, optimal).mean()
 
 
 def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:

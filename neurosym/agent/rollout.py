@@ -115,6 +115,8 @@ class Rollout(NamedTuple):
     when only recorded (PPO's behaviour policy); None when neither (the update recomputes)"""
     values: torch.Tensor | None = None
     """(T, K) the acting values, likewise"""
+    optimal: torch.Tensor | None = None
+    """(T, K, A) bool: the planner's optimal actions in each observation, when ``labels`` was given"""
 
 
 class RolloutState:
@@ -137,6 +139,7 @@ def collect_rollout(
     keep_graph: bool = False,
     record: bool = False,
     device: torch.device | None = None,
+    labels: Callable[[Any], np.ndarray] | None = None,
 ) -> tuple[Rollout, Finished]:
     """Act ``n_steps`` steps in every sub-env with sampled actions.
 
@@ -154,12 +157,17 @@ def collect_rollout(
     ``device``: where the model lives (observations go there, actions are
     drawn on the CPU so that the generator's stream is the same on any device);
     the recorded logits and values stay there, the rest of the rollout is on the CPU.
+    ``labels(venv) -> (K, A) bool``: the optimal actions in the current state
+    of every sub-env (a planner's), asked before each step and kept in the
+    rollout's ``optimal``.
     """
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
-    logits_t, values_t = [], []
+    logits_t, values_t, optimal_t = [], [], []
     finished = Finished.empty()
     for _ in range(n_steps):
+        if labels is not None:
+            optimal_t.append(labels(venv))
         with torch.set_grad_enabled(keep_graph):
             obs_in = torch.from_numpy(state.obs)
             logits, value = model(obs_in if device is None else obs_in.to(device))  # (K, A), (K,)
@@ -192,6 +200,7 @@ def collect_rollout(
         valid=torch.from_numpy(np.stack(valids)),
         logits=torch.stack(logits_t) if logits_t else None,
         values=torch.stack(values_t) if values_t else None,
+        optimal=torch.from_numpy(np.stack(optimal_t)) if optimal_t else None,
     )
     return rollout, finished
 

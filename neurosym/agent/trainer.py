@@ -503,6 +503,10 @@ def train(
             )
         frames0 = episodes0 = 0
         wall0 = 0.0
+    if train_config.planner_coef and family != "rgw":
+        raise ConfigError(
+            f"--planner-coef learns from the RGW planner; {family} has none (use --planner-coef 0)"
+        )
     if world.distributed and train_config.algo != "ppo":
         raise ConfigError(
             "torchrun trains the synchronous learner: pass --algo ppo "
