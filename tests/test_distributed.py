@@ -122,7 +122,11 @@ def _ddp_update(rank: int, world: int, port: int, data: str, out: str) -> None:
     k = full.actions.shape[1] // world
     mine = slice(rank * k, (rank + 1) * k)  # this rank's envs
     part = Rollout(
-        **{name: t[:, mine] for name, t in full._asdict().items() if name != "last_obs"},
+        **{
+            name: t[:, mine]
+            for name, t in full._asdict().items()
+            if name != "last_obs" and t is not None  # no planner labels here
+        },
         last_obs=full.last_obs[mine],
     )
     ddp = DistributedDataParallel(model)
