@@ -412,7 +412,9 @@ def test_rollout_keeps_the_planners_optimal_actions() -> None:
     venv = make_batched("rgw-random", 3, seed=5)
     state = RolloutState(venv, seed=5)
     asked = Planner().action_sets(venv)[0]
-    ro, _ = collect_rollout(model, state, 6, torch.Generator().manual_seed(0), labels=planner_labels())
+    ro, _ = collect_rollout(
+        model, state, 6, torch.Generator().manual_seed(0), labels=planner_labels()
+    )
     assert ro.optimal.shape == (6, 3, 4) and ro.optimal.dtype == torch.bool
     assert np.array_equal(ro.optimal[0].numpy(), asked)  # asked before the step, in that state
     assert bool(ro.optimal[ro.valid].any(-1).all())  # every real state has an optimal action

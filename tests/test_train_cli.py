@@ -202,14 +202,15 @@ def test_train_critic_warmup_moves_the_value_head_alone(neurosym, tmp_path: Path
 def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
     neurosym, tmp_path: Path
 ) -> None:
-    """The same A3C fine-tune of the DAgger agent at a high learning rate, without and with the
-    planner's loss beside it: with it, the policy's probability on the planner's optimal actions,
-    on the start states of levels neither run played, ends higher."""
+    """The same A3C fine-tune of a DAgger agent (the deep-encoder one: DAgger alone, no A3C yet),
+    with the README's fine-tuning settings but a 10x learning rate, without and with the planner's
+    loss beside it: A3C alone throws the planner's actions away within a few updates; with the
+    planner's loss the policy keeps them (nll on the start states of levels neither run played)."""
     from neurosym.agent.planner_loss import optimal_set_nll
     from neurosym.envs import make_batched
     from neurosym.envs.rgw_solver import Planner
 
-    source = ROOT / "checkpoints" / "rgw-random-predinet.pt"
+    source = ROOT / "checkpoints" / "rgw-random-predinet-deep.pt"
     nll = {}
     venv = make_batched("rgw-random", 64, seed=3_000_000_000)
     obs, _ = venv.reset(seed=3_000_000_000)
@@ -219,6 +220,8 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
         proc = neurosym(
             "train", "--env", "rgw-random", "--init-from", str(source), "--out", str(out),
             "--workers", "2", "--frames", "4000", "--lr", "1e-3", "--entropy", "0", "--value-coef", "0",
+            "--optimizer", "adam", "--sil", "0", "--explore", "0", "--reward-scale", "0.1",
+            "--normalize-advantages", "--grad-clip", "0.5",
             "--planner-coef", coef, "--slim", *TINY,
         )  # fmt: skip
         assert proc.returncode == 0, proc.stderr
@@ -228,7 +231,7 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
         with torch.no_grad():
             logits = agent.model(torch.from_numpy(obs))[0]
         nll[coef] = optimal_set_nll(logits, optimal).mean().item()
-    assert nll["5"] < nll["0"] - 0.05, nll
+    assert nll["5"] < nll["0"] - 1.0, nll  # measured: 0.39-0.80 against 4.7-7.6 nats
 
 
 @pytest.mark.expensive
@@ -369,8 +372,16 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
             "--planner-coef learns from the RGW planner; boxworld has none",
         ),
         (
-            ("--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
-             "--planner-coef", "1"),
+            (
+                "--env",
+                "rgw-random",
+                "--module",
+                "predinet",
+                "--algo",
+                "imitate",
+                "--planner-coef",
+                "1",
+            ),
             "--planner-coef is an A3C setting; --algo imitate does not use it",
         ),  # fmt: skip
         (

@@ -427,7 +427,13 @@ def worker(
         while not stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
             rollout, finished = collect_rollout(
-                local, state, train_config.n_steps, generator, bonus, memory, keep_graph,
+                local,
+                state,
+                train_config.n_steps,
+                generator,
+                bonus,
+                memory,
+                keep_graph,
                 labels=labels,
             )
             batch = memory.sample(train_config.n_steps, generator) if memory is not None else None
