@@ -383,7 +383,7 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
                 "1",
             ),
             "--planner-coef is an A3C setting; --algo imitate does not use it",
-        ),  # fmt: skip
+        ),
         (
             ("--env", "rgw2", "--module", "predinet", "--planner-coef", "-1"),
             "planner_coef must be >= 0, got -1.0",
