@@ -321,6 +321,22 @@ def test_kept_graph_gives_the_recomputed_loss() -> None:
     kept.backward()
 
 
+def test_recorded_queries_give_the_recomputed_loss() -> None:
+    """A PrediNet rollout carries acting's queries; the update's loss is the same without them."""
+    from neurosym.agent.rollout import RolloutState, collect_rollout
+    from neurosym.envs import make_batched
+
+    torch.manual_seed(0)
+    model = ActorCritic(ModelConfig.for_family("rgw", "predinet", (9, 10, 10)))
+    state = RolloutState(make_batched("rgw2", 3, seed=0), seed=0)
+    ro, _ = collect_rollout(model, state, 4, torch.Generator().manual_seed(0))
+    assert ro.queries is not None and [q.shape for q in ro.queries.parts] == [(3, 256)] * 4
+    reused, _ = a3c_loss(model, ro, TrainConfig())
+    recomputed, _ = a3c_loss(model, ro._replace(queries=None), TrainConfig())
+    torch.testing.assert_close(reused, recomputed, rtol=1e-5, atol=1e-6)
+    reused.backward()
+
+
 def test_critic_warmup_update_moves_the_value_head_alone() -> None:
     """critic_only + only_prefix: the value loss, and only value.* weights (and their Adam state) move."""
     from neurosym.agent.a3c import SharedAdam

@@ -247,7 +247,9 @@ def a3c_loss(
     parts.append(rollout.last_obs)
     if sil_batch is not None:
         parts.append(sil_batch.obs)
-    logits_all, values_all = model(torch.cat(parts))  # ([T*K +] K [+ M], A), ([T*K +] K [+ M],)
+    # acting's recorded queries are the first T * K rows' (same weights, same observations)
+    reuse = {} if kept or rollout.queries is None else {"queries": rollout.queries}
+    logits_all, values_all = model(torch.cat(parts), **reuse)  # ([T*K +] K [+ M], A), (.., )
     n = 0 if kept else T * K  # rows of the rollout itself in this pass
     if kept:
         logits, values = rollout.logits, rollout.values  # (T, K, A), (T, K)

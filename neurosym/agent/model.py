@@ -11,6 +11,7 @@ policy's hidden features vary with the observation from the first update.
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import torch
@@ -20,7 +21,7 @@ from neurosym.agent.config import ModelConfig
 from neurosym.agent.encoder import Encoder
 from neurosym.agent.introspection import Introspection
 from neurosym.agent.mhdpa import MHDPA
-from neurosym.agent.predinet import PrediNet
+from neurosym.agent.predinet import PrediNet, QueryRecord
 from neurosym.errors import ConfigError
 
 
@@ -82,10 +83,21 @@ class ActorCritic(nn.Module):
                 nn.init.orthogonal_(layer.weight, gain=1.0)
                 nn.init.zeros_(layer.bias)
 
+    def recording(self) -> contextlib.AbstractContextManager[QueryRecord | None]:
+        """A block whose graph-free forwards the relational module remembers, for a later
+        ``forward(..., queries=record)`` over the same observations first (PrediNet's
+        queries; other modules record nothing and yield None)."""
+        if isinstance(self.relational, PrediNet):
+            return self.relational.recording_queries()
+        return contextlib.nullcontext()
+
     def forward(
-        self, obs: torch.Tensor, introspect: bool = False
+        self, obs: torch.Tensor, introspect: bool = False, queries: QueryRecord | None = None
     ) -> tuple[torch.Tensor, torch.Tensor] | tuple[torch.Tensor, torch.Tensor, Introspection]:
-        """obs (B, C, H, W), uint8 or float in the env's raw scale -> logits (B, 4), value (B,)[, intro]."""
+        """obs (B, C, H, W), uint8 or float in the env's raw scale -> logits (B, 4), value (B,)[, intro].
+
+        ``queries``: what :meth:`recording` kept while acting on the first rows of ``obs`` with
+        the same weights (saves computing them again; ignored when the weights changed)."""
         if obs.dim() != 4 or tuple(obs.shape[1:]) != self.config.obs_shape:
             raise ConfigError(
                 f"observation batch must have shape (B, {', '.join(map(str, self.config.obs_shape))}), "
@@ -93,7 +105,10 @@ class ActorCritic(nn.Module):
             )
         x = obs.to(torch.float32) * self.config.obs_scale  # (B, C, H, W)
         entities = self.encoder(x)  # (B, N, F)
-        features, intro = self.relational(entities, introspect)  # (B, output_size)
+        if queries is not None and isinstance(self.relational, PrediNet):
+            features, intro = self.relational(entities, introspect, queries)  # (B, output_size)
+        else:
+            features, intro = self.relational(entities, introspect)  # (B, output_size)
         h = self.body(features)  # (B, hidden[-1])
         logits = self.policy(h)  # (B, n_actions)
         value = self.value(h).squeeze(-1)  # (B,)

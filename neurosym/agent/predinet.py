@@ -41,17 +41,88 @@ With the encoder's channels-last convolutions these made a forward and
 backward over a 1352-observation update batch 25-35 % faster on one core, and
 training on rgw2 with W = 2, K = 32 went from 8.0 k to 10.7 k frames/s
 (bench/train.py's fps part).
+* The attention has a hand-written backward (:class:`PrediNetAttention`):
+  L's three gradients are one batched product and one ``addmm`` instead of
+  two small products, a strided add and a plain one.
+* A3C acts on a rollout and then runs the model over the same observations
+  with the same weights to build the update's graph: the queries acting
+  computed are kept (:meth:`PrediNet.recording_queries`) and taken back by
+  that forward, so the largest product of the forward runs once per
+  observation, not twice.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
+from typing import NamedTuple
 
 import torch
-import torch.nn.functional as nnf
 from torch import nn
 
 from neurosym.agent.introspection import PrediNetIntrospection
+
+
+class QueryRecord(NamedTuple):
+    """Queries of forwards run without a graph, and the weights they were computed with."""
+
+    key: tuple
+    parts: list[torch.Tensor]
+
+
+class PrediNetAttention(torch.autograd.Function):
+    """(L, W_Q1|W_Q2, W_K, scale[, known first rows of Q]) -> attentions a (B, 2H, N), attended
+    entities e (B, 2H, F) and the queries Q (B, 2H D; no gradient flows back through this output).
+
+    The same function as autograd's ``q = flat(L) W_Q^T; s = scale (q W_K) L^T;
+    a = softmax(s); e = a L``, with a hand-written backward: L is used three
+    times (flat(L), the scores, e), and autograd summed its three gradients
+    with two small batched products (inner size 2H) and a strided add (the
+    scores' gradient arrives transposed): a quarter of an rgw2 update's
+    backward. Here the two products are one, ``[a; g_s]^T [g_e; Q W_K]``
+    (inner size 4H), and the flat path's gradient is added by the same
+    ``addmm`` that computes it.
+    """
+
+    @staticmethod
+    def forward(ctx, L, w_q, w_k, scale, q_head=None):  # type: ignore[override]
+        B, N, F = L.shape
+        D = w_k.shape[0]
+        flat = L.reshape(B, N * F)
+        if q_head is None:
+            q = flat @ w_q.t()  # (B, 2H D)
+        else:  # the first rows' queries are known (acting computed them with these weights)
+            q = torch.cat([q_head, flat[q_head.shape[0] :] @ w_q.t()])
+        q = q.view(B, -1, D)  # (B, 2H, D)
+        qk = (q @ w_k) * scale  # (B, 2H, F)
+        a = torch.softmax(qk @ L.transpose(1, 2), dim=-1)  # (B, 2H, N)
+        e = a @ L  # (B, 2H, F)
+        ctx.save_for_backward(L, w_q, w_k, q, qk, a)
+        ctx.scale = scale
+        q_flat = q.view(B, -1)
+        ctx.mark_non_differentiable(q_flat)
+        return a, e, q_flat
+
+    @staticmethod
+    def backward(ctx, g_a, g_e, _g_q):  # type: ignore[override]
+        L, w_q, w_k, q, qk, a = ctx.saved_tensors
+        B, N, F = L.shape
+        if g_e is None:
+            g_e = torch.zeros_like(qk)
+        g_at = g_e @ L.transpose(1, 2)  # (B, 2H, N) the attention's gradient through e
+        if g_a is not None:
+            g_at = g_at + g_a
+        g_s = a * (g_at - (g_at * a).sum(-1, keepdim=True))  # softmax backward
+        g_qk = g_s @ L  # (B, 2H, F)
+        # e = a L and s = qk L^T: L's two gradients in one product
+        g_l = torch.cat([a, g_s], 1).transpose(1, 2) @ torch.cat([g_e, qk], 1)  # (B, N, F)
+        g_qk = g_qk * ctx.scale
+        g_wk = q.reshape(-1, q.shape[-1]).t() @ g_qk.reshape(-1, F)  # (D, F)
+        g_q = (g_qk @ w_k.t()).reshape(B, -1)  # (B, 2H D)
+        g_wq = g_q.t() @ L.reshape(B, N * F)  # (2H D, N F)
+        g_l = torch.addmm(g_l.reshape(B, N * F), g_q, w_q).view(B, N, F)  # + flat(L)'s gradient
+        return g_l, g_wq, g_wk, None, None
 
 
 class PrediNet(nn.Module):
@@ -79,15 +150,62 @@ class PrediNet(nn.Module):
         self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
 
-    def forward(self, L: torch.Tensor, introspect: bool = False):
+    def query_weight(self) -> torch.Tensor:
+        """(2 H D, N F): W_Q1 | W_Q2, concatenated once per weight version when no graph is built.
+
+        Acting runs 40 forwards between two weight updates; rebuilding the
+        (256, 2600) concatenation in each was a twentieth of an rgw2 worker's time.
+        """
+        w1, w2 = self.query1.weight, self.query2.weight
+        if torch.is_grad_enabled() and (w1.requires_grad or w2.requires_grad):
+            return torch.cat([w1, w2])
+        key = (w1.data_ptr(), w1._version, w2.data_ptr(), w2._version, w1.dtype, w1.device)
+        cached = getattr(self, "_query_cache", None)
+        if cached is None or cached[0] != key:
+            cached = (key, torch.cat([w1.detach(), w2.detach()]))
+            self._query_cache = cached
+        return cached[1]
+
+    def weights_key(self) -> tuple:
+        """Identifies the current W_Q and W_K values: recorded queries are valid while it holds."""
+        return tuple((w.data_ptr(), w._version) for w in (self.query1.weight, self.query2.weight))
+
+    @contextlib.contextmanager
+    def recording_queries(self) -> Iterator[QueryRecord]:
+        """Keep the queries of every forward run without a graph inside the block.
+
+        A3C acts on a rollout and then runs the model over the same observations
+        again, with the same weights, to build the update's graph; the query
+        projection (B x 2600 by 2600 x 256 on rgw2) is a tenth of a worker's time,
+        and :meth:`forward` takes the recorded queries back (``queries=``) instead
+        of computing them twice.
+        """
+        record = QueryRecord(self.weights_key(), [])
+        self._recording = record
+        try:
+            yield record
+        finally:
+            self._recording = None
+
+    def forward(
+        self, L: torch.Tensor, introspect: bool = False, queries: QueryRecord | None = None
+    ):
+        """``queries``: a record of this module's own earlier forwards over the first rows of
+        ``L``, used only while the weights are unchanged (else recomputed)."""
         B, N, F = L.shape
-        H, D = self.heads, self.key_size
-        flat = L.reshape(B, N * F)  # (B, N * F)
-        w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2 H D, N F): W_Q1 | W_Q2
-        q = nnf.linear(flat, w_q).view(B, 2 * H, D)  # Q1, Q2 of every head
-        q_in_l = (q @ self.key.weight) * self.scale  # (B, 2H, F)  Q W_K: Q K^T = (Q W_K) L^T
-        a = torch.softmax(q_in_l @ L.transpose(1, 2), dim=-1)  # (B, 2H, N)
-        e = a @ L  # (B, 2H, F)
+        H = self.heads
+        q_head = None
+        if queries is not None and queries.parts and queries.key == self.weights_key():
+            q_head = torch.cat(queries.parts) if len(queries.parts) > 1 else queries.parts[0]
+            if q_head.shape[0] > B:
+                q_head = None
+        a, e, q = PrediNetAttention.apply(
+            L, self.query_weight(), self.key.weight, self.scale, q_head
+        )
+        recording = getattr(self, "_recording", None)
+        if recording is not None and not torch.is_grad_enabled():
+            if recording.key == self.weights_key():
+                recording.parts.append(q)
         a1, a2, e1, e2 = a[:, :H], a[:, H:], e[:, :H], e[:, H:]  # (B, H, N), (B, H, F)
         rel = self.embed(e1[..., :-2] - e2[..., :-2])  # (B, H, J)  D^h
         pos1, pos2 = e1[..., -2:], e2[..., -2:]  # (B, H, 2)

@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -117,6 +118,9 @@ class Rollout(NamedTuple):
     """(T, K) the acting values, likewise"""
     optimal: torch.Tensor | None = None
     """(T, K, A) bool: the planner's optimal actions in each observation, when ``labels`` was given"""
+    queries: Any | None = None
+    """what the model kept of its acting forwards (``ActorCritic.recording``: PrediNet's
+    queries), for an update that runs the model over ``obs`` again with the same weights"""
 
 
 class RolloutState:
@@ -165,31 +169,37 @@ def collect_rollout(
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
     logits_t, values_t, optimal_t = [], [], []
     finished = Finished.empty()
-    for _ in range(n_steps):
-        if labels is not None:
-            optimal_t.append(labels(venv))
-        with torch.set_grad_enabled(keep_graph):
-            obs_in = torch.from_numpy(state.obs)
-            logits, value = model(obs_in if device is None else obs_in.to(device))  # (K, A), (K,)
-        if keep_graph or record:
-            logits_t.append(logits)
-            values_t.append(value)
-        acting = logits if device is None else logits.detach().cpu()
-        actions = select_actions(acting, greedy=False, generator=generator).numpy()
-        obs, reward, terminated, truncated, info = venv.step(actions)
-        valid, done = tracker.step(venv, reward, terminated, truncated, info)
-        finished.extend(done)
-        if memory is not None:
-            memory.step(state.obs, actions, reward, valid, terminated | truncated)
-        if bonus is not None:
-            reward = reward + bonus(obs, valid)
-        obs_t.append(state.obs)
-        actions_t.append(actions)
-        rewards.append(reward)
-        terms.append(terminated)
-        truncs.append(truncated)
-        valids.append(valid)
-        state.obs = np.ascontiguousarray(obs)
+    # no graph kept and nothing recorded: the update will run the model over these
+    # observations again, and may take back what the model remembers of acting
+    reuse = not keep_graph and not record and hasattr(model, "recording")
+    with model.recording() if reuse else contextlib.nullcontext() as queries:
+        for _ in range(n_steps):
+            if labels is not None:
+                optimal_t.append(labels(venv))
+            with torch.set_grad_enabled(keep_graph):
+                obs_in = torch.from_numpy(state.obs)
+                logits, value = model(
+                    obs_in if device is None else obs_in.to(device)
+                )  # (K, A), (K,)
+            if keep_graph or record:
+                logits_t.append(logits)
+                values_t.append(value)
+            acting = logits if device is None else logits.detach().cpu()
+            actions = select_actions(acting, greedy=False, generator=generator).numpy()
+            obs, reward, terminated, truncated, info = venv.step(actions)
+            valid, done = tracker.step(venv, reward, terminated, truncated, info)
+            finished.extend(done)
+            if memory is not None:
+                memory.step(state.obs, actions, reward, valid, terminated | truncated)
+            if bonus is not None:
+                reward = reward + bonus(obs, valid)
+            obs_t.append(state.obs)
+            actions_t.append(actions)
+            rewards.append(reward)
+            terms.append(terminated)
+            truncs.append(truncated)
+            valids.append(valid)
+            state.obs = np.ascontiguousarray(obs)
     rollout = Rollout(
         obs=torch.from_numpy(np.stack(obs_t)),
         last_obs=torch.from_numpy(state.obs),
@@ -201,6 +211,7 @@ def collect_rollout(
         logits=torch.stack(logits_t) if logits_t else None,
         values=torch.stack(values_t) if values_t else None,
         optimal=torch.from_numpy(np.stack(optimal_t)) if optimal_t else None,
+        queries=queries,
     )
     return rollout, finished
 
