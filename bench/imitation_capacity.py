@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from neurosym.agent.augment import augment_batch
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.imitation import imitation_loss, planner_choice
 from neurosym.agent.model import ActorCritic
@@ -118,7 +119,12 @@ def measure(model: Any, obs: np.ndarray, sets: np.ndarray) -> tuple[float, float
 
 
 def fit(
-    variant: str, data: dict[str, tuple[np.ndarray, np.ndarray]], steps: int, batch: int, seed: int
+    variant: str,
+    data: dict[str, tuple[np.ndarray, np.ndarray]],
+    steps: int,
+    batch: int,
+    seed: int,
+    augment: bool = False,
 ) -> dict[str, Any]:
     module, overrides = parse_variant(variant)
     train_obs, train_sets = data["train"]
@@ -129,11 +135,15 @@ def fit(
         model = ActorCritic(ModelConfig.for_family("rgw", module, train_obs.shape[1:], **overrides))
     optimizer = torch.optim.Adam(model.parameters(), lr=5e-4)
     rng = np.random.default_rng(seed)
+    generator = torch.Generator().manual_seed(seed)
     curve, t0 = [], time.perf_counter()
     for step in range(1, steps + 1):
         idx = rng.integers(0, len(train_obs), batch)
-        logits, _ = model(torch.from_numpy(train_obs[idx]))
-        loss = imitation_loss(logits, torch.from_numpy(train_sets[idx]))
+        obs, sets = torch.from_numpy(train_obs[idx]), torch.from_numpy(train_sets[idx])
+        if augment:
+            obs, sets = augment_batch(obs, sets, generator)
+        logits, _ = model(obs)
+        loss = imitation_loss(logits, sets)
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 0.5)
@@ -153,6 +163,7 @@ def fit(
     test_loss, test_hit = measure(model, *data["test"])
     return {
         "variant": variant,
+        "augment": augment,
         "parameters": model.parameter_count(),
         "steps": steps,
         "seconds": round(seconds, 1),
@@ -179,6 +190,11 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=512)
     parser.add_argument("--follow", type=float, default=0.5)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--augment",
+        action="store_true",
+        help="train on a random rotation or mirror of each batch (neurosym/agent/augment.py)",
+    )
     args = parser.parse_args()
     torch.set_num_threads(2)
     t0 = time.perf_counter()
@@ -201,7 +217,10 @@ def main() -> None:
         flush=True,
     )
     for variant in args.variants:
-        print(json.dumps(fit(variant, data, args.steps, args.batch, args.seed)), flush=True)
+        print(
+            json.dumps(fit(variant, data, args.steps, args.batch, args.seed, args.augment)),
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -109,6 +109,43 @@ def test_updates_fit_the_planners_labels() -> None:
     assert last < 0.5 * first, (first, last)
 
 
+def test_augmented_updates_fit_the_turned_levels_too() -> None:
+    """--augment: fitted on random turns and mirrors, the network also knows the levels turned;
+    fitted on the levels as they come, it knows them less well."""
+    from neurosym.agent.augment import action_permutation, transform_grid
+
+    venv = make_batched("rgw-random", 32, seed=11)
+    obs, _ = venv.reset(seed=11)
+    planner = Planner()
+    buf = LabelBuffer(256, obs.shape[1:], obs.dtype)
+    rng = np.random.default_rng(0)
+    for _ in range(8):
+        sets, values = planner.action_sets(venv)
+        buf.add(obs, sets, values)
+        obs, *_ = venv.step(rng.integers(0, 4, 32))
+    turned_obs = transform_grid(torch.from_numpy(buf.obs), 1, False).contiguous()
+    turned_sets = torch.empty(buf.optimal.shape, dtype=torch.bool)
+    turned_sets[:, list(action_permutation(1, False, 10, 10))] = torch.from_numpy(buf.optimal)
+    losses = {}
+    for augment in (False, True):
+        torch.manual_seed(0)
+        cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs.shape[1:]),
+                                     entity_norm=True, attention_gain=8.0, init="orthogonal")  # fmt: skip
+        model = ActorCritic(cfg)
+        train = TrainConfig.for_family(
+            "rgw", algo="imitate", dagger_batch=256, dagger_steps=10, augment=augment
+        )
+        opt = torch.optim.Adam(model.parameters(), lr=2e-3)
+        gen, step_rng = torch.Generator().manual_seed(0), np.random.default_rng(0)
+        for _ in range(8):
+            imitation_update(model, opt, buf, train, step_rng, torch.device("cpu"), gen)
+        with torch.no_grad():
+            losses[augment] = imitation_loss(model(turned_obs)[0], turned_sets).item()
+    assert losses[True] < 0.8 * losses[False], losses
+    with pytest.raises(ConfigError, match="--augment .* needs --algo imitate, not a3c"):
+        TrainConfig.for_family("rgw", augment=True)
+
+
 def test_imitate_needs_the_rgw_planner() -> None:
     with pytest.raises(ConfigError, match="imitate learns from the RGW planner; boxworld"):
         TrainConfig.for_family("boxworld", algo="imitate")

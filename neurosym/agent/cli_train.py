@@ -45,6 +45,7 @@ _OVERRIDES = (
     ("--planner-coef", "planner_coef", "train"),
     ("--dagger-beta-frames", "dagger_beta_frames", "train"),
     ("--dagger-steps", "dagger_steps", "train"),
+    ("--augment", "augment", "train"),
     ("--attention-gain", "attention_gain", "model"),
     ("--entity-norm", "entity_norm", "model"),
     ("--init", "init", "model"),
@@ -153,6 +154,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="imitate: frames over which following the planner falls from always to never",
     )
     a3c.add_argument("--dagger-steps", type=int, help="imitate: gradient steps per rollout")
+    a3c.add_argument(
+        "--augment",
+        action=argparse.BooleanOptionalAction,
+        help="imitate: fit each minibatch turned or mirrored at random (RGW's symmetries)",
+    )
     a3c.add_argument(
         "--critic-warmup",
         type=int,

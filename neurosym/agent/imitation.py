@@ -32,6 +32,7 @@ import torch
 
 from neurosym.agent import distributed
 from neurosym.agent.a3c import LossStats, learner_process, report_update
+from neurosym.agent.augment import augment_batch
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.planner_loss import optimal_set_nll
@@ -92,11 +93,15 @@ def imitation_update(
     config: TrainConfig,
     rng: np.random.Generator,
     device: torch.device,
+    generator: torch.Generator | None = None,
 ) -> LossStats:
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
     for _ in range(config.dagger_steps):
-        obs, optimal, values = (x.to(device) for x in buffer.sample(config.dagger_batch, rng))
+        obs, optimal, values = buffer.sample(config.dagger_batch, rng)
+        if config.augment:  # the level turned or mirrored; the return still to earn is the same
+            obs, optimal = augment_batch(obs, optimal, generator)
+        obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
         logits, value = model(obs)
         policy_loss = imitation_loss(logits, optimal)
         value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
@@ -166,7 +171,7 @@ def imitation_learner(
                 valid, done = tracker.step(venv, reward, terminated, truncated, info)
                 finished.extend(done)
                 steps += int(valid.sum())
-            stats = imitation_update(local, local_opt, buffer, train_config, rng, dev)
+            stats = imitation_update(local, local_opt, buffer, train_config, rng, dev, generator)
             copy_into_shared(local, local_opt, shared, optimizer)
             frames += steps
             report_update(queue, rank, steps, finished, stats)
