@@ -197,9 +197,7 @@ def test_predinet_attention_backward_matches_autograd() -> None:
     L = torch.randn(B, N, F, dtype=torch.float64, generator=g, requires_grad=True)
     w_q = torch.randn(2 * H * D, N * F, dtype=torch.float64, generator=g, requires_grad=True)
     w_k = torch.randn(D, F, dtype=torch.float64, generator=g, requires_grad=True)
-    assert torch.autograd.gradcheck(
-        lambda *x: PrediNetAttention.apply(*x, 0.7)[:2], (L, w_q, w_k)
-    )
+    assert torch.autograd.gradcheck(lambda *x: PrediNetAttention.apply(*x, 0.7)[:2], (L, w_q, w_k))
     # and equal to autograd's own gradients, for a loss on e alone and on a and e
     for use_a in (False, True):
         grads = []
