@@ -86,9 +86,8 @@ def test_label_buffer_keeps_the_latest_states() -> None:
     assert sorted(buf.obs[:, 0].tolist()) == [12, 13, 14, 15, 16]
 
 
-def test_updates_fit_the_planners_labels() -> None:
-    """On a fixed buffer of rgw-random states the imitation loss falls well below its start."""
-    torch.manual_seed(0)
+def labelled_buffer() -> tuple[LabelBuffer, np.random.Generator]:
+    """256 labelled states of rgw-random (8 random steps of 32 levels), and the rng that drew them."""
     venv = make_batched("rgw-random", 32, seed=11)
     obs, _ = venv.reset(seed=11)
     planner = Planner()
@@ -98,9 +97,21 @@ def test_updates_fit_the_planners_labels() -> None:
         sets, values = planner.action_sets(venv)
         buf.add(obs, sets, values)
         obs, *_ = venv.step(rng.integers(0, 4, 32))
-    cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs.shape[1:]),
+    return buf, rng
+
+
+def seeing_predinet(obs_shape: tuple[int, ...]) -> ActorCritic:
+    """The PrediNet that DAgger trains (LayerNorm on entities, attention gain 8, orthogonal init)."""
+    cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs_shape),
                                  entity_norm=True, attention_gain=8.0, init="orthogonal")  # fmt: skip
-    model = ActorCritic(cfg)
+    return ActorCritic(cfg)
+
+
+def test_updates_fit_the_planners_labels() -> None:
+    """On a fixed buffer of rgw-random states the imitation loss falls well below its start."""
+    torch.manual_seed(0)
+    buf, rng = labelled_buffer()
+    model = seeing_predinet(buf.obs.shape[1:])
     train = TrainConfig.for_family("rgw", algo="imitate", dagger_batch=256, dagger_steps=10)
     opt = torch.optim.Adam(model.parameters(), lr=2e-3)
     first = imitation_update(model, opt, buf, train, rng, torch.device("cpu")).policy_loss
@@ -114,24 +125,14 @@ def test_augmented_updates_fit_the_turned_levels_too() -> None:
     fitted on the levels as they come, it knows them less well."""
     from neurosym.agent.augment import action_permutation, transform_grid
 
-    venv = make_batched("rgw-random", 32, seed=11)
-    obs, _ = venv.reset(seed=11)
-    planner = Planner()
-    buf = LabelBuffer(256, obs.shape[1:], obs.dtype)
-    rng = np.random.default_rng(0)
-    for _ in range(8):
-        sets, values = planner.action_sets(venv)
-        buf.add(obs, sets, values)
-        obs, *_ = venv.step(rng.integers(0, 4, 32))
+    buf, _ = labelled_buffer()
     turned_obs = transform_grid(torch.from_numpy(buf.obs), 1, False).contiguous()
     turned_sets = torch.empty(buf.optimal.shape, dtype=torch.bool)
     turned_sets[:, list(action_permutation(1, False, 10, 10))] = torch.from_numpy(buf.optimal)
     losses = {}
     for augment in (False, True):
         torch.manual_seed(0)
-        cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs.shape[1:]),
-                                     entity_norm=True, attention_gain=8.0, init="orthogonal")  # fmt: skip
-        model = ActorCritic(cfg)
+        model = seeing_predinet(buf.obs.shape[1:])
         train = TrainConfig.for_family(
             "rgw", algo="imitate", dagger_batch=256, dagger_steps=10, augment=augment
         )

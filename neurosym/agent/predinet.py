@@ -150,24 +150,10 @@ class PrediNet(nn.Module):
         self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
 
-    def query_weight(self) -> torch.Tensor:
-        """(2 H D, N F): W_Q1 | W_Q2, concatenated once per weight version when no graph is built.
-
-        Acting runs 40 forwards between two weight updates; rebuilding the
-        (256, 2600) concatenation in each was a twentieth of an rgw2 worker's time.
-        """
-        w1, w2 = self.query1.weight, self.query2.weight
-        if torch.is_grad_enabled() and (w1.requires_grad or w2.requires_grad):
-            return torch.cat([w1, w2])
-        key = (w1.data_ptr(), w1._version, w2.data_ptr(), w2._version, w1.dtype, w1.device)
-        cached = getattr(self, "_query_cache", None)
-        if cached is None or cached[0] != key:
-            cached = (key, torch.cat([w1.detach(), w2.detach()]))
-            self._query_cache = cached
-        return cached[1]
-
     def weights_key(self) -> tuple:
-        """Identifies the current W_Q and W_K values: recorded queries are valid while it holds."""
+        """Identifies the current W_Q values. A recorded query also depends on its entities, so
+        a record is valid only for the same observations through the same encoder, which the
+        caller guarantees (A3C: one weight load per rollout, no step until its update)."""
         return tuple((w.data_ptr(), w._version) for w in (self.query1.weight, self.query2.weight))
 
     @contextlib.contextmanager
@@ -200,7 +186,11 @@ class PrediNet(nn.Module):
             if q_head.shape[0] > B:
                 q_head = None
         a, e, q = PrediNetAttention.apply(
-            L, self.query_weight(), self.key.weight, self.scale, q_head
+            L,
+            torch.cat([self.query1.weight, self.query2.weight]),
+            self.key.weight,
+            self.scale,
+            q_head,
         )
         recording = getattr(self, "_recording", None)
         if recording is not None and not torch.is_grad_enabled():
