@@ -61,6 +61,47 @@ def test_shares_and_pairs_of_a_fixture() -> None:
     ]
 
 
+def test_next_object_follows_the_agents_next_event() -> None:
+    rows = [
+        (0, 0, 0, SWORD, ENEMY),  # next: sword (picked at step 1) -> on it
+        (0, 1, 0, SWORD, ENEMY),  # step 1's own event is still ahead of state 1 -> on it
+        (0, 2, 0, AGENT, TERM),  # next: terminal -> on it
+        (0, 3, 0, AGENT, AGENT),  # next: terminal -> not on it
+        (1, 0, 0, AGENT, WALL),  # episode 1 meets only terrain: left out
+        (0, 0, 1, PIT_1, PIT_2),
+        (0, 1, 1, PIT_1, PIT_1),
+        (0, 2, 1, ENEMY, SWORD),  # next: terminal -> not on it
+        (0, 3, 1, TERM, AGENT),  # argument 1 on the next object counts too
+        (1, 0, 1, AGENT, EMPTY),
+    ]
+    rec = attends(rows)
+    rec.events = pd.DataFrame(
+        [(0, 1, "picked(sword)"), (0, 3, "reached(terminal)"), (1, 0, "crossed(mountain)")],
+        columns=["episode", "t", "event"],
+    )
+    h0, h1 = head_summary(rec).to_dict("records")
+    assert h0["next_object"] == pytest.approx(3 / 4)
+    assert h1["next_object"] == pytest.approx(1 / 4)
+    # a recording without events (or that never meets an object): None, not 0
+    assert head_summary(attends(rows))["next_object"].tolist() == [None, None]
+
+
+def test_event_objects_of_both_families() -> None:
+    from neurosym.export.heads import event_object
+
+    assert [event_object(e) for e in ("picked(sword)", "defeated(enemy)", "teleported")] == [
+        "sword",
+        "enemy",
+        "teleport",
+    ]
+    assert [event_object(e) for e in ("got(key(red))", "opened(lock(red))", "got(gem)")] == [
+        "key(red)",
+        "lock(red)",
+        "gem",
+    ]
+    assert event_object("crossed(mountain)") is None and event_object("done") is None
+
+
 def test_an_mhdpa_recording_has_no_argument_pairs() -> None:
     rec = SimpleNamespace(attends=pd.DataFrame(columns=["episode", "t", "head", "arg"]))
     df = head_summary(rec)
@@ -87,4 +128,4 @@ def test_on_a_recording_and_in_the_extract_report(
     written = write_outputs(tmp_path / "out", rec, facts, ("pl",))
     print_report(rec, facts, written, kb=written.get("kb.pl"))
     text = capsys.readouterr().out
-    assert "two objects" in text and "top pairs (share of states)" in text
+    assert "two objects" in text and "next object" in text and "top pairs (share of states)" in text

@@ -14,6 +14,17 @@ is where relations show. :func:`head_summary` measures it from a recording's
   states that pair takes (so the shares add up to at most ``two_objects``);
   None where the head relates fewer pairs. Equal counts are ordered by name.
 
+* ``next_object``: whether the head looks where the agent is going. Of the
+  head's states from which the agent still meets an object later in its
+  episode (the first event naming one at or after that step: ``picked(sword)``,
+  ``defeated(enemy)``, ``reached(terminal)``, ``teleported``, ``got(key(red))``,
+  ``opened(lock(red))``, ...), the share in which one of its two arguments is
+  an object of that type (events never name the agent). None where no state has an object
+  ahead (a recording without events, or episodes that met nothing). A head that
+  relates the agent to the sword until the sword is taken and then to the
+  enemy scores near 1; one fixed on the sword scores only the states before
+  it is taken.
+
 ``neurosym extract`` prints this table; the function returns it as a DataFrame
 (``df.to_dict("records")`` gives JSON-ready rows).
 """
@@ -27,6 +38,37 @@ import pandas as pd
 BACKGROUND = ("empty", "wall", "mountain")
 """entities that are terrain, not objects (DESIGN.md: walls and mountains have no at/5)"""
 
+EVENT_OBJECTS = {"teleported": "teleport"}
+"""events without an argument that still name the object met (RGW's teleport)"""
+
+
+def event_object(event: str) -> str | None:
+    """The object type an event names: ``picked(sword)`` -> ``sword``, ``got(key(red))`` -> ``key(red)``.
+
+    None for terrain (``crossed(mountain)``) and for events that name no object.
+    """
+    if event in EVENT_OBJECTS:
+        return EVENT_OBJECTS[event]
+    start = event.find("(")
+    if start < 0 or not event.endswith(")"):
+        return None
+    inner = event[start + 1 : -1]
+    return None if inner in BACKGROUND or "," in inner else inner
+
+
+def next_objects(rec: Any) -> pd.DataFrame:
+    """Per state (episode, t): the object type of the first object event at or after step t.
+
+    Events of ``steps`` row t belong to the transition out of state t, so the
+    object taken at step t is still ahead in state t. States with none ahead
+    are left out.
+    """
+    events = getattr(rec, "events", None)
+    if events is None or events.empty:
+        return pd.DataFrame(columns=["episode", "t", "next"])
+    ev = events.assign(next=events["event"].astype(str).map(event_object)).dropna(subset=["next"])
+    return ev[["episode", "t", "next"]].sort_values(["episode", "t"], kind="stable")
+
 
 def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
     """One row per PrediNet head: states, two_objects, pair_1, share_1, ..., pair_top, share_top.
@@ -35,7 +77,7 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
     with its ``attends`` table). An MHDPA recording has no argument pairs:
     the table is empty.
     """
-    columns = ["head", "states", "two_objects"]
+    columns = ["head", "states", "two_objects", "next_object"]
     for k in range(1, top + 1):
         columns += [f"pair_{k}", f"share_{k}"]
     att = rec.attends
@@ -52,11 +94,16 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
         & ((both["row_1"] != both["row_2"]) | (both["col_1"] != both["col_2"]))
     )
     both["pair"] = both["entity_1"].astype(str) + "-" + both["entity_2"].astype(str)
+    both["next"] = _next_at(both, next_objects(rec))
+    ahead = both["next"].notna()
+    on_next = ahead & ((both["entity_1"] == both["next"]) | (both["entity_2"] == both["next"]))
     rows = []
     for head, group in both.groupby("head", sort=True):
         mask = objects.loc[group.index]
         n = len(group)
         row: dict[str, Any] = {"head": int(head), "states": n, "two_objects": float(mask.mean())}
+        n_ahead = int(ahead.loc[group.index].sum())
+        row["next_object"] = float(on_next.loc[group.index].sum() / n_ahead) if n_ahead else None
         counts = group.loc[mask, "pair"].value_counts()
         counts = counts.sort_index().sort_values(ascending=False, kind="stable")  # ties: by name
         for k in range(1, top + 1):
@@ -66,7 +113,18 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
                 row[f"pair_{k}"], row[f"share_{k}"] = None, None
         rows.append(row)
     df = pd.DataFrame(rows, columns=columns)
-    for k in range(1, top + 1):  # None where a head has fewer pairs (not NaN: JSON-ready)
-        for name in (f"pair_{k}", f"share_{k}"):
-            df[name] = pd.Series([r[name] for r in rows], dtype=object)
+    names = ["next_object"] + [f"{c}_{k}" for k in range(1, top + 1) for c in ("pair", "share")]
+    for name in names:  # None where a head has fewer pairs or nothing ahead (not NaN: JSON-ready)
+        df[name] = pd.Series([r[name] for r in rows], dtype=object)
     return df
+
+
+def _next_at(states: pd.DataFrame, ahead: pd.DataFrame) -> pd.Series:
+    """For each row of ``states`` (episode, t): the next object type at or after t, else None."""
+    if ahead.empty:
+        return pd.Series([None] * len(states), index=states.index, dtype=object)
+    left = states[["episode", "t"]].astype("int64").reset_index().sort_values("t", kind="stable")
+    right = ahead.astype({"episode": "int64", "t": "int64"}).sort_values("t", kind="stable")
+    found = pd.merge_asof(left, right, on="t", by="episode", direction="forward")
+    out = found.set_index("index")["next"].reindex(states.index)
+    return out.astype(object).where(out.notna(), None)

@@ -105,7 +105,7 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
         title="heads: two arguments on two different objects",
         show_edge=False,
     )
-    for col in ("head", "states", "two objects", "top pairs (share of states)"):
+    for col in ("head", "states", "two objects", "next object", "top pairs (share of states)"):
         table.add_column(col, justify="left" if col.startswith("top") else "right")
     for row in heads.to_dict("records"):
         pairs = [
@@ -117,6 +117,7 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
             str(row["head"]),
             str(row["states"]),
             f"{100 * row['two_objects']:.0f} %",
+            "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
             escape(", ".join(pairs) or "none"),
         )
     say(table)
