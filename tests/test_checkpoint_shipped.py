@@ -21,11 +21,12 @@ ROUTES = {
 OPTIMAL = {"rgw1": 11.0, "rgw2": 10.7}
 
 
-def play(path: Path, route: list[str]) -> tuple[float, list[str], int]:
+def play(path: Path, route: list[str], env_name: str | None = None) -> tuple[float, list[str], int]:
+    """Greedy play of one episode (reset seed 0) on the agent's own env, or on ENV_NAME."""
     from neurosym.envs import make
 
     agent = load_agent(path)
-    env = make(agent.env_name, **agent.env_kwargs)
+    env = make(env_name) if env_name else make(agent.env_name, **agent.env_kwargs)
     obs, info = env.reset(seed=0)
     total, events = 0.0, []
     for t in range(1000):
@@ -66,7 +67,8 @@ UNSEEN = 3_000_000_000
 # bw2-mhdpa: 97.7 %, 75.3 %; bw3-mhdpa: 100 %, 85.7 %;
 # rgw-random-predinet (DAgger with --augment, 30-minute snapshot): 87.3 %, 52.0 % (on these 100: 82 %, 44 %);
 # rgw-random-mhdpa (DAgger with --augment): 84.0 %, 56.7 % (on these 100: 83 %, 55 %);
-# rgw-random-predinet-deep: 86.0 %, 53.0 %; uniformly random actions 4.6 % on rgw-random)
+# rgw-random-predinet-deep (DAgger with --augment): 95.7 %, 73.7 % (on these 100: 92 %, 65 %);
+# uniformly random actions 4.6 % on rgw-random)
 UNSEEN_FLOOR = {
     "bw1-predinet": {"sample": 0.9, "greedy": 0.7},
     "bw1-mhdpa": {"sample": 0.95, "greedy": 0.85},
@@ -76,7 +78,7 @@ UNSEEN_FLOOR = {
     "bw3-mhdpa": {"sample": 0.95, "greedy": 0.75},
     "rgw-random-predinet": {"sample": 0.75, "greedy": 0.4},
     "rgw-random-mhdpa": {"sample": 0.75, "greedy": 0.45},
-    "rgw-random-predinet-deep": {"sample": 0.75, "greedy": 0.42},
+    "rgw-random-predinet-deep": {"sample": 0.85, "greedy": 0.55},
 }
 
 
@@ -127,6 +129,14 @@ def test_the_rgw_random_predinet_relates_two_objects() -> None:
     best = heads.loc[heads["two_objects"].idxmax()]
     assert best["two_objects"] > 0.5, heads
     assert "agent" in best["pair_1"] and best["pair_1"] != "agent-agent"
+
+
+def test_the_deep_rgw_random_predinet_plays_rgw2_zero_shot() -> None:
+    """Never trained on rgw2, it takes sword, teleport, enemy and terminal greedily (10.4 of the
+    optimal 10.7: a longer way, not a loop); the agents before it timed out there."""
+    total, events, _ = play(CHECKPOINTS / "rgw-random-predinet-deep.pt", ROUTES["rgw2"], "rgw2")
+    assert events == ROUTES["rgw2"], (total, events)
+    assert total >= 10.0, (total, events)
 
 
 @pytest.mark.parametrize("name", RGW)
