@@ -449,3 +449,23 @@ def test_ctrl_c_stops_cleanly_with_a_checkpoint(tmp_path: Path, sig: signal.Sign
     assert "stopped (interrupted)" in stdout
     agent = load_agent(out / "checkpoint.pt")
     assert agent.meta["metrics"]["stop_reason"] == "interrupted" and agent.meta["frames"] > 0
+
+
+def test_resume_keeps_a_slim_run_slim_unless_told_otherwise(neurosym, tmp_path: Path) -> None:
+    """--slim is remembered from the checkpoint (no optimizer state); --no-slim writes it again."""
+    out = tmp_path / "run"
+    first = neurosym(
+        "train", "--env", "rgw1", "--module", "predinet", "--out", str(out), "--workers", "1",
+        "--frames", "300", "--slim", *TINY,
+    )  # fmt: skip
+    assert first.returncode == 0, first.stderr
+    ckpt = out / "checkpoint.pt"
+    assert torch.load(ckpt, weights_only=True)["optimizer"] is None
+    again = neurosym("train", "--out", str(out), "--resume", "--frames", "2000", *TINY)
+    assert again.returncode == 0, again.stderr
+    assert torch.load(ckpt, weights_only=True)["optimizer"] is None
+    full = neurosym("train", "--out", str(out), "--resume", "--frames", "4000", "--no-slim", *TINY)
+    assert full.returncode == 0, full.stderr
+    payload = torch.load(ckpt, weights_only=True)
+    assert payload["optimizer"] is not None
+    assert "--no-slim" in payload["command"].split(" && ")[-1]

@@ -240,7 +240,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="recent episodes behind mean return and success (100)",
     )
     watch.add_argument(
-        "--slim", action="store_true", help="leave the optimizer state out of checkpoints"
+        "--slim",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="leave the optimizer state out of checkpoints (with --resume: as the run was)",
     )
     watch.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -300,8 +303,8 @@ def command_line(args: argparse.Namespace) -> str:
     ):
         if getattr(args, dest) != default:
             parts += [flag, str(getattr(args, dest))]
-    if args.slim:
-        parts.append("--slim")
+    if args.slim is not None:
+        parts.append("--slim" if args.slim else "--no-slim")
     if args.tensorboard:
         parts.append("--tensorboard")
     if args.device != "cpu":

@@ -35,7 +35,7 @@ import signal
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -105,8 +105,9 @@ class RunOptions:
     """seconds between metrics rows"""
     window: int = 100
     """recent episodes behind mean_return and success_rate"""
-    slim: bool = False
-    """leave the optimizer state out of checkpoints"""
+    slim: bool | None = None
+    """leave the optimizer state out of checkpoints; None: as the checkpoint a resumed run
+    continues (slim when it holds no optimizer state), else keep it"""
     progress: bool = True
     """show a rich progress bar on stderr"""
     tensorboard: bool = False
@@ -458,6 +459,8 @@ def train(
         if payload.get("command") and command:
             command = f"{payload['command']} && {command}"
         wall0 = float(payload["metrics"].get("wall_s", 0.0))
+        if options.slim is None:  # a slim run stays slim unless told --no-slim
+            options = replace(options, slim=payload.get("optimizer") is None)
         init_meta = {k: payload["metrics"][k] for k in INIT_KEYS if k in payload["metrics"]}
     else:
         if env is None:
