@@ -133,7 +133,7 @@ def test_the_rgw_random_predinet_relates_two_objects() -> None:
 
 def test_the_deep_rgw_random_predinet_plays_rgw2_zero_shot() -> None:
     """Never trained on rgw2, it takes sword, teleport, enemy and terminal greedily (10.4 of the
-    optimal 10.7: a longer way, not a loop); the shipped agents before it timed out there."""
+    optimal 10.7 in 21 steps, not a loop); the shipped agents before it timed out there."""
     total, events, _ = play(CHECKPOINTS / "rgw-random-predinet-deep.pt", ROUTES["rgw2"], "rgw2")
     assert events == ROUTES["rgw2"], (total, events)
     assert total >= 10.0, (total, events)
