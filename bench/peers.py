@@ -8,7 +8,9 @@ Side by side, one after the other on the same cores, the same frame budget:
   not a neurosym dependency) on the same env and one-hot observation, with a
   small CNN policy (two 3x3 convolutions, 256 units) and the settings of
   neurosym's PPO: 64 envs x 128 steps, 4 epochs of 4 minibatches, lr 5e-4,
-  gamma 0.99, GAE 0.95, clip 0.2, entropy 0.01, rewards x 0.1.
+  gamma 0.99, GAE 0.95, clip 0.2, entropy 0.01, rewards x 0.1
+  (``--sb3-n-steps`` / ``--sb3-epochs`` change the rollout and passes, to
+  give the peer what ``--ppo-args`` gives neurosym's PPO).
 
 For each it prints one JSON line: the frames and wall seconds at which the
 success rate over the last ``--window`` training episodes first reached
@@ -147,7 +149,8 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
     venv = DummyVecEnv([make_env] * 64)
     venv.seed(args.seed)
     model = PPO(
-        "CnnPolicy", venv, n_steps=128, batch_size=2048, n_epochs=4, learning_rate=5e-4,
+        "CnnPolicy", venv, n_steps=args.sb3_n_steps, batch_size=64 * args.sb3_n_steps // 4,
+        n_epochs=args.sb3_epochs, learning_rate=5e-4,
         gamma=0.99, gae_lambda=0.95, clip_range=0.2, ent_coef=0.01, vf_coef=0.5,
         max_grad_norm=0.5, seed=args.seed, verbose=0,
         policy_kwargs={"features_extractor_class": SmallCNN, "normalize_images": False},
@@ -178,6 +181,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--threads", type=int, default=2, help="torch threads for SB3 (2)")
     parser.add_argument(
+        "--sb3-n-steps", type=int, default=128, help="SB3: steps per env per update (128)"
+    )
+    parser.add_argument("--sb3-epochs", type=int, default=4, help="SB3: passes per update (4)")
+    parser.add_argument(
         "--stop-at-target",
         action=argparse.BooleanOptionalAction,
         default=True,
@@ -191,6 +198,8 @@ def main(argv: list[str] | None = None) -> int:
             help=f"more `neurosym train` flags for neurosym-{algo}, e.g. '--envs 32' (none)",
         )
     args = parser.parse_args(argv)
+    if args.sb3_n_steps < 4 or args.sb3_epochs < 1:
+        parser.error("--sb3-n-steps must be >= 4 and --sb3-epochs >= 1")
     runs = [r.strip() for r in args.runs.split(",") if r.strip()]
     unknown = sorted(set(runs) - set(RUNS))
     if unknown:
@@ -209,7 +218,11 @@ def main(argv: list[str] | None = None) -> int:
                 "target": args.target,
                 "budget_frames": args.frames,
                 "budget_minutes": args.minutes,
-                "flags": None if run == "sb3-ppo" else getattr(args, f"{run.split('-')[1]}_args"),
+                "flags": (
+                    f"n_steps={args.sb3_n_steps} n_epochs={args.sb3_epochs}"
+                    if run == "sb3-ppo"
+                    else getattr(args, f"{run.split('-')[1]}_args")
+                ),
                 **result,
             }
         )

@@ -436,3 +436,26 @@ def test_rollout_keeps_the_planners_optimal_actions() -> None:
     assert bool(ro.optimal[ro.valid].any(-1).all())  # every real state has an optimal action
     loss, _ = a3c_loss(model, ro, TrainConfig(planner_coef=1.0))
     loss.backward()
+
+
+def test_frame_rate_spans_updates_not_one_log_row() -> None:
+    """A learner that reports 8,000 frames every 8 s runs at 1,000 frames/s, on every row.
+
+    Logged every 2 s over the row's own interval, the rate read 4,000 on one
+    row in four and 0 on the others (PPO's metrics.csv before the window)."""
+    from neurosym.agent.trainer import FrameRate
+
+    rate = FrameRate(0.0, 0, window=30.0)
+    frames, rates = 0, []
+    for tick in range(1, 61):  # 120 s of rows every 2 s, an update every 8 s
+        now = 2.0 * tick
+        if tick % 4 == 0:
+            frames += 8000
+        rates.append(rate.update(now, frames))
+    assert rates[:3] == [0.0, 0.0, 0.0]  # nothing reported yet
+    assert rates[3:] == pytest.approx([1000.0] * 57)
+    assert len(rate.points) <= 6  # the window's reports, not the run's
+    # a learner that stopped: after a window without a report the rate falls away
+    for tick in range(61, 101):
+        last = rate.update(2.0 * tick, frames)
+    assert last < 250.0

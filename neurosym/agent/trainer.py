@@ -335,6 +335,33 @@ class _Stats:
         return out
 
 
+class FrameRate:
+    """Frames per second between the learners' reports of the last ``window`` seconds.
+
+    A row's own 2-second interval is the wrong span for a synchronous learner:
+    PPO reports its 8,192 frames once every several seconds, so per-row rates
+    alternated between bursts (4 k/s) and zeros while the run made 1.1 k/s.
+    Measured from the first to the last report in the window, a steady
+    learner's rate is the same on every row; once no report has come for a
+    whole window the rate runs to now and falls towards 0.
+    """
+
+    def __init__(self, now: float, frames: int, window: float = 30.0) -> None:
+        self.window = window
+        self.points: collections.deque[tuple[float, int]] = collections.deque([(now, frames)])
+
+    def update(self, now: float, frames: int) -> float:
+        """Record the frame count at ``now``; the current rate."""
+        if frames != self.points[-1][1]:
+            self.points.append((now, frames))
+        while len(self.points) > 2 and now - self.points[1][0] >= self.window:
+            self.points.popleft()
+        (t0, f0), (t1, f1) = self.points[0], self.points[-1]
+        if len(self.points) > 1 and now - t1 < self.window:
+            return (f1 - f0) / max(t1 - t0, 1e-9)
+        return (frames - f0) / max(now - t0, 1e-9)
+
+
 class _StopSignal:
     """Ctrl-C and SIGTERM as a flag the watch loop polls, not an exception.
 
@@ -659,7 +686,7 @@ def train(
         return every is not None and now - last_snapshot >= every * 60
 
     eval_cost = 0.0
-    last_frames = stats.frames
+    rate = FrameRate(start, stats.frames)
     greedy: float | None = None
     greedy_success: float | None = None
     best_state: dict[str, torch.Tensor] | None = None
@@ -725,9 +752,9 @@ def train(
                         solved_frames, solved_wall = stats.frames, wall0 + (last_eval - start)
                 now = time.monotonic()
                 if now - last_log >= options.log_interval or stop_reason:
-                    fps = (stats.frames - last_frames) / max(now - last_log, 1e-9)
+                    fps = rate.update(now, stats.frames)
                     log_row(stats.row(wall0 + now - start, fps, greedy, greedy_success))
-                    last_log, last_frames = now, stats.frames
+                    last_log = now
                     progress.update(
                         task,
                         completed=min(
@@ -805,7 +832,7 @@ def train(
     if (
         not rows or int(rows[-1]["frames"]) != stats.frames
     ):  # what arrived while the workers stopped
-        fps = (stats.frames - last_frames) / max(time.monotonic() - last_log, 1e-9)
+        fps = rate.update(time.monotonic(), stats.frames)
         log_row(stats.row(wall, fps, greedy, greedy_success))
     if board is not None:
         board.close()
