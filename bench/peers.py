@@ -146,11 +146,13 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
         return gym.wrappers.TransformReward(env, lambda r: 0.1 * r)
 
     torch.set_num_threads(args.threads)
-    venv = DummyVecEnv([make_env] * 64)
+    envs, minibatches = 64, 4  # neurosym's PPO: 64 envs, 4 minibatches per pass
+    venv = DummyVecEnv([make_env] * envs)
     venv.seed(args.seed)
     model = PPO(
-        "CnnPolicy", venv, n_steps=args.sb3_n_steps, batch_size=64 * args.sb3_n_steps // 4,
-        n_epochs=args.sb3_epochs, learning_rate=5e-4,
+        "CnnPolicy", venv, n_steps=args.sb3_n_steps,
+        batch_size=envs * args.sb3_n_steps // minibatches, n_epochs=args.sb3_epochs,
+        learning_rate=5e-4,
         gamma=0.99, gae_lambda=0.95, clip_range=0.2, ent_coef=0.01, vf_coef=0.5,
         max_grad_norm=0.5, seed=args.seed, verbose=0,
         policy_kwargs={"features_extractor_class": SmallCNN, "normalize_images": False},
