@@ -192,6 +192,26 @@ def test_ppo_update_prefers_the_paying_action_within_the_clip() -> None:
     assert 0.25 < tight < 0.3 < loose
 
 
+def test_ppo_update_reports_how_far_the_policy_moved() -> None:
+    def stats_for(clip_range: float, epochs: int):
+        model = Lookup()
+        config = TrainConfig(
+            algo="ppo", lr=0.05, entropy=0.0, ppo_epochs=epochs, ppo_minibatches=2,
+            clip_range=clip_range,
+        )  # fmt: skip
+        opt = torch.optim.SGD(model.parameters(), lr=config.lr)
+        rollout = _bandit_rollout(model)
+        return ppo_update(model, opt, rollout, config, torch.Generator().manual_seed(0))
+
+    one = stats_for(0.05, 1)
+    many = stats_for(0.05, 10)
+    loose = stats_for(100.0, 10)
+    # the first minibatch step starts at the acting policy (ratio 1, KL 0); later ones have moved
+    assert 0.0 <= one.approx_kl < many.approx_kl
+    assert 0.0 < many.clip_fraction <= 1.0
+    assert loose.clip_fraction == 0.0 and loose.approx_kl > many.approx_kl
+
+
 def test_a3c_loss_with_normalised_advantages_pushes_both_ways() -> None:
     model = Lookup()
     ro = _bandit_rollout(model)._replace(logits=None, values=None)

@@ -36,6 +36,7 @@ env planner's optimal actions in each visited state, as DAgger labels them.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import signal
 import traceback
@@ -141,12 +142,19 @@ def set_optimizer_hyperparameters(optimizer: SharedOptimizer, config: TrainConfi
 
 
 class LossStats(NamedTuple):
-    """Per-update diagnostics (per env, summed over time)."""
+    """Per-update diagnostics (per env, summed over time).
+
+    ``approx_kl`` and ``clip_fraction`` are PPO's (NaN for the other learners):
+    how far each minibatch step moved the policy from the one that acted, as
+    SB3 and CleanRL log them, the first thing to read when a PPO run collapses.
+    """
 
     policy_loss: float
     value_loss: float
     entropy: float
     grad_norm: float
+    approx_kl: float = math.nan
+    clip_fraction: float = math.nan
 
 
 def n_step_returns(

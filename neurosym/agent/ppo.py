@@ -87,7 +87,7 @@ def ppo_update(
     b_adv = advantages.flatten()[valid]  # (M,)
     b_returns = b_adv + values.flatten()[valid]  # (M,)
     M = b_obs.shape[0]
-    totals = torch.zeros(4)
+    totals = torch.zeros(6)
     steps = 0
     for _ in range(config.ppo_epochs):
         order = torch.randperm(M, generator=generator).to(device)
@@ -104,7 +104,8 @@ def ppo_update(
             adv = b_adv[mb]
             if config.normalize_advantages and adv.numel() > 1:
                 adv = (adv - adv.mean()) / (adv.std() + 1e-8)
-            ratio = (logp - b_logp[mb]).exp()
+            log_ratio = logp - b_logp[mb]
+            ratio = log_ratio.exp()
             clipped = ratio.clamp(1.0 - config.clip_range, 1.0 + config.clip_range)
             policy_loss = -torch.min(ratio * adv, clipped * adv).mean()
             value_loss = 0.5 * (value - b_returns[mb]).pow(2).mean()
@@ -113,8 +114,19 @@ def ppo_update(
             (loss * weight).backward()
             norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
             optimizer.step()
+            with torch.no_grad():
+                # Schulman's low-variance estimator of KL(old || new), as SB3 and CleanRL log it
+                approx_kl = ((ratio - 1.0) - log_ratio).mean()
+                clip_fraction = ((ratio - 1.0).abs() > config.clip_range).float().mean()
             totals += torch.stack(
-                [policy_loss.detach(), value_loss.detach(), entropy.detach(), norm.detach()]
+                [
+                    policy_loss.detach(),
+                    value_loss.detach(),
+                    entropy.detach(),
+                    norm.detach(),
+                    approx_kl,
+                    clip_fraction,
+                ]
             ).cpu()
             steps += 1
     mean = (totals / max(steps, 1)).tolist()

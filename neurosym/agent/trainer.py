@@ -44,7 +44,12 @@ import torch
 import torch.multiprocessing as mp
 
 from neurosym.agent import distributed
-from neurosym.agent.a3c import set_optimizer_hyperparameters, shared_optimizer, worker
+from neurosym.agent.a3c import (
+    LossStats,
+    set_optimizer_hyperparameters,
+    shared_optimizer,
+    worker,
+)
 from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.model import ActorCritic
@@ -69,6 +74,8 @@ METRIC_COLUMNS = (
     "value_loss",
     "entropy",
     "grad_norm",
+    "approx_kl",
+    "clip_fraction",
 )
 INIT_KEYS = ("init_from", "init_env", "init_frames", "init_wall_s")
 """What a run started with --init-from records of its source, in its metrics (kept on resume)."""
@@ -245,6 +252,8 @@ class _TensorBoard:
         "value_loss": "losses/value_loss",
         "entropy": "losses/entropy",
         "grad_norm": "losses/grad_norm",
+        "approx_kl": "losses/approx_kl",
+        "clip_fraction": "losses/clipfrac",
     }
 
     def __init__(self, directory: Path) -> None:
@@ -310,7 +319,7 @@ class _Stats:
         self, wall: float, fps: float, greedy: float | None, greedy_success: float | None
     ) -> dict[str, Any]:
         """One metrics.csv row (strings, blank where unknown); takes the losses since the last row."""
-        losses = self.take_losses() or (None, None, None, None)
+        losses = self.take_losses() or (None,) * len(LossStats._fields)
         return {
             "wall_s": _fmt(wall, ".2f"),
             "frames": self.frames,
@@ -325,6 +334,8 @@ class _Stats:
             "value_loss": _fmt(losses[1], ".5g"),
             "entropy": _fmt(losses[2], ".5g"),
             "grad_norm": _fmt(losses[3], ".5g"),
+            "approx_kl": _fmt(losses[4], ".3g"),
+            "clip_fraction": _fmt(losses[5], ".3g"),
         }
 
     def take_losses(self) -> tuple[float, ...] | None:
