@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 import torch
 
@@ -15,7 +17,7 @@ from neurosym.agent.a3c import (
     shared_optimizer,
 )
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.ppo import ppo_update
+from neurosym.agent.ppo import explained_variance, ppo_update
 from neurosym.agent.rollout import Rollout
 from neurosym.errors import ConfigError
 
@@ -210,6 +212,16 @@ def test_ppo_update_reports_how_far_the_policy_moved() -> None:
     assert 0.0 <= one.approx_kl < many.approx_kl
     assert 0.0 < many.clip_fraction <= 1.0
     assert loose.clip_fraction == 0.0 and loose.approx_kl > many.approx_kl
+    # the acting critic's values against the rollout's returns: a number at most 1
+    assert one.explained_variance <= 1.0
+
+
+def test_explained_variance_reads_a_perfect_a_useless_and_a_constant_critic() -> None:
+    target = torch.tensor([0.0, 1.0, 2.0, 3.0])
+    assert explained_variance(target, target) == 1.0
+    assert explained_variance(torch.full((4,), 1.5), target) == 0.0
+    assert explained_variance(-target, target) < 0.0  # worse than the mean
+    assert math.isnan(explained_variance(target, torch.ones(4)))
 
 
 def test_a3c_loss_with_normalised_advantages_pushes_both_ways() -> None:

@@ -144,9 +144,12 @@ def set_optimizer_hyperparameters(optimizer: SharedOptimizer, config: TrainConfi
 class LossStats(NamedTuple):
     """Per-update diagnostics (per env, summed over time).
 
-    ``approx_kl`` and ``clip_fraction`` are PPO's (NaN for the other learners):
-    how far each minibatch step moved the policy from the one that acted, as
-    SB3 and CleanRL log them, the first thing to read when a PPO run collapses.
+    ``approx_kl``, ``clip_fraction`` and ``explained_variance`` are PPO's (NaN
+    for the other learners), as SB3 and CleanRL log them: how far each
+    minibatch step moved the policy from the one that acted, and how much of
+    the rollout's returns' variance the acting critic's values explained (1:
+    all, 0: no better than their mean), the first things to read when a PPO
+    run does not learn.
     """
 
     policy_loss: float
@@ -155,6 +158,7 @@ class LossStats(NamedTuple):
     grad_norm: float
     approx_kl: float = math.nan
     clip_fraction: float = math.nan
+    explained_variance: float = math.nan
 
 
 def n_step_returns(

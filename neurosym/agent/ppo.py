@@ -85,7 +85,9 @@ def ppo_update(
     b_logp = F.log_softmax(rollout.logits.to(device), dim=-1).flatten(0, 1)[valid]  # (M, A)
     b_logp = b_logp.gather(-1, b_actions.unsqueeze(-1)).squeeze(-1)  # (M,)
     b_adv = advantages.flatten()[valid]  # (M,)
-    b_returns = b_adv + values.flatten()[valid]  # (M,)
+    b_values = values.flatten()[valid]  # (M,)
+    b_returns = b_adv + b_values  # (M,)
+    explained = explained_variance(b_values, b_returns)
     M = b_obs.shape[0]
     totals = torch.zeros(6)
     steps = 0
@@ -130,7 +132,17 @@ def ppo_update(
             ).cpu()
             steps += 1
     mean = (totals / max(steps, 1)).tolist()
-    return LossStats(*mean)
+    return LossStats(*mean, explained_variance=explained)
+
+
+def explained_variance(predicted: torch.Tensor, target: torch.Tensor) -> float:
+    """1 - Var(target - predicted) / Var(target); NaN when the targets do not vary."""
+    if target.numel() < 2:
+        return float("nan")
+    var = target.var()
+    if var <= 0:
+        return float("nan")
+    return float(1.0 - (target - predicted).var() / var)
 
 
 @torch.no_grad()

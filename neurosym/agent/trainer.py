@@ -76,6 +76,7 @@ METRIC_COLUMNS = (
     "grad_norm",
     "approx_kl",
     "clip_fraction",
+    "explained_variance",
 )
 INIT_KEYS = ("init_from", "init_env", "init_frames", "init_wall_s")
 """What a run started with --init-from records of its source, in its metrics (kept on resume)."""
@@ -254,6 +255,7 @@ class _TensorBoard:
         "grad_norm": "losses/grad_norm",
         "approx_kl": "losses/approx_kl",
         "clip_fraction": "losses/clipfrac",
+        "explained_variance": "losses/explained_variance",
     }
 
     def __init__(self, directory: Path) -> None:
@@ -336,6 +338,7 @@ class _Stats:
             "grad_norm": _fmt(losses[3], ".5g"),
             "approx_kl": _fmt(losses[4], ".3g"),
             "clip_fraction": _fmt(losses[5], ".3g"),
+            "explained_variance": _fmt(losses[6], ".3g"),
         }
 
     def take_losses(self) -> tuple[float, ...] | None:
