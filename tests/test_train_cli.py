@@ -278,12 +278,21 @@ def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path:
         "charts/fps",
         "losses/entropy",
         "losses/policy_loss",
+        "losses/approx_kl",
+        "losses/clipfrac",
+        "losses/explained_variance",
     } <= tags  # no episode ends in 256 frames
+    with open(out / "metrics.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["approx_kl"]]
+    assert rows and all(float(r["approx_kl"]) >= 0 for r in rows)
+    assert all(0 <= float(r["clip_fraction"]) <= 1 for r in rows)
     steps = [e.step for e in events.Scalars("losses/policy_loss")]
     assert steps and steps == sorted(steps) and steps[-1] <= agent.meta["frames"]
 
     wrong = neurosym("train", "--out", str(out), "--resume", "--algo", "a3c", "--quiet")
     assert wrong.returncode == 1 and "trained with --algo ppo" in wrong.stderr
+    sil = neurosym("train", "--out", str(out), "--resume", "--sil", "1", "--quiet")
+    assert sil.returncode == 1 and "ppo has none" in sil.stderr
     again = neurosym(
         "train", "--out", str(out), "--resume", "--frames", str(agent.meta["frames"] + 256),
         "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2",

@@ -541,12 +541,12 @@ def train(
         train_config = TrainConfig.for_family(
             family, preset=preset, algo=algo or "a3c", **train_overrides
         )
-        if train_config.algo != "a3c" and train_config.sil > 0:
-            raise ConfigError(
-                f"--sil is A3C's self-imitation; {train_config.algo} has none (use --sil 0)"
-            )
         frames0 = episodes0 = 0
         wall0 = 0.0
+    if train_config.algo != "a3c" and train_config.sil > 0:  # a new run's or a resume's --sil
+        raise ConfigError(
+            f"--sil is A3C's self-imitation; {train_config.algo} has none (use --sil 0)"
+        )
     if train_config.planner_coef and family != "rgw":
         raise ConfigError(
             f"--planner-coef learns from the RGW planner; {family} has none (use --planner-coef 0)"
