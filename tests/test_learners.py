@@ -216,6 +216,34 @@ def test_ppo_update_reports_how_far_the_policy_moved() -> None:
     assert one.explained_variance <= 1.0
 
 
+def test_ppo_running_advantages_keep_a_rewardless_rollout_small() -> None:
+    """Per minibatch, a rollout whose advantages are all tiny moves the policy as far as one
+    with real rewards; divided by the running RMS of the rollouts before it, it barely does."""
+
+    def paying_prob_after(mode: str, scale: AdvantageScale | None, reward: float) -> float:
+        model = Lookup()
+        config = TrainConfig(
+            algo="ppo", lr=0.05, entropy=0.0, ppo_epochs=4, ppo_minibatches=2,
+            ppo_advantages=mode,
+        )  # fmt: skip
+        rollout = _bandit_rollout(model)
+        rollout = rollout._replace(rewards=rollout.rewards * reward)
+        opt = torch.optim.SGD(model.parameters(), lr=config.lr)
+        ppo_update(model, opt, rollout, config, torch.Generator().manual_seed(0), scale)
+        return float(torch.softmax(model.logits[1].detach(), -1)[2])
+
+    rewarded = paying_prob_after("minibatch", None, 1.0)
+    tiny_minibatch = paying_prob_after("minibatch", None, 1e-3)
+    scale = AdvantageScale()
+    rewarded_running = paying_prob_after("running", scale, 1.0)  # primes the running RMS
+    tiny_running = paying_prob_after("running", scale, 1e-3)
+    assert rewarded > 0.27 and rewarded_running > 0.27  # up to the clip (0.25 * 1.2)
+    # scaled back up to (nearly) the same step; the gradient clip, which sees the value
+    # head's larger gradient under real rewards, makes the difference
+    assert abs(tiny_minibatch - rewarded) < 0.05 * (rewarded - 0.25)
+    assert 0.25 < tiny_running < 0.25 + 0.01 * (rewarded - 0.25)  # the sign kept, the size too
+
+
 def test_explained_variance_reads_a_perfect_a_useless_and_a_constant_critic() -> None:
     target = torch.tensor([0.0, 1.0, 2.0, 3.0])
     assert explained_variance(target, target) == 1.0

@@ -41,6 +41,7 @@ _OVERRIDES = (
     ("--ppo-epochs", "ppo_epochs", "train"),
     ("--ppo-minibatches", "ppo_minibatches", "train"),
     ("--clip-range", "clip_range", "train"),
+    ("--ppo-advantages", "ppo_advantages", "train"),
     ("--critic-warmup", "critic_warmup", "train"),
     ("--planner-coef", "planner_coef", "train"),
     ("--dagger-beta-frames", "dagger_beta_frames", "train"),
@@ -148,6 +149,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
     a3c.add_argument("--ppo-epochs", type=int, help="PPO passes over each rollout")
     a3c.add_argument("--ppo-minibatches", type=int, help="PPO minibatches per pass")
     a3c.add_argument("--clip-range", type=float, help="PPO probability-ratio clip")
+    a3c.add_argument(
+        "--ppo-advantages",
+        choices=("minibatch", "running"),
+        help="PPO's advantage normalisation: per minibatch, or a running RMS over rollouts",
+    )
     a3c.add_argument(
         "--dagger-beta-frames",
         type=int,

@@ -41,6 +41,7 @@ FAMILIES = ("rgw", "boxworld")
 PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
 OPTIMIZERS = ("adam", "rmsprop")
+PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
 
 # Table 4 values that differ by env family.
@@ -326,6 +327,11 @@ class TrainConfig:
     """PPO: minibatches per pass"""
     clip_range: float = 0.2
     """PPO: probability-ratio clip"""
+    ppo_advantages: str = "minibatch"
+    """PPO, with ``normalize_advantages``: "minibatch" centres and scales each minibatch's
+    advantages (SB3, CleanRL); "running" divides each rollout's by a running RMS of the
+    advantages seen so far (A3C's :class:`~neurosym.agent.a3c.AdvantageScale`), so that a
+    rollout without reward keeps its small advantages small instead of scaled to unit size"""
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""
     grad_clip: float = 0.5
@@ -369,7 +375,11 @@ class TrainConfig:
                 f"--augment turns the planner's labelled states; it needs --algo imitate, "
                 f"not {self.algo}"
             )
-        for name, allowed in (("algo", ALGOS), ("optimizer", OPTIMIZERS)):
+        for name, allowed in (
+            ("algo", ALGOS),
+            ("optimizer", OPTIMIZERS),
+            ("ppo_advantages", PPO_ADVANTAGES),
+        ):
             if getattr(self, name) not in allowed:
                 raise ConfigError(
                     f"unknown {name} {getattr(self, name)!r}; expected one of {', '.join(allowed)}"

@@ -13,7 +13,9 @@ al. 2017)::
     loss  = -mean(min(ratio A, clip(ratio, 1 - eps, 1 + eps) A))
             + value_coef * mean(0.5 (V(o) - (A_old + V_old(o)))^2) - entropy * mean(H)
 
-with A normalised per minibatch when ``normalize_advantages``. It writes
+with A normalised when ``normalize_advantages``: per minibatch (``ppo_advantages``
+"minibatch", as SB3 and CleanRL do) or per rollout by a running RMS kept across
+updates ("running", A3C's :class:`~neurosym.agent.a3c.AdvantageScale`). It writes
 straight into the trainer's shared model with the trainer's optimiser and
 reports to the trainer through the same queue messages as an A3C worker, so
 evaluation, metrics, checkpoints, resume and stopping are one code path for
@@ -39,6 +41,7 @@ import torch.nn.functional as F
 
 from neurosym.agent import distributed
 from neurosym.agent.a3c import (
+    AdvantageScale,
     LossStats,
     gae_advantages,
     learner_process,
@@ -57,11 +60,13 @@ def ppo_update(
     rollout: Rollout,
     config: TrainConfig,
     generator: torch.Generator,
+    scale: AdvantageScale | None = None,
 ) -> LossStats:
     """Epochs of clipped-surrogate minibatch steps on one rollout; the mean loss parts.
 
     ``model`` may be wrapped in DistributedDataParallel; the rollout's CPU
-    tensors are moved to the model's device.
+    tensors are moved to the model's device. ``scale``: the learner's running
+    RMS for ``ppo_advantages == "running"`` (a fresh one if None).
     """
     assert rollout.logits is not None and rollout.values is not None, "record the rollout"
     core = getattr(model, "module", model)
@@ -88,6 +93,10 @@ def ppo_update(
     b_values = values.flatten()[valid]  # (M,)
     b_returns = b_adv + b_values  # (M,)
     explained = explained_variance(b_values, b_returns)
+    per_minibatch = config.normalize_advantages and config.ppo_advantages == "minibatch"
+    if config.normalize_advantages and config.ppo_advantages == "running":
+        scale = scale if scale is not None else AdvantageScale()
+        b_adv = scale(b_adv, torch.ones_like(b_adv))  # the returns above keep the raw ones
     M = b_obs.shape[0]
     totals = torch.zeros(6)
     steps = 0
@@ -104,7 +113,7 @@ def ppo_update(
             logp = logp_all.gather(-1, b_actions[mb].unsqueeze(-1)).squeeze(-1)
             entropy = -(logp_all.exp() * logp_all).sum(-1).mean()
             adv = b_adv[mb]
-            if config.normalize_advantages and adv.numel() > 1:
+            if per_minibatch and adv.numel() > 1:
                 adv = (adv - adv.mean()) / (adv.std() + 1e-8)
             log_ratio = logp - b_logp[mb]
             ratio = log_ratio.exp()
@@ -227,6 +236,7 @@ def ppo_learner(
             copy_into_shared(local, local_opt, shared, optimizer)
         venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
         state = RolloutState(venv, env_seed)
+        scale = AdvantageScale()  # used when ppo_advantages is "running"
         bonus = None
         if train_config.explore > 0:
             bonus = CountBonus(train_config.explore, half_life=train_config.explore_half_life)
@@ -240,7 +250,7 @@ def ppo_learner(
             rollout, finished = collect_rollout(
                 local, state, train_config.n_steps, generator, bonus, record=True, device=dev
             )
-            stats = ppo_update(model, local_opt, rollout, train_config, generator)
+            stats = ppo_update(model, local_opt, rollout, train_config, generator, scale)
             copy_into_shared(local, local_opt, shared, optimizer)
             frames = int(rollout.valid.sum())
             if world.distributed:
