@@ -438,6 +438,28 @@ def test_rollout_keeps_the_planners_optimal_actions() -> None:
     loss.backward()
 
 
+def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it() -> None:
+    """A3C reports no PPO parts (blank), and one PPO update without an explained variance
+    (its returns did not vary) does not blank the row's mean of the others."""
+    from neurosym.agent.trainer import _Stats
+
+    nan = float("nan")
+    stats = _Stats(0, 0, window=10)
+    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, 1e-3, 0.1, nan))
+    stats.add(8, [], [], [], (3.0, 4.0, 1.1, 0.7, 3e-3, 0.3, 0.6))
+    row = stats.row(1.0, 8.0, None, None)
+    assert (row["policy_loss"], row["entropy"], row["grad_norm"]) == ("2", "1.2", "0.6")
+    assert (row["approx_kl"], row["clip_fraction"], row["explained_variance"]) == (
+        "0.002",
+        "0.2",
+        "0.6",
+    )
+    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, nan, nan, nan))  # an A3C worker's report
+    row = stats.row(2.0, 8.0, None, None)
+    assert row["policy_loss"] == "1" and row["approx_kl"] == row["explained_variance"] == ""
+    assert stats.row(3.0, 8.0, None, None)["policy_loss"] == ""  # no update since the last row
+
+
 def test_frame_rate_spans_updates_not_one_log_row() -> None:
     """A learner that reports 8,000 frames every 8 s runs at 1,000 frames/s, on every row.
 

@@ -344,9 +344,13 @@ class _Stats:
     def take_losses(self) -> tuple[float, ...] | None:
         if not self.losses:
             return None
-        out = tuple(float(v) for v in np.mean(np.asarray(self.losses), axis=0))
+        losses = np.asarray(self.losses, dtype=np.float64)  # (updates, parts)
+        # a part an update could not measure (NaN: a learner without it, or returns that did
+        # not vary for explained_variance) is left out of the mean, not allowed to blank it
+        counts = (~np.isnan(losses)).sum(axis=0)
+        sums = np.nansum(losses, axis=0)
         self.losses = []
-        return out
+        return tuple(float(s / c) if c else math.nan for s, c in zip(sums, counts, strict=True))
 
 
 class FrameRate:
