@@ -231,7 +231,10 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
         with torch.no_grad():
             logits = agent.model(torch.from_numpy(obs))[0]
         nll[coef] = optimal_set_nll(logits, optimal).mean().item()
-    assert nll["5"] < nll["0"] - 1.0, nll  # measured: 0.39-0.80 against 4.7-7.6 nats
+    # the source starts at 0.04 nats. Measured with the re-shipped source (2026-11-26, seven
+    # runs): 0.09-0.19 with the planner's loss against 0.93-17 without (Hogwild's timing
+    # decides how far A3C alone drifts; the former "- 1.0 nats" failed about one run in three)
+    assert nll["5"] < 0.4 and nll["5"] < nll["0"] / 3, nll
 
 
 @pytest.mark.expensive
