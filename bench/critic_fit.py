@@ -77,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     from sklearn.model_selection import cross_val_score
 
     from neurosym.agent.checkpoint import load_agent
-    from neurosym.agent.diagnostics import gradient_report
+    from neurosym.agent.diagnostics import explained_variance, gradient_report
 
     agent = load_agent(args.checkpoint)
     model = agent.model
@@ -93,7 +93,6 @@ def main(argv: list[str] | None = None) -> int:
     for gamma in (float(g) for g in args.gammas.split(",")):
         returns, known = mc_returns(rewards * args.reward_scale, done, gamma)
         target, value = returns[known], values[known]
-        err = target - value
         r2 = cross_val_score(Ridge(alpha=1.0), hidden[known], target, cv=5, scoring="r2")
         grads = gradient_report(
             model,
@@ -112,7 +111,9 @@ def main(argv: list[str] | None = None) -> int:
                     "states": int(known.sum()),
                     "return_mean": round(float(target.mean()), 3),
                     "value_mean": round(float(value.mean()), 3),
-                    "explained_variance": round(float(1 - err.var() / target.var()), 3),
+                    "explained_variance": round(
+                        explained_variance(torch.as_tensor(value), torch.as_tensor(target)), 3
+                    ),
                     "ridge_r2": [round(float(s), 3) for s in r2],
                     "grad_norms": {
                         part: {k: round(v, 5) for k, v in d.items() if k != "per_weight"}

@@ -17,7 +17,8 @@ from neurosym.agent.a3c import (
     shared_optimizer,
 )
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.ppo import explained_variance, ppo_update
+from neurosym.agent.diagnostics import explained_variance
+from neurosym.agent.ppo import ppo_update
 from neurosym.agent.rollout import Rollout
 from neurosym.errors import ConfigError
 

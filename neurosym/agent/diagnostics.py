@@ -111,3 +111,17 @@ def gradient_report(
             if name == "actor":
                 entry["per_weight"] = float(flat.abs().mean())
     return report
+
+
+def explained_variance(predicted: torch.Tensor, target: torch.Tensor) -> float:
+    """How much of ``target``'s variance ``predicted`` explains (SB3's figure for a critic):
+    1 - Var(target - predicted) / Var(target); NaN when the targets do not vary.
+
+    Used by PPO's metrics and ``bench/critic_fit.py``.
+    """
+    if target.numel() < 2:
+        return float("nan")
+    var = target.var()
+    if var <= 0:
+        return float("nan")
+    return float(1.0 - (target - predicted).var() / var)

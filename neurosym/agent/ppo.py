@@ -49,6 +49,7 @@ from neurosym.agent.a3c import (
     shared_optimizer,
 )
 from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.diagnostics import explained_variance
 from neurosym.agent.exploration import CountBonus
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
@@ -142,16 +143,6 @@ def ppo_update(
             steps += 1
     mean = (totals / max(steps, 1)).tolist()
     return LossStats(*mean, explained_variance=explained)
-
-
-def explained_variance(predicted: torch.Tensor, target: torch.Tensor) -> float:
-    """1 - Var(target - predicted) / Var(target); NaN when the targets do not vary."""
-    if target.numel() < 2:
-        return float("nan")
-    var = target.var()
-    if var <= 0:
-        return float("nan")
-    return float(1.0 - (target - predicted).var() / var)
 
 
 @torch.no_grad()
