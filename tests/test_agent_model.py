@@ -238,3 +238,44 @@ def test_recorded_queries_give_the_same_update_and_go_stale_with_the_weights() -
     torch.testing.assert_close(stale[0], changed[0])
     assert not torch.allclose(stale[0], fresh[0])
     assert make("mhdpa").recording().__enter__() is None  # nothing to record
+
+
+def test_learned_queries_are_one_vector_for_every_scene() -> None:
+    """ModelConfig.query "learned": no query projection, the same Q for every scene, the same
+    gradients as plain autograd, and heads that still attend by what is in each scene."""
+    from neurosym.agent.predinet import PrediNetAttention
+
+    net = make("predinet", query="learned")
+    rel = net.relational
+    names = {n for n, _ in rel.named_parameters()}
+    assert "queries" in names and not any(n.startswith("query1") for n in names)
+    assert rel.queries.shape == (2 * 4 * 32,)
+    obs = obs_batch(3, RGW[0])
+    _, _, intro = net(obs, introspect=True)
+    # same queries, different scenes: different attentions (keys read each entity)
+    assert not torch.allclose(intro.attention1[0], intro.attention1[1])
+    g = torch.Generator().manual_seed(0)
+    L = torch.randn(3, 7, 5, dtype=torch.float64, generator=g, requires_grad=True)
+    q = torch.randn(2 * 2 * 4, dtype=torch.float64, generator=g, requires_grad=True)
+    w_k = torch.randn(4, 5, dtype=torch.float64, generator=g, requires_grad=True)
+    mine = lambda L, q, w_k: PrediNetAttention.apply(L, None, w_k, 0.7, None, q)[:2]  # noqa: E731
+    assert torch.autograd.gradcheck(mine, (L, q, w_k))
+    a, e = mine(L, q, w_k)
+    ref = torch.softmax(((q.view(1, -1, 4) @ w_k) * 0.7) @ L.transpose(1, 2), dim=-1)
+    torch.testing.assert_close(a, ref)
+    torch.testing.assert_close(e, ref @ L)
+    # A3C's query record has nothing to keep and the update's forward is unchanged
+    with torch.no_grad(), net.recording() as record:
+        net(obs)
+    assert record is not None and record.parts == []
+    torch.testing.assert_close(net(obs, queries=record)[0], net(obs)[0])
+
+
+def test_learned_queries_are_predinet_only_and_old_configs_read_as_scene() -> None:
+    with pytest.raises(ConfigError, match="unknown query 'flat'; expected one of scene, learned"):
+        ModelConfig(module="predinet", obs_shape=(3, 4, 4), query="flat")
+    with pytest.raises(ConfigError, match="query 'learned' is PrediNet's; mhdpa's queries"):
+        ModelConfig(module="mhdpa", obs_shape=(3, 4, 4), query="learned")
+    data = ModelConfig.for_family("rgw", "predinet", RGW[0]).to_dict()
+    del data["query"]  # a checkpoint from before the switch
+    assert ModelConfig.from_dict(data).query == "scene"

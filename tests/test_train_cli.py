@@ -331,10 +331,34 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
     assert "--preset thesis" in agent.meta["command"]
 
 
+@pytest.mark.expensive
+def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: Path) -> None:
+    """--query learned trains (A3C's recorded-query path included), is kept in the checkpoint
+    and its command, and the saved agent loads with one query vector and no projection."""
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "bw1", "--module", "predinet", "--query", "learned", "--out", str(out),
+        "--workers", "1", "--envs", "4", "--frames", "400", "--quiet",
+        "--eval-interval", "0.5", "--eval-episodes", "2",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.config.query == "learned" and "--query learned" in agent.meta["command"]
+    params = dict(agent.model.relational.named_parameters())
+    assert "queries" in params and "query1.weight" not in params
+    assert agent.meta["frames"] >= 400
+    obs = torch.zeros((2, *agent.config.obs_shape), dtype=torch.uint8)
+    assert agent.model(obs)[0].shape == (2, 4)
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
         (("--env", "rgw9", "--module", "predinet"), "rgw9"),
+        (
+            ("--env", "bw1", "--module", "mhdpa", "--query", "learned"),
+            "query 'learned' is PrediNet's; mhdpa's queries come from each entity",
+        ),
         (("--module", "predinet"), "--env is needed unless --resume"),
         (
             ("--env", "rgw2", "--module", "predinet", "--snapshot-every", "0"),

@@ -50,6 +50,7 @@ _OVERRIDES = (
     ("--attention-gain", "attention_gain", "model"),
     ("--entity-norm", "entity_norm", "model"),
     ("--init", "init", "model"),
+    ("--query", "query", "model"),
     ("--heads", "heads", "model"),
     ("--key-size", "key_size", "model"),
     ("--relations", "relations", "model"),
@@ -209,6 +210,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--entity-norm",
         action=argparse.BooleanOptionalAction,
         help="LayerNorm on the entities (default on; thesis off)",
+    )
+    model.add_argument(
+        "--query",
+        choices=("scene", "learned"),
+        help="PrediNet's queries: from the whole scene (scene, DESIGN and the thesis; default) "
+        "or learned vectors, the same for every scene (learned)",
     )
     model.add_argument(
         "--init",

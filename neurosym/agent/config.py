@@ -43,6 +43,7 @@ ALGOS = ("a3c", "ppo", "imitate")
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
+QUERIES = ("scene", "learned")
 
 # Table 4 values that differ by env family.
 _MODEL_FAMILY: dict[str, dict[str, Any]] = {
@@ -194,6 +195,17 @@ class ModelConfig:
     the fresh attention is uniform to within 1.3x on bw1 (max weight 0.0063 against 1/196), so
     every head attends to the mean entity and PrediNet's D is 0; at 8 the largest weight is
     5x uniform (entropy 96 % of uniform's), so heads start out looking at something"""
+    query: str = "scene"
+    """PrediNet's queries: "scene" (Q = flat(L) W_Q, DESIGN.md and the thesis) or "learned" (a
+    learned Q1, Q2 per head, the same for every scene: attention by what and where an entity
+    is, not by the rest of the scene; see neurosym/agent/predinet.py for the measurements).
+    "learned" also drops the query projection, two thirds of a bw1 forward's arithmetic (PPO
+    64 x 2 on bw1: 2.3-3.2 k frames/s against 1.5-2.0 k). Measured on bw1 (PPO 64 steps x 2
+    passes, frames to 90 % training success, seeds 0/1/2): scene 657 k / none / none in 8
+    minutes; learned none (seed 0 collapsed to 0.2 % success) / 1,216 k / 461 k; learned with
+    ppo_advantages "running" 652 k / 787 k / 542 k (seed 3: 624 k). Not yet measured on
+    bw2/bw3 or under A3C, and bw2/bw3's chains may need a query that depends on the held
+    key, so "scene" stays the default."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
@@ -232,6 +244,13 @@ class ModelConfig:
             raise ConfigError("conv_channels and hidden_sizes must be positive")
         if not self.obs_scale > 0:
             raise ConfigError(f"obs_scale must be positive, got {self.obs_scale}")
+        if self.query not in QUERIES:
+            raise ConfigError(f"unknown query {self.query!r}; expected one of {', '.join(QUERIES)}")
+        if self.query != "scene" and self.module != "predinet":
+            raise ConfigError(
+                f"query {self.query!r} is PrediNet's; {self.module}'s queries come from each "
+                "entity (use query 'scene')"
+            )
         if self.init not in INITS:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
         if not self.attention_gain > 0:
@@ -335,7 +354,10 @@ class TrainConfig:
     Measured on bw1 (PrediNet, 64 steps x 2 passes, README "Measured"): per minibatch with
     ``--attention-gain 32`` the policy collapsed below random (0.4 % success); "running" did not
     collapse, but took off later on seed 0 (75 % after 897 k frames against 90 % at 657 k) and
-    not at all on seed 1, so the default stays "minibatch"
+    not at all on seed 1, so the default stays "minibatch". With learned PrediNet queries
+    (ModelConfig.query) it is what kept seed 0 from the same collapse (0.2 % after 1.29 M
+    frames per minibatch; 90 % at 652 k with "running"), and that pair is the fastest bw1
+    learner measured here (README "Measured"; not the default, since bw2/bw3 are unmeasured)
     """
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""

@@ -36,6 +36,7 @@ def build_relational(config: ModelConfig) -> nn.Module:
             config.relations,
             config.output_size,
             config.attention_gain,
+            config.query,
         )
     return MHDPA(
         config.entity_size,

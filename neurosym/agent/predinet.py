@@ -21,6 +21,19 @@ Choices made here (DESIGN.md leaves them open):
   information; the positions are in R as pos(E1), pos(E2). D is computed as
   (E1 - E2) W_S, which equals E1 W_S - E2 W_S and is exactly antisymmetric in
   floating point.
+* ``query="learned"`` (ModelConfig.query; "scene", DESIGN's flat(L) W_Q, is
+  the default): each head's Q1, Q2 are learned vectors, the same for every
+  scene, so a head selects by what an entity is and where it stands, not by
+  the rest of the scene. Why it exists: with scene queries, Adam's first
+  update on bw1 moves every one of W_Q's 5,096 inputs by about lr in the same
+  direction (most of flat(L) is the same in every level: coordinates, walls,
+  background), so the queries jump by the same large vector in every scene
+  and the attention saturates on fixed cells (largest weight 0.033 -> 0.66
+  after one PPO update, 0.78 after two: ``bench/diagnose.py --ppo-updates 2``;
+  4 of 8 attentions on one fixed cell in 97-100 % of observations after
+  375 k frames of seed 1, which never took off). A learned query moves by
+  about lr per step. It cannot make which lock a head attends to depend on
+  the colour of the held key, which bw2/bw3's chains may need.
 * The heads' R vectors are concatenated, (B, H * (J + 4)), and a linear layer
   projects them to Table 4's output size (26). It is linear so that the
   output is a plain read-out of R and the R vectors stay the only relational
@@ -86,11 +99,13 @@ class PrediNetAttention(torch.autograd.Function):
     """
 
     @staticmethod
-    def forward(ctx, L, w_q, w_k, scale, q_head=None):  # type: ignore[override]
+    def forward(ctx, L, w_q, w_k, scale, q_head=None, q_learned=None):  # type: ignore[override]
         B, N, F = L.shape
         D = w_k.shape[0]
         flat = L.reshape(B, N * F)
-        if q_head is None:
+        if q_learned is not None:  # ModelConfig.query "learned": the same queries for every scene
+            q = q_learned.expand(B, -1).contiguous()
+        elif q_head is None:
             q = flat @ w_q.t()  # (B, 2H D)
         else:  # the first rows' queries are known (acting computed them with these weights)
             q = torch.cat([q_head, flat[q_head.shape[0] :] @ w_q.t()])
@@ -100,6 +115,7 @@ class PrediNetAttention(torch.autograd.Function):
         e = a @ L  # (B, 2H, F)
         ctx.save_for_backward(L, w_q, w_k, q, qk, a)
         ctx.scale = scale
+        ctx.learned = q_learned is not None
         q_flat = q.view(B, -1)
         ctx.mark_non_differentiable(q_flat)
         return a, e, q_flat
@@ -120,9 +136,11 @@ class PrediNetAttention(torch.autograd.Function):
         g_qk = g_qk * ctx.scale
         g_wk = q.reshape(-1, q.shape[-1]).t() @ g_qk.reshape(-1, F)  # (D, F)
         g_q = (g_qk @ w_k.t()).reshape(B, -1)  # (B, 2H D)
+        if ctx.learned:  # no flat(L) path; the one query vector gathers every row's gradient
+            return g_l, None, g_wk, None, None, g_q.sum(0)
         g_wq = g_q.t() @ L.reshape(B, N * F)  # (2H D, N F)
         g_l = torch.addmm(g_l.reshape(B, N * F), g_q, w_q).view(B, N, F)  # + flat(L)'s gradient
-        return g_l, g_wq, g_wk, None, None
+        return g_l, g_wq, g_wk, None, None, None
 
 
 class PrediNet(nn.Module):
@@ -137,15 +155,24 @@ class PrediNet(nn.Module):
         relations: int,
         output_size: int,
         attention_gain: float = 1.0,
+        query: str = "scene",
     ) -> None:
         super().__init__()
         assert entity_size > 2, "entities need features besides the 2 coordinates"
         self.heads, self.key_size, self.relations = heads, key_size, relations
+        self.query_mode = query
         self.key = nn.Linear(entity_size, key_size, bias=False)  # W_K, shared
-        self.query1 = nn.Linear(
-            n_entities * entity_size, heads * key_size, bias=False
-        )  # W_Q1^h, all heads
-        self.query2 = nn.Linear(n_entities * entity_size, heads * key_size, bias=False)  # W_Q2^h
+        if query == "learned":
+            # Q1^h, Q2^h of every head as one (2H D) vector; std 1 gives a fresh attention about
+            # as peaked as the scene queries' (bw1, gain 8: largest weight 0.079 against 0.033)
+            self.queries = nn.Parameter(torch.randn(2 * heads * key_size))
+        else:
+            self.query1 = nn.Linear(
+                n_entities * entity_size, heads * key_size, bias=False
+            )  # W_Q1^h, all heads
+            self.query2 = nn.Linear(
+                n_entities * entity_size, heads * key_size, bias=False
+            )  # W_Q2^h
         self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
         self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
@@ -154,6 +181,8 @@ class PrediNet(nn.Module):
         """Identifies the current W_Q values. A recorded query also depends on its entities, so
         a record is valid only for the same observations through the same encoder, which the
         caller guarantees (A3C: one weight load per rollout, no step until its update)."""
+        if self.query_mode == "learned":
+            return ((self.queries.data_ptr(), self.queries._version),)
         return tuple((w.data_ptr(), w._version) for w in (self.query1.weight, self.query2.weight))
 
     @contextlib.contextmanager
@@ -185,15 +214,20 @@ class PrediNet(nn.Module):
             q_head = torch.cat(queries.parts) if len(queries.parts) > 1 else queries.parts[0]
             if q_head.shape[0] > B:
                 q_head = None
-        a, e, q = PrediNetAttention.apply(
-            L,
-            torch.cat([self.query1.weight, self.query2.weight]),
-            self.key.weight,
-            self.scale,
-            q_head,
-        )
+        if self.query_mode == "learned":  # nothing worth recording: the queries are weights
+            a, e, q = PrediNetAttention.apply(
+                L, None, self.key.weight, self.scale, None, self.queries
+            )
+        else:
+            a, e, q = PrediNetAttention.apply(
+                L,
+                torch.cat([self.query1.weight, self.query2.weight]),
+                self.key.weight,
+                self.scale,
+                q_head,
+            )
         recording = getattr(self, "_recording", None)
-        if recording is not None and not torch.is_grad_enabled():
+        if recording is not None and not torch.is_grad_enabled() and self.query_mode != "learned":
             if recording.key == self.weights_key():
                 recording.parts.append(q)
         a1, a2, e1, e2 = a[:, :H], a[:, H:], e[:, :H], e[:, H:]  # (B, H, N), (B, H, F)
