@@ -9,6 +9,8 @@ model or the learner::
 
     python bench/diagnose.py                        # rgw2 and bw1, both modules, both presets
     python bench/diagnose.py --envs bw1 --presets thesis
+    python bench/diagnose.py --envs bw1 --modules predinet --presets default \
+        --ppo-updates 3 --query learned     # also after each of the first PPO updates
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.diagnostics import gradient_report, input_signal
+from neurosym.agent.diagnostics import gradient_report, input_signal, signal_after_ppo_updates
 from neurosym.agent.model import ActorCritic
 from neurosym.envs import env_family, make_batched
 
@@ -55,6 +57,15 @@ def main() -> None:
     parser.add_argument("--modules", default="predinet,mhdpa")
     parser.add_argument("--presets", default="thesis,default")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--ppo-updates",
+        type=int,
+        default=0,
+        help="also print the figures after each of this many PPO updates (default preset only)",
+    )
+    parser.add_argument(
+        "--query", choices=("scene", "learned"), default=None, help="PrediNet's queries"
+    )
     args = parser.parse_args()
     torch.set_num_threads(1)
     for env in args.envs.split(","):
@@ -71,15 +82,26 @@ def main() -> None:
             scale = float(getattr(probe, "obs_scale", 1.0))
             for module in args.modules.split(","):
                 torch.manual_seed(args.seed)
-                config = ModelConfig.for_family(family, module, shape, scale, preset=preset)
+                query = args.query if module == "predinet" else None
+                config = ModelConfig.for_family(
+                    family, module, shape, scale, preset=preset, query=query
+                )
                 model = ActorCritic(config)
                 row = {"env": env, "module": module, "preset": preset, "obs_shape": list(shape)}
+                row["query"] = config.query
                 row.update(input_signal(model, obs.numpy()))
                 row["rollout_reward"] = total
                 row["grads"] = gradient_report(
                     model, obs, actions, returns, train.normalize_advantages
                 )
                 print(json.dumps(row), flush=True)
+                if args.ppo_updates and preset != "thesis":  # thesis is A3C only
+                    after = signal_after_ppo_updates(
+                        model, env, obs.numpy(), args.ppo_updates, args.seed, **kwargs
+                    )
+                    for update, figures in enumerate(after, 1):
+                        short = {k: row[k] for k in ("env", "module", "preset", "query")}
+                        print(json.dumps({**short, "ppo_update": update, **figures}), flush=True)
 
 
 if __name__ == "__main__":

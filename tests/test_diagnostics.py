@@ -7,7 +7,13 @@ import pytest
 import torch
 
 from neurosym.agent.config import ModelConfig, preset_env_kwargs
-from neurosym.agent.diagnostics import gradient_report, input_signal, random_observations
+from neurosym.agent.diagnostics import (
+    fixed_cell_share,
+    gradient_report,
+    input_signal,
+    random_observations,
+    signal_after_ppo_updates,
+)
 from neurosym.agent.model import ActorCritic
 
 
@@ -54,3 +60,32 @@ def test_gradient_report_splits_actor_and_critic(bw1_obs) -> None:
     assert report["value"]["actor"] == 0 and report["value"]["critic"] > 0
     assert report["policy"]["critic"] == 0 and report["policy"]["actor"] > 0
     assert report["encoder"]["actor"] > 0 and report["encoder"]["critic"] > 0
+
+
+def test_fixed_cell_share_tells_position_from_content() -> None:
+    attention = torch.zeros(2, 4, 1, 5)  # (a1|a2, B, H, N)
+    attention[0, :, 0, 3] = 1.0  # attention1 always on cell 3: by position
+    attention[1, torch.arange(4), 0, torch.tensor([0, 1, 2, 2])] = 1.0  # attention2 follows
+    assert fixed_cell_share(attention) == [1.0, 0.5]
+
+
+@pytest.mark.expensive
+def test_one_ppo_update_saturates_scene_queries_not_learned_ones(bw1_obs) -> None:
+    """Why --query learned exists: Adam's first steps on the 5,096-input scene-query layer turn
+    the fresh attention into a near one-hot on fixed cells; learned queries move by ~lr."""
+    probe = bw1_obs["default"][:64]
+    after = {}
+    for query in ("scene", "learned"):
+        torch.manual_seed(0)
+        config = ModelConfig.for_family("boxworld", "predinet", probe.shape[1:], query=query)
+        model = ActorCritic(config)
+        before = input_signal(model, probe)
+        assert before["attention_max"] < 0.1  # both start out spread
+        after[query] = signal_after_ppo_updates(
+            model, "bw1", probe, 1, **preset_env_kwargs("boxworld")
+        )[0]
+    # bench/diagnose.py --ppo-updates 2 (16 envs x 32 steps): scene 0.033 -> 0.66 -> 0.78
+    # (entropy 95 % -> 19 % -> 12 % of uniform's); learned 0.079 -> 0.076 -> 0.076
+    assert after["scene"]["attention_max"] > 0.5
+    assert after["learned"]["attention_max"] < 0.1
+    assert after["learned"]["attention_entropy_ratio"] > 0.8

@@ -13,6 +13,12 @@ of a fresh (or trained) model on a batch of observations:
   critic's gradient on the shared layers is orders of magnitude above the
   actor's, the shared layers learn to predict value and nothing else.
 
+* :func:`signal_after_ppo_updates`: the same figures after each of the first
+  PPO updates. A fresh network that sees its input can stop seeing it in one
+  update: PrediNet's scene queries are a 5,096-input layer on bw1, Adam moves
+  each weight by about lr whatever its gradient's size, and the attention
+  saturates on fixed cells (``fixed_cell_share`` near 1).
+
 ``bench/diagnose.py`` prints both for every env family and module, for the
 model switches and learner settings of a preset, so a change to either is
 judged by these figures before and after.
@@ -59,7 +65,7 @@ def input_signal(model: ActorCritic, obs: np.ndarray) -> dict[str, float]:
     p = weights.clamp_min(1e-30)
     entropy = -(p * p.log()).sum(-1)  # per query
     probs = torch.softmax(logits, dim=-1)
-    return {
+    report = {
         "logit_std": float(logits.std(dim=0).mean()),
         "value_std": float(value.std()),
         "policy_max_prob": float(probs.max(dim=-1).values.mean()),
@@ -67,6 +73,22 @@ def input_signal(model: ActorCritic, obs: np.ndarray) -> dict[str, float]:
         "attention_uniform": 1.0 / n,
         "attention_entropy_ratio": float(entropy.mean() / math.log(n)),
     }
+    if hasattr(intro, "attention1"):
+        report["fixed_cell_share"] = fixed_cell_share(weights)
+    return report
+
+
+def fixed_cell_share(attention: torch.Tensor) -> list[float]:
+    """Per PrediNet attention (both of every head): the share of observations whose most
+    attended cell is that attention's most common one. 1.0 is attention by position (the
+    same cell whatever the scene), about 1/B attention that follows the scene. Telling only
+    when the attention is peaked (``attention_max`` well above 1/N): a near-uniform
+    attention's argmax is decided by small position-dependent terms.
+
+    ``attention``: (2, B, H, N), attention1 and attention2 stacked."""
+    top = attention.argmax(dim=-1)  # (2, B, H)
+    top = top.permute(0, 2, 1).reshape(-1, top.shape[1])  # (2H, B): a1 heads, then a2 heads
+    return [float(torch.bincount(row).max()) / row.numel() for row in top]
 
 
 def gradient_report(
@@ -125,3 +147,37 @@ def explained_variance(predicted: torch.Tensor, target: torch.Tensor) -> float:
     if var <= 0:
         return float("nan")
     return float(1.0 - (target - predicted).var() / var)
+
+
+def signal_after_ppo_updates(
+    model: ActorCritic,
+    env: str,
+    probe: np.ndarray,
+    updates: int,
+    seed: int = 0,
+    envs: int = 16,
+    n_steps: int = 32,
+    **env_kwargs: Any,
+) -> list[dict[str, Any]]:
+    """:func:`input_signal` on ``probe`` after each of ``updates`` PPO updates of ``model`` (in
+    place) on its own rollouts, with the family's PPO settings but ``envs`` x ``n_steps``
+    rollouts and 2 passes (8 Adam steps per update)."""
+    from neurosym.agent.a3c import AdvantageScale, shared_optimizer
+    from neurosym.agent.config import TrainConfig
+    from neurosym.agent.ppo import ppo_update
+    from neurosym.agent.rollout import RolloutState, collect_rollout
+    from neurosym.envs import env_family, make_batched
+
+    train = TrainConfig.for_family(
+        env_family(env), algo="ppo", envs=envs, n_steps=n_steps, ppo_epochs=2
+    )
+    optimizer = shared_optimizer(model.parameters(), train)
+    state = RolloutState(make_batched(env, envs, seed=seed, **env_kwargs), seed)
+    generator = torch.Generator().manual_seed(seed)
+    scale = AdvantageScale()
+    figures = []
+    for _ in range(updates):
+        rollout, _ = collect_rollout(model, state, n_steps, generator, None, record=True)
+        ppo_update(model, optimizer, rollout, train, generator, scale)
+        figures.append(input_signal(model, probe))
+    return figures
