@@ -26,6 +26,13 @@ and relational modules cost or save::
     python bench/peers.py --runs sb3-ppo --frames 500000
     python bench/peers.py --frames 5000000 --minutes 15          # each run: 15 minutes at most
     python bench/peers.py --runs neurosym-a3c --a3c-args '--envs 32'   # other train flags
+
+neurosym's fastest learner on bw1 so far (README, "Beside the thesis": 2.7-4.2x
+SB3's PPO in wall time on seeds 0-2, 2026-11-26) is PPO with learned PrediNet
+queries, short rollouts and a running advantage scale::
+
+    python bench/peers.py --env bw1 --frames 5000000 --minutes 8 --runs neurosym-ppo \
+        --ppo-args '--n-steps 64 --ppo-epochs 2 --query learned --ppo-advantages running'
 """
 
 from __future__ import annotations
