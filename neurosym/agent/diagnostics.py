@@ -53,7 +53,7 @@ def random_observations(env: str, n: int, seed: int = 0, **env_kwargs: Any) -> n
 
 
 @torch.no_grad()
-def input_signal(model: ActorCritic, obs: np.ndarray) -> dict[str, float]:
+def input_signal(model: ActorCritic, obs: np.ndarray) -> dict[str, Any]:
     """Spread of logits, value and attention over a batch of observations."""
     logits, value, intro = model(torch.from_numpy(obs), introspect=True)
     n = model.config.n_entities
