@@ -27,10 +27,12 @@ and relational modules cost or save::
     python bench/peers.py --frames 5000000 --minutes 15          # each run: 15 minutes at most
     python bench/peers.py --runs neurosym-a3c --a3c-args '--envs 32'   # other train flags
 
-neurosym's fastest learner on bw1 so far (README, "Beside the thesis": 2.7-4.2x
-SB3's PPO in wall time on seeds 0-2, 2026-11-26) is PPO with learned PrediNet
-queries, short rollouts and a running advantage scale::
+neurosym's fastest learners on bw1 so far (README "Measured", 2026-11-26) have
+learned PrediNet queries: A3C 4.5-7.1x SB3's PPO in wall time to 90 % (seeds
+0-2), PPO with short rollouts and a running advantage scale 2.7-4.2x (seeds 0-3)::
 
+    python bench/peers.py --env bw1 --frames 5000000 --minutes 8 --runs neurosym-a3c \
+        --a3c-args '--query learned'
     python bench/peers.py --env bw1 --frames 5000000 --minutes 8 --runs neurosym-ppo \
         --ppo-args '--n-steps 64 --ppo-epochs 2 --query learned --ppo-advantages running'
 """

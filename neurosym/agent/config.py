@@ -203,9 +203,10 @@ class ModelConfig:
     64 x 2 on bw1: 2.3-3.2 k frames/s against 1.5-2.0 k). Measured on bw1 (PPO 64 steps x 2
     passes, frames to 90 % training success, seeds 0/1/2): scene 657 k / none / none in 8
     minutes; learned none (seed 0 collapsed to 0.2 % success) / 1,216 k / 461 k; learned with
-    ppo_advantages "running" 652 k / 787 k / 542 k (seed 3: 624 k). Not yet measured on
-    bw2/bw3 or under A3C, and bw2/bw3's chains may need a query that depends on the held
-    key, so "scene" stays the default."""
+    ppo_advantages "running" 652 k / 787 k / 542 k (seed 3: 624 k). A3C (the defaults): scene
+    1,167 k / none / none in 10 minutes, learned 531 k / 837 k / 705 k (135-205 s). Not yet
+    measured on bw2/bw3, whose chains may need a query that depends on the held key, so
+    "scene" stays the default."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
@@ -356,8 +357,8 @@ class TrainConfig:
     collapse, but took off later on seed 0 (75 % after 897 k frames against 90 % at 657 k) and
     not at all on seed 1, so the default stays "minibatch". With learned PrediNet queries
     (ModelConfig.query) it is what kept seed 0 from the same collapse (0.2 % after 1.29 M
-    frames per minibatch; 90 % at 652 k with "running"), and that pair is the fastest bw1
-    learner measured here (README "Measured"; not the default, since bw2/bw3 are unmeasured)
+    frames per minibatch; 90 % at 652 k with "running"), and that pair is the fastest PPO on
+    bw1 measured here (README "Measured"; not the default, since bw2/bw3 are unmeasured)
     """
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""
