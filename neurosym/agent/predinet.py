@@ -202,6 +202,28 @@ class PrediNet(nn.Module):
         finally:
             self._recording = None
 
+    def _scene_attention(
+        self, L: torch.Tensor, queries: QueryRecord | None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Attention with queries from flat(L), reusing a valid record and feeding an open one."""
+        q_head = None
+        if queries is not None and queries.parts and queries.key == self.weights_key():
+            q_head = torch.cat(queries.parts) if len(queries.parts) > 1 else queries.parts[0]
+            if q_head.shape[0] > L.shape[0]:
+                q_head = None
+        a, e, q = PrediNetAttention.apply(
+            L,
+            torch.cat([self.query1.weight, self.query2.weight]),
+            self.key.weight,
+            self.scale,
+            q_head,
+        )
+        recording = getattr(self, "_recording", None)
+        if recording is not None and not torch.is_grad_enabled():
+            if recording.key == self.weights_key():
+                recording.parts.append(q)
+        return a, e
+
     def forward(
         self, L: torch.Tensor, introspect: bool = False, queries: QueryRecord | None = None
     ):
@@ -209,27 +231,12 @@ class PrediNet(nn.Module):
         ``L``, used only while the weights are unchanged (else recomputed)."""
         B, N, F = L.shape
         H = self.heads
-        q_head = None
-        if queries is not None and queries.parts and queries.key == self.weights_key():
-            q_head = torch.cat(queries.parts) if len(queries.parts) > 1 else queries.parts[0]
-            if q_head.shape[0] > B:
-                q_head = None
-        if self.query_mode == "learned":  # nothing worth recording: the queries are weights
-            a, e, q = PrediNetAttention.apply(
+        if self.query_mode == "learned":  # nothing to record or reuse: the queries are weights
+            a, e, _ = PrediNetAttention.apply(
                 L, None, self.key.weight, self.scale, None, self.queries
             )
         else:
-            a, e, q = PrediNetAttention.apply(
-                L,
-                torch.cat([self.query1.weight, self.query2.weight]),
-                self.key.weight,
-                self.scale,
-                q_head,
-            )
-        recording = getattr(self, "_recording", None)
-        if recording is not None and not torch.is_grad_enabled() and self.query_mode != "learned":
-            if recording.key == self.weights_key():
-                recording.parts.append(q)
+            a, e = self._scene_attention(L, queries)
         a1, a2, e1, e2 = a[:, :H], a[:, H:], e[:, :H], e[:, H:]  # (B, H, N), (B, H, F)
         rel = self.embed(e1[..., :-2] - e2[..., :-2])  # (B, H, J)  D^h
         pos1, pos2 = e1[..., -2:], e2[..., -2:]  # (B, H, 2)
