@@ -129,3 +129,30 @@ def test_on_a_recording_and_in_the_extract_report(
     print_report(rec, facts, written, kb=written.get("kb.pl"))
     text = capsys.readouterr().out
     assert "two objects" in text and "next object" in text and "top pairs (share of states)" in text
+    assert "on or beside two objects" in text and "top pair (share of states)" in text
+
+
+def test_beside_reads_a_terrain_argument_as_the_object_next_to_it() -> None:
+    # one state's map: agent (2, 2), sword (2, 5), enemy (5, 5), a pit (4, 3)
+    positions = pd.DataFrame(
+        [(0, 0, "agent", "agent", 2, 2), (0, 0, "sword_1", "sword", 2, 5)]
+        + [(0, 0, "enemy_1", "enemy", 5, 5), (0, 0, "pit_1", "pit", 4, 3)],
+        columns=["episode", "t", "object", "type", "row", "col"],
+    )
+    rows = [
+        (0, 0, 0, ("empty", 2, 3), ("sword", 2, 5)),  # beside the agent, on the sword
+        (0, 0, 1, ("empty", 1, 2), ("empty", 2, 4)),  # beside the agent, beside the sword
+        (0, 0, 2, ("empty", 2, 4), ("sword", 2, 5)),  # the sword twice: one object, not two
+        (0, 0, 3, ("agent", 2, 2), ("empty", 8, 8)),  # nothing beside (8, 8): not read as one
+        (0, 0, 4, ("wall", 4, 4), ("agent", 2, 2)),  # beside the pit and the enemy: ties by name
+    ]
+    rec = attends(rows)
+    rec.positions = positions
+    df = head_summary(rec).set_index("head")
+    assert df["two_objects"].tolist() == [0.0] * 5  # the strict figure counts none of them
+    assert df["beside_objects"].tolist() == [1.0, 1.0, 0.0, 0.0, 1.0]
+    # (4, 4) touches the pit (4, 3) and the enemy (5, 5), both one cell away: 'enemy' sorts first
+    assert df["beside_pair"].tolist() == ["agent-sword", "agent-sword", None, None, "enemy-agent"]
+    assert df.loc[0, "beside_share"] == pytest.approx(1.0) and df.loc[2, "beside_share"] is None
+    # a recording without positions: None, not 0
+    assert head_summary(attends(rows))["beside_objects"].tolist() == [None] * 5

@@ -25,6 +25,17 @@ is where relations show. :func:`head_summary` measures it from a recording's
   enemy scores near 1; one fixed on the sword scores only the states before
   it is taken.
 
+* ``beside_objects``, ``beside_pair``, ``beside_share``: the same count with
+  each argument read as the object on its cell or, on a terrain cell, the
+  object on one of the 8 cells around it (the nearest by row and column;
+  ties: the type name, then row, then column). An entity is a conv feature of
+  a neighbourhood (3 x 3 cells for Table 4's encoder), so a head that
+  attends to the cell beside the agent still sees the agent, and one that
+  does so on most states relates the agent to its other argument, which
+  ``two_objects`` does not count. None without a ``positions`` table.
+  ``two_objects`` stays the strict figure (the argmax cell itself); this
+  one says where the strict one misses a head that looks beside objects.
+
 ``neurosym extract`` prints this table; the function returns it as a DataFrame
 (``df.to_dict("records")`` gives JSON-ready rows).
 """
@@ -33,6 +44,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 BACKGROUND = ("empty", "wall", "mountain")
@@ -80,6 +92,7 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
     columns = ["head", "states", "two_objects", "next_object"]
     for k in range(1, top + 1):
         columns += [f"pair_{k}", f"share_{k}"]
+    columns += ["beside_objects", "beside_pair", "beside_share"]
     att = rec.attends
     if att is None or att.empty:
         return pd.DataFrame(columns=columns)
@@ -94,6 +107,7 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
         & ((both["row_1"] != both["row_2"]) | (both["col_1"] != both["col_2"]))
     )
     both["pair"] = both["entity_1"].astype(str) + "-" + both["entity_2"].astype(str)
+    beside = _beside_pairs(both, getattr(rec, "positions", None))  # (pair or None) per row
     both["next"] = _next_at(both, next_objects(rec))
     ahead = both["next"].notna()
     on_next = ahead & ((both["entity_1"] == both["next"]) | (both["entity_2"] == both["next"]))
@@ -111,9 +125,11 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
                 row[f"pair_{k}"], row[f"share_{k}"] = counts.index[k - 1], counts.iloc[k - 1] / n
             else:
                 row[f"pair_{k}"], row[f"share_{k}"] = None, None
+        row.update(_top_beside(beside, group.index, n))
         rows.append(row)
     df = pd.DataFrame(rows, columns=columns)
     names = ["next_object"] + [f"{c}_{k}" for k in range(1, top + 1) for c in ("pair", "share")]
+    names += ["beside_objects", "beside_pair", "beside_share"]
     for name in names:  # None where a head has fewer pairs or nothing ahead (not NaN: JSON-ready)
         df[name] = pd.Series([r[name] for r in rows], dtype=object)
     return df
@@ -128,3 +144,52 @@ def _next_at(states: pd.DataFrame, ahead: pd.DataFrame) -> pd.Series:
     found = pd.merge_asof(left, right, on="t", by="episode", direction="forward")
     out = found.set_index("index")["next"].reindex(states.index)
     return out.astype(object).where(out.notna(), None)
+
+
+def _beside_pairs(both: pd.DataFrame, positions: pd.DataFrame | None) -> pd.Series | None:
+    """Per row of ``both`` (one state and head): "type-type" of the two objects its arguments
+    are read as (on the cell, else the nearest of the 8 around it), None where that is not two
+    different objects; None in all when there is no ``positions`` table."""
+    if positions is None or positions.empty:
+        return None
+    pos = positions[["episode", "t", "type", "row", "col"]].astype(
+        {"episode": "int64", "t": "int64", "row": "int64", "col": "int64"}
+    )
+    read = []
+    for arg in (1, 2):
+        cells = both[["episode", "t", f"entity_{arg}", f"row_{arg}", f"col_{arg}"]].copy()
+        cells.columns = ["episode", "t", "entity", "row", "col"]
+        cells = cells.astype({"episode": "int64", "t": "int64", "row": "int64", "col": "int64"})
+        cells["cell"] = range(len(cells))
+        on = ~cells["entity"].isin(BACKGROUND)
+        obj = pd.DataFrame(index=cells.index, columns=["type", "row", "col"], dtype=object)
+        obj.loc[on, "type"] = cells.loc[on, "entity"].astype(str)
+        obj.loc[on, ["row", "col"]] = cells.loc[on, ["row", "col"]].to_numpy()
+        near = cells[~on].merge(pos, on=["episode", "t"], suffixes=("", "_o"))
+        dist = np.maximum((near["row"] - near["row_o"]).abs(), (near["col"] - near["col_o"]).abs())
+        near = near[dist == 1].assign(dist=dist[dist == 1])
+        near = near.sort_values(["cell", "dist", "type", "row_o", "col_o"], kind="stable")
+        near = near.drop_duplicates("cell")  # the first, nearest object of each cell
+        index = cells.index[near["cell"].to_numpy()]
+        obj.loc[index, "type"] = near["type"].astype(str).to_numpy()
+        obj.loc[index, ["row", "col"]] = near[["row_o", "col_o"]].to_numpy()
+        read.append(obj)
+    first, second = read
+    found = first["type"].notna() & second["type"].notna()
+    other = (first["row"] != second["row"]) | (first["col"] != second["col"])
+    other |= first["type"] != second["type"]
+    pairs = first["type"].astype(str) + "-" + second["type"].astype(str)
+    return pairs.where(found & other, None)
+
+
+def _top_beside(beside: pd.Series | None, index: pd.Index, n: int) -> dict[str, Any]:
+    """beside_objects, beside_pair, beside_share of one head's rows (all None without positions)."""
+    if beside is None:
+        return {"beside_objects": None, "beside_pair": None, "beside_share": None}
+    mine = beside.loc[index].dropna()
+    counts = mine.value_counts().sort_index().sort_values(ascending=False, kind="stable")
+    return {
+        "beside_objects": len(mine) / n,
+        "beside_pair": counts.index[0] if len(counts) else None,
+        "beside_share": counts.iloc[0] / n if len(counts) else None,
+    }

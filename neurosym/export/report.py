@@ -121,6 +121,23 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
             escape(", ".join(pairs) or "none"),
         )
     say(table)
+    if heads["beside_objects"].isna().all():
+        return
+    beside = table_type(
+        title="heads: arguments on or beside two different objects",
+        show_edge=False,
+    )
+    for col in ("head", "on or beside two objects", "top pair (share of states)"):
+        beside.add_column(col, justify="left" if col.startswith("top") else "right")
+    for row in heads.to_dict("records"):
+        share = row["beside_objects"]
+        pair = row["beside_pair"]
+        beside.add_row(
+            str(row["head"]),
+            "-" if share is None else f"{100 * share:.0f} %",
+            "none" if pair is None else escape(f"{pair} {100 * row['beside_share']:.0f} %"),
+        )
+    say(beside)
 
 
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
