@@ -3,7 +3,7 @@
 ``neurosym extract`` reports per PrediNet head how often its two arguments are
 two different objects (``two_objects``, the argmax cells themselves) and how
 often they are on or beside two (``beside_objects``, terrain read as the
-nearest object on the 8 cells around it). The second reading is lenient on a
+object on the 8 cells around it). The second reading is lenient on a
 small map crowded with objects, so a figure needs its chance level: the same
 two numbers when each state's two arguments are drawn uniformly from the grid
 (an object's cell names that object, any other cell is terrain), over the same

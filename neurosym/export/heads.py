@@ -26,9 +26,9 @@ is where relations show. :func:`head_summary` measures it from a recording's
   it is taken.
 
 * ``beside_objects``, ``beside_pair``, ``beside_share``: the same count with
-  each argument read as the object on its cell or, on a terrain cell, the
-  object on one of the 8 cells around it (the nearest by row and column;
-  ties: the type name, then row, then column). An entity is a conv feature of
+  each argument read as the object on its cell or, on a terrain cell, an
+  object on one of the 8 cells around it (where there are several, the first
+  by type name, then row, then column). An entity is a conv feature of
   a neighbourhood (3 x 3 cells for Table 4's encoder), so a head that
   attends to the cell beside the agent still sees the agent, and one that
   does so on most states relates the agent to its other argument, which
@@ -148,7 +148,7 @@ def _next_at(states: pd.DataFrame, ahead: pd.DataFrame) -> pd.Series:
 
 def _beside_pairs(both: pd.DataFrame, positions: pd.DataFrame | None) -> pd.Series | None:
     """Per row of ``both`` (one state and head): "type-type" of the two objects its arguments
-    are read as (on the cell, else the nearest of the 8 around it), None where that is not two
+    are read as (on the cell, else one on the 8 cells around it), None where that is not two
     different objects; None in all when there is no ``positions`` table."""
     if positions is None or positions.empty:
         return None
@@ -167,9 +167,8 @@ def _beside_pairs(both: pd.DataFrame, positions: pd.DataFrame | None) -> pd.Seri
         obj.loc[on, ["row", "col"]] = cells.loc[on, ["row", "col"]].to_numpy()
         near = cells[~on].merge(pos, on=["episode", "t"], suffixes=("", "_o"))
         dist = np.maximum((near["row"] - near["row_o"]).abs(), (near["col"] - near["col_o"]).abs())
-        near = near[dist == 1].assign(dist=dist[dist == 1])
-        near = near.sort_values(["cell", "dist", "type", "row_o", "col_o"], kind="stable")
-        near = near.drop_duplicates("cell")  # the first, nearest object of each cell
+        near = near[dist == 1].sort_values(["cell", "type", "row_o", "col_o"], kind="stable")
+        near = near.drop_duplicates("cell")  # one object per cell: the first by type, row, col
         index = cells.index[near["cell"].to_numpy()]
         obj.loc[index, "type"] = near["type"].astype(str).to_numpy()
         obj.loc[index, ["row", "col"]] = near[["row_o", "col_o"]].to_numpy()
