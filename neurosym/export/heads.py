@@ -118,8 +118,7 @@ def head_summary(rec: Any, top: int = 3) -> pd.DataFrame:
         row: dict[str, Any] = {"head": int(head), "states": n, "two_objects": float(mask.mean())}
         n_ahead = int(ahead.loc[group.index].sum())
         row["next_object"] = float(on_next.loc[group.index].sum() / n_ahead) if n_ahead else None
-        counts = group.loc[mask, "pair"].value_counts()
-        counts = counts.sort_index().sort_values(ascending=False, kind="stable")  # ties: by name
+        counts = _ranked(group.loc[mask, "pair"])
         for k in range(1, top + 1):
             if k <= len(counts):
                 row[f"pair_{k}"], row[f"share_{k}"] = counts.index[k - 1], counts.iloc[k - 1] / n
@@ -146,30 +145,34 @@ def _next_at(states: pd.DataFrame, ahead: pd.DataFrame) -> pd.Series:
     return out.astype(object).where(out.notna(), None)
 
 
+def _ranked(pairs: pd.Series) -> pd.Series:
+    """Counts of each pair, most frequent first; equal counts ordered by name."""
+    return pairs.value_counts().sort_index().sort_values(ascending=False, kind="stable")
+
+
 def _beside_pairs(both: pd.DataFrame, positions: pd.DataFrame | None) -> pd.Series | None:
     """Per row of ``both`` (one state and head): "type-type" of the two objects its arguments
     are read as (on the cell, else one on the 8 cells around it), None where that is not two
     different objects; None in all when there is no ``positions`` table."""
     if positions is None or positions.empty:
         return None
-    pos = positions[["episode", "t", "type", "row", "col"]].astype(
-        {"episode": "int64", "t": "int64", "row": "int64", "col": "int64"}
-    )
+    ints = {"episode": "int64", "t": "int64", "row": "int64", "col": "int64"}
+    pos = positions[["episode", "t", "type", "row", "col"]].astype(ints)
     read = []
     for arg in (1, 2):
         cells = both[["episode", "t", f"entity_{arg}", f"row_{arg}", f"col_{arg}"]].copy()
         cells.columns = ["episode", "t", "entity", "row", "col"]
-        cells = cells.astype({"episode": "int64", "t": "int64", "row": "int64", "col": "int64"})
-        cells["cell"] = range(len(cells))
+        cells = cells.astype(ints)
         on = ~cells["entity"].isin(BACKGROUND)
         obj = pd.DataFrame(index=cells.index, columns=["type", "row", "col"], dtype=object)
         obj.loc[on, "type"] = cells.loc[on, "entity"].astype(str)
         obj.loc[on, ["row", "col"]] = cells.loc[on, ["row", "col"]].to_numpy()
-        near = cells[~on].merge(pos, on=["episode", "t"], suffixes=("", "_o"))
+        near = cells[~on].rename_axis("cell").reset_index()  # "cell": the row of ``both``
+        near = near.merge(pos, on=["episode", "t"], suffixes=("", "_o"))
         dist = np.maximum((near["row"] - near["row_o"]).abs(), (near["col"] - near["col_o"]).abs())
         near = near[dist == 1].sort_values(["cell", "type", "row_o", "col_o"], kind="stable")
         near = near.drop_duplicates("cell")  # one object per cell: the first by type, row, col
-        index = cells.index[near["cell"].to_numpy()]
+        index = near["cell"].to_numpy()
         obj.loc[index, "type"] = near["type"].astype(str).to_numpy()
         obj.loc[index, ["row", "col"]] = near[["row_o", "col_o"]].to_numpy()
         read.append(obj)
@@ -186,7 +189,7 @@ def _top_beside(beside: pd.Series | None, index: pd.Index, n: int) -> dict[str, 
     if beside is None:
         return {"beside_objects": None, "beside_pair": None, "beside_share": None}
     mine = beside.loc[index].dropna()
-    counts = mine.value_counts().sort_index().sort_values(ascending=False, kind="stable")
+    counts = _ranked(mine)
     return {
         "beside_objects": len(mine) / n,
         "beside_pair": counts.index[0] if len(counts) else None,
