@@ -185,6 +185,29 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     assert ev.returncode == 0, ev.stderr[-2000:]
 
 
+def test_train_with_a_local_view_records_it_and_resumes_with_it(
+    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
+    """--local-view is a model switch: in the checkpoint's config and command, kept on --resume."""
+    out = tmp_path / "run"
+    first = neurosym("train", "--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
+                     "--envs", "4", "--n-steps", "8", "--dagger-steps", "1", "--frames", "64",
+                     "--kernel-size", "1", "--local-view", "3", "--quiet", "--eval-episodes", "1",
+                     "--out", out)  # fmt: skip
+    assert first.returncode == 0, first.stderr[-2000:]
+    again = neurosym("train", "--out", out, "--resume", "--frames", "128", "--quiet",
+                     "--eval-episodes", "1")  # fmt: skip
+    assert again.returncode == 0, again.stderr[-2000:]
+    agent = load_agent(out / "checkpoint.pt")
+    config = agent.config
+    assert (config.local_view, config.agent_plane, config.kernel_size) == (3, 0, 1)
+    assert "--kernel-size 1 --local-view 3" in agent.meta["command"]
+    assert agent.model.body[0].in_features == agent.config.output_size + 9 * 9
+    other = neurosym("train", "--out", out, "--resume", "--frames", "200", "--local-view", "5")
+    assert other.returncode != 0
+    assert "local_view 3 (asked for 5)" in other.stderr, other.stderr[-2000:]
+
+
 def test_train_imitate_on_box_world_is_one_line(
     neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:

@@ -57,6 +57,7 @@ _OVERRIDES = (
     ("--value-size", "value_size", "model"),
     ("--conv-channels", "conv_channels", "model"),
     ("--kernel-size", "kernel_size", "model"),
+    ("--local-view", "local_view", "model"),
 )
 
 
@@ -202,6 +203,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     model.add_argument(
         "--kernel-size", type=int, help="encoder conv kernel, stride 1, grid shape kept (2)"
+    )
+    model.add_argument(
+        "--local-view",
+        type=int,
+        metavar="K",
+        help="the MLP also sees the K x K cells around the agent, K odd (0: off, Table 4)",
     )
     model.add_argument(
         "--attention-gain", type=float, help="factor on the attention logits (default 8; thesis 1)"

@@ -124,6 +124,8 @@ _DEFAULT_MODEL: dict[str, dict[str, Any]] = {
     # weights and about 60 % of a forward-backward; 32 halves both
     "boxworld": {**_SEEING_MODEL, "key_size": 32},
 }
+# the one-hot plane that marks the agent (neurosym/envs/rgw_rules.py, boxworld_entities.py)
+_AGENT_PLANE: dict[str, int] = {"rgw": 0, "boxworld": 1}
 _LEGACY: dict[str, dict[str, Any]] = {
     # what the code did before each setting existed (checkpoints without the key)
     "ModelConfig": {"entity_norm": False, "attention_gain": 1.0, "init": "torch"},
@@ -216,6 +218,18 @@ class ModelConfig:
     gives 3.7e-3 (bench/diagnose.py). The policy head starts at gain 0.01 either way (a near
     uniform first policy)."""
 
+    local_view: int = 0
+    """0 (Table 4's network, the default): the actor-critic MLP sees only the relational
+    module's output. K (odd): it also sees the one-hot K x K window of cells centred on the
+    agent (zeros off the grid), flattened. With single-cell entities (kernel_size 1) a head
+    must attend a cell to know what is on it, and the cells agent of issue 11 fell into a pit
+    in 37 % of unseen levels (`neurosym eval --checkpoint
+    checkpoints/rgw-random-predinet-cells.pt --episodes 100 --seed 3000000000 --sample`): a
+    3 x 3 window shows what one step can reach, so the heads are left with what lies beyond"""
+    agent_plane: int = -1
+    """the observation plane marking the agent, which ``local_view`` centres on (RGW 0,
+    Box-World's one-hot 1; -1 when local_view is 0)"""
+
     def __post_init__(self) -> None:
         if self.module not in MODULES:
             raise ConfigError(
@@ -256,11 +270,25 @@ class ModelConfig:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
         if not self.attention_gain > 0:
             raise ConfigError(f"attention_gain must be positive, got {self.attention_gain}")
+        if self.local_view < 0 or (self.local_view and self.local_view % 2 == 0):
+            raise ConfigError(
+                f"local_view must be 0 (off) or an odd window size such as 3, got {self.local_view}"
+            )
+        if self.local_view and not 0 <= self.agent_plane < self.obs_shape[0]:
+            raise ConfigError(
+                f"local_view needs the agent's plane, one of 0..{self.obs_shape[0] - 1}, "
+                f"got {self.agent_plane}"
+            )
 
     @property
     def n_entities(self) -> int:
         """Entities the relational module sees: one per grid cell."""
         return self.obs_shape[1] * self.obs_shape[2]
+
+    @property
+    def local_size(self) -> int:
+        """Features of the window around the agent the MLP sees besides the relations (0: none)."""
+        return self.obs_shape[0] * self.local_view**2
 
     @property
     def entity_size(self) -> int:
@@ -286,6 +314,13 @@ class ModelConfig:
             **switches,
             **{k: v for k, v in overrides.items() if v is not None},
         }
+        if values.get("local_view"):
+            if obs_scale != 1.0:
+                raise ConfigError(
+                    "--local-view reads the agent's plane of a one-hot observation; this env's "
+                    "observation is grey or RGB (use obs_mode=onehot)"
+                )
+            values["agent_plane"] = _AGENT_PLANE[family]
         return cls(module=module, obs_shape=obs_shape, obs_scale=obs_scale, **values)
 
     def to_dict(self) -> dict[str, Any]:
