@@ -152,7 +152,7 @@ def test_the_cells_predinet_relates_objects_on_rgw2(tmp_path: Path) -> None:
     from neurosym.export.facts import extract_facts
     from neurosym.export.heads import head_summary
     from neurosym.export.recorder import record
-    from neurosym.export.report import RULE_FILES
+    from neurosym.export.report import RULE_FILES, rules_dir
     from neurosym.prolog.knowledge_base import KnowledgeBase
     from neurosym.terms import Term
 
@@ -165,7 +165,9 @@ def test_the_cells_predinet_relates_objects_on_rgw2(tmp_path: Path) -> None:
     goal = heads[(heads["pair_1"] == "agent-enemy") & (heads["pair_2"] == "agent-sword")]
     assert len(goal) == 1, heads
     assert goal["two_objects"].item() > 0.9 and goal["share_1"].item() > 0.5, heads
-    rules = [CHECKPOINTS.parent / "rules" / name for name in RULE_FILES["rgw"]]  # extract's
+    folder = rules_dir()
+    assert folder is not None, "rules/ is not beside the package"
+    rules = [folder / name for name in RULE_FILES["rgw"]]  # the files extract reads
     kb_path = extract_facts(rec).to_prolog(tmp_path / "kb.pl")
     with KnowledgeBase(kb_path, rules=rules) as kb:
         assert kb.once("sword_enemy_link(A)")["A"] == Term("indirect", (("agent",),))

@@ -124,8 +124,6 @@ _DEFAULT_MODEL: dict[str, dict[str, Any]] = {
     # weights and about 60 % of a forward-backward; 32 halves both
     "boxworld": {**_SEEING_MODEL, "key_size": 32},
 }
-# the one-hot plane that marks the agent (neurosym/envs/rgw_rules.py, boxworld_entities.py)
-_AGENT_PLANE: dict[str, int] = {"rgw": 0, "boxworld": 1}
 _LEGACY: dict[str, dict[str, Any]] = {
     # what the code did before each setting existed (checkpoints without the key)
     "ModelConfig": {"entity_norm": False, "attention_gain": 1.0, "init": "torch"},
@@ -138,6 +136,17 @@ _LEGACY: dict[str, dict[str, Any]] = {
         "preset": "legacy",
     },
 }
+
+
+def _agent_plane(family: str) -> int:
+    """The one-hot plane that marks the agent, as the family's env lays out its observation."""
+    if family == "rgw":
+        from neurosym.envs.rgw_rules import AGENT  # plane e holds entity e
+
+        return AGENT
+    from neurosym.envs.boxworld_entities import TYPE_PLANES
+
+    return TYPE_PLANES.index("agent")
 
 
 def _check_family(family: str) -> None:
@@ -323,7 +332,7 @@ class ModelConfig:
                     "--local-view reads the agent's plane of a one-hot observation; this env's "
                     "observation is grey or RGB (use obs_mode=onehot)"
                 )
-            values["agent_plane"] = _AGENT_PLANE[family]
+            values["agent_plane"] = _agent_plane(family)
         return cls(module=module, obs_shape=obs_shape, obs_scale=obs_scale, **values)
 
     def to_dict(self) -> dict[str, Any]:
