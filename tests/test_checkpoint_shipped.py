@@ -68,8 +68,8 @@ UNSEEN = 3_000_000_000
 # bw1-mhdpa: sampled 100 %, greedy 94.7 %; bw2-predinet: 100 %, 97.7 %; bw3-predinet: 99.0 %, 86.3 %;
 # bw2-mhdpa: 97.7 %, 75.3 %; bw3-mhdpa: 100 %, 85.7 %;
 # rgw-random-predinet (DAgger with --augment, 30-minute snapshot): 87.3 %, 52.0 % (on these 100: 82 %, 44 %);
-# rgw-random-mhdpa (DAgger with --augment, 6-layer encoder, 156 minutes): 97.0 %, 81.7 %
-# (on these 100: 97 %, 69 %);
+# rgw-random-mhdpa (DAgger with --augment, 6-layer encoder, 251 minutes): 98.3 %, 89.3 %
+# (on these 100: 99 %, 83 %);
 # rgw-random-predinet-deep (DAgger with --augment, 60 + 100 minutes): 99.0 %, 93.3 % (on these 100: 99 %, 90 %);
 # rgw-random-predinet-cells (1 x 1 encoder, 8 heads, DAgger with --augment, 15 + 50 minutes):
 # 40.3 %, 12.3 % (on these 100: 38 %, 10 %); uniformly random actions 4.6 % on rgw-random)
@@ -81,7 +81,7 @@ UNSEEN_FLOOR = {
     "bw3-predinet": {"sample": 0.95, "greedy": 0.75},
     "bw3-mhdpa": {"sample": 0.95, "greedy": 0.75},
     "rgw-random-predinet": {"sample": 0.75, "greedy": 0.4},
-    "rgw-random-mhdpa": {"sample": 0.9, "greedy": 0.6},
+    "rgw-random-mhdpa": {"sample": 0.95, "greedy": 0.75},
     "rgw-random-predinet-deep": {"sample": 0.95, "greedy": 0.85},
     "rgw-random-predinet-cells": {"sample": 0.3, "greedy": 0.06},
 }
