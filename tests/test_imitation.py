@@ -218,3 +218,80 @@ def test_train_imitate_on_box_world_is_one_line(
     assert proc.returncode != 0
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "imitate learns from the RGW planner" in lines[0], proc.stderr
+
+
+def test_regret_names_the_return_each_action_gives_up() -> None:
+    """A mountain the free route avoids costs 0.1, a pit the whole terminal, a dawdle nothing."""
+    from neurosym.envs.rgw_maps import parse_map
+    from neurosym.envs.rgw_solver import Plan, Rules
+
+    level = parse_map("W.W\nMA.\nWP.\nW.T\n")
+    plan = Plan(level.cells, np.array([level.start]), level.height, level.width, Rules())
+    regret = plan.regret(0, level.start, 0, 100)
+    assert regret.dtype == np.float32
+    # up: a free cell, back later at no cost; right: the route; down: the pit; left: the mountain
+    assert regret.tolist() == pytest.approx([0.0, 0.0, 11.0, 0.1])
+    assert plan.action_set(0, level.start, 0, 100).tolist() == [False, True, False, False]
+    # three steps left: only the route (right, down, down) still ends on the terminal
+    assert plan.regret(0, level.start, 0, 3).tolist() == pytest.approx([10.0, 0.0, 11.0, 10.1])
+    # two: no route does; what is left to lose is the pit's -1 and the mountain's -0.1
+    assert plan.regret(0, level.start, 0, 2).tolist() == pytest.approx([0.0, 0.0, 1.0, 0.1])
+
+
+def test_labels_add_regrets_that_vanish_on_the_optimal_sets() -> None:
+    venv = make_batched("rgw-random", 32, seed=5)
+    venv.reset(seed=5)
+    planner = Planner()
+    critical = 0
+    for _ in range(12):
+        sets, values, regret = planner.labels(venv)
+        same_sets, same_values = planner.action_sets(venv)
+        assert (sets == same_sets).all() and (values == same_values).all()
+        assert regret.shape == (32, 4) and (regret >= 0).all() and (regret[sets] == 0).all()
+        critical += int((regret.max(1) > 0).sum())
+        venv.step(sets.argmax(1))
+    assert critical > 0  # some states let an action give return up
+
+
+def test_safe_coef_adds_the_loss_of_the_set_that_gives_nothing_up() -> None:
+    """With safe_coef C the policy loss is the fastest set's plus C times the safe set's."""
+    buf = LabelBuffer(4, (9, 10, 10), np.uint8)
+    optimal = np.array([[True, False, False, False]] * 4)
+    safe = np.array([[True, True, False, False]] * 4)
+    buf.add(np.zeros((4, 9, 10, 10), np.uint8), optimal, np.zeros(4, "f4"), safe)
+    assert (buf.safe[:4] == safe).all()
+    model = seeing_predinet((9, 10, 10))
+    with torch.no_grad():
+        logits = model(torch.zeros(1, 9, 10, 10))[0]
+    fast = imitation_loss(logits, torch.from_numpy(optimal[:1])).item()
+    kept = imitation_loss(logits, torch.from_numpy(safe[:1])).item()
+    losses = {}
+    for coef in (0.0, 3.0):
+        train = TrainConfig.for_family(
+            "rgw", algo="imitate", dagger_batch=4, dagger_steps=1, safe_coef=coef, lr=1e-12
+        )
+        opt = torch.optim.Adam(model.parameters(), lr=1e-12)
+        rng = np.random.default_rng(0)
+        stats = imitation_update(model, opt, buf, train, rng, torch.device("cpu"))
+        losses[coef] = stats.policy_loss
+    assert losses[0.0] == pytest.approx(fast, rel=1e-4)
+    assert losses[3.0] == pytest.approx(fast + 3.0 * kept, rel=1e-4)
+    with pytest.raises(ConfigError, match="--safe-coef weighs DAgger's labels; it needs --algo"):
+        TrainConfig.for_family("rgw", safe_coef=1.0)
+    with pytest.raises(ConfigError, match="safe_coef must be >= 0, got -1"):
+        TrainConfig.for_family("rgw", algo="imitate", safe_coef=-1.0)
+
+
+def test_augmented_safe_sets_turn_with_the_optimal_sets() -> None:
+    """Stacked (B, 4, 2) sets move as one: each column pair stays with its action."""
+    from neurosym.agent.augment import augment_batch
+
+    optimal = torch.tensor([[True, False, False, False], [False, False, True, False]])
+    safe = torch.tensor([[True, True, False, False], [False, True, True, True]])
+    for seed in range(8):
+        obs = torch.zeros(2, 9, 10, 10)
+        gen = torch.Generator().manual_seed(seed)
+        _, moved = augment_batch(obs, torch.stack((optimal, safe), -1), gen)
+        o, s = moved.unbind(-1)
+        assert (o.sum(1) == 1).all() and (s.sum(1) == safe.sum(1)).all()
+        assert (s | ~o).all()  # the fastest action stays inside the safe set

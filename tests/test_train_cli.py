@@ -426,6 +426,10 @@ def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: P
             "planner_coef must be >= 0, got -1.0",
         ),
         (
+            ("--env", "rgw2", "--module", "predinet", "--safe-coef", "2"),
+            "--safe-coef weighs DAgger's labels; it needs --algo imitate, not a3c",
+        ),
+        (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),
             "--env-option wants KEY=VALUE",
         ),

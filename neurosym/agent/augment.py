@@ -57,7 +57,7 @@ def action_permutation(k: int, flip: bool, height: int, width: int) -> tuple[int
 def augment_batch(
     obs: torch.Tensor, actions: torch.Tensor, generator: torch.Generator | None = None
 ) -> tuple[torch.Tensor, torch.Tensor]:
-    """One random symmetry per batch: obs (B, C, H, W), actions (B, A) per-action values or masks.
+    """One random symmetry per batch: obs (B, C, H, W), actions (B, A, ...) per-action values or masks.
 
     Returns the transformed observations and the per-action columns moved to
     their transformed actions. Non-square grids draw only from the

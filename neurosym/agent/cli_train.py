@@ -47,6 +47,7 @@ _OVERRIDES = (
     ("--dagger-beta-frames", "dagger_beta_frames", "train"),
     ("--dagger-steps", "dagger_steps", "train"),
     ("--augment", "augment", "train"),
+    ("--safe-coef", "safe_coef", "train"),
     ("--attention-gain", "attention_gain", "model"),
     ("--entity-norm", "entity_norm", "model"),
     ("--init", "init", "model"),
@@ -166,6 +167,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--augment",
         action=argparse.BooleanOptionalAction,
         help="imitate: fit each minibatch turned or mirrored at random (RGW's symmetries)",
+    )
+    a3c.add_argument(
+        "--safe-coef",
+        type=float,
+        metavar="C",
+        help="imitate: weight of the loss on actions that give return up (the planner's "
+        "regret > 0) beside the fastest actions' loss (0: none)",
     )
     a3c.add_argument(
         "--critic-warmup",

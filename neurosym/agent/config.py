@@ -438,6 +438,13 @@ class TrainConfig:
     """imitate: states per gradient step"""
     dagger_steps: int = 8
     """imitate: gradient steps per rollout of envs x n_steps states"""
+    safe_coef: float = 0.0
+    """imitate: weight of a second set loss beside the planner's fastest actions, whose set is
+    every action that gives no return up (:meth:`rgw_solver.Plan.regret` 0); 0 = none. It is 0
+    wherever no action loses return, so its weight falls only on the states where an episode
+    can miss its optimum (a mountain a free route avoids, the enemy met unarmed). On the
+    shipped MHDPA's sampled play a quarter of the states are such states, and its set loss
+    there (0.21) was twice the rest's (0.11): ``bench/regret_profile.py``"""
     augment: bool = False
     """imitate: fit each minibatch turned by a random quarter turn or mirrored
     (neurosym/agent/augment.py; RGW's rules and its planner are symmetric). Without it the
@@ -488,6 +495,12 @@ class TrainConfig:
             raise ConfigError(
                 f"--planner-coef is an A3C setting; --algo {self.algo} does not use it"
                 + (" (DAgger learns from the planner alone)" if self.algo == "imitate" else "")
+            )
+        if self.safe_coef < 0:
+            raise ConfigError(f"safe_coef must be >= 0, got {self.safe_coef}")
+        if self.safe_coef and self.algo != "imitate":
+            raise ConfigError(
+                f"--safe-coef weighs DAgger's labels; it needs --algo imitate, not {self.algo}"
             )
         if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
             raise ConfigError("entropy, value_coef, explore and sil must be >= 0")

@@ -15,8 +15,12 @@ every visited state is labelled with the planner's optimal actions, and the
 network is fitted on a buffer of the latest labelled states. Labels are the
 *set* of optimal actions (:meth:`Plan.action_set`); the loss is
 ``-log sum_{a optimal} p(a)``, so equal routes are not told apart by an
-arbitrary tie-break. The critic is fitted to the planner's best return still
-to earn (times ``reward_scale``), so that a later RL run can start from it.
+arbitrary tie-break. With ``safe_coef`` C > 0 the loss adds
+``C * -log sum_{a safe} p(a)``, the set of every action that gives no return
+up (the planner's regret 0): it weighs only the states where an episode can
+miss its optimum, which the fastest-route loss weighs like any other. The
+critic is fitted to the planner's best return still to earn (times
+``reward_scale``), so that a later RL run can start from it.
 
 Same signature and messages as :func:`neurosym.agent.ppo.ppo_learner`; one
 process, RGW only (Box-World has no planner here), no torchrun.
@@ -41,31 +45,43 @@ from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
 
 class LabelBuffer:
-    """A ring of the latest labelled states: observations, optimal-action sets, values."""
+    """A ring of the latest labelled states: observations, optimal and safe action sets, values."""
 
     def __init__(self, capacity: int, obs_shape: tuple[int, ...], obs_dtype: np.dtype) -> None:
         self.obs = np.zeros((capacity, *obs_shape), dtype=obs_dtype)
         self.optimal = np.zeros((capacity, 4), dtype=bool)
+        self.safe = np.ones((capacity, 4), dtype=bool)
         self.values = np.zeros(capacity, dtype=np.float32)
         self.size = 0
         self._next = 0
 
-    def add(self, obs: np.ndarray, optimal: np.ndarray, values: np.ndarray) -> None:
+    def add(
+        self,
+        obs: np.ndarray,
+        optimal: np.ndarray,
+        values: np.ndarray,
+        safe: np.ndarray | None = None,
+    ) -> None:
+        """Append states; ``safe`` (n, 4) bool: actions that give no return up (default: all)."""
+        if safe is None:
+            safe = np.ones_like(optimal)
         for start in range(0, len(obs), len(self.obs)):  # a batch larger than the ring wraps
-            o, m, v = (x[start : start + len(self.obs)] for x in (obs, optimal, values))
+            o, m, v, s = (x[start : start + len(self.obs)] for x in (obs, optimal, values, safe))
             idx = (self._next + np.arange(len(o))) % len(self.obs)
-            self.obs[idx], self.optimal[idx], self.values[idx] = o, m, v
+            self.obs[idx], self.optimal[idx], self.values[idx], self.safe[idx] = o, m, v, s
             self._next = int((self._next + len(o)) % len(self.obs))
             self.size = min(self.size + len(o), len(self.obs))
 
     def sample(
         self, n: int, rng: np.random.Generator
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``n`` states drawn uniformly: obs, optimal sets, values, safe sets."""
         idx = rng.integers(0, self.size, n)
         return (
             torch.from_numpy(self.obs[idx]),
             torch.from_numpy(self.optimal[idx]),
             torch.from_numpy(self.values[idx]),
+            torch.from_numpy(self.safe[idx]),
         )
 
 
@@ -98,12 +114,15 @@ def imitation_update(
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
     for _ in range(config.dagger_steps):
-        obs, optimal, values = buffer.sample(config.dagger_batch, rng)
+        obs, optimal, values, safe = buffer.sample(config.dagger_batch, rng)
         if config.augment:  # the level turned or mirrored; the return still to earn is the same
-            obs, optimal = augment_batch(obs, optimal, generator)
+            obs, sets = augment_batch(obs, torch.stack((optimal, safe), dim=-1), generator)
+            optimal, safe = sets.unbind(-1)
         obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
         logits, value = model(obs)
         policy_loss = imitation_loss(logits, optimal)
+        if config.safe_coef:
+            policy_loss = policy_loss + config.safe_coef * imitation_loss(logits, safe.to(device))
         value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
         loss = policy_loss + config.value_coef * value_loss
         optimizer.zero_grad(set_to_none=True)
@@ -157,7 +176,7 @@ def imitation_learner(
             beta = expert_share(frames, train_config.dagger_beta_frames)
             steps = 0
             for _ in range(train_config.n_steps):
-                optimal, values = planner.action_sets(venv)
+                optimal, values, regret = planner.labels(venv)
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
@@ -165,7 +184,7 @@ def imitation_learner(
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end
-                buffer.add(obs[real], optimal[real], values[real])
+                buffer.add(obs[real], optimal[real], values[real], regret[real] <= 0)
                 obs, reward, terminated, truncated, info = venv.step(actions)
                 obs = np.ascontiguousarray(obs)
                 valid, done = tracker.step(venv, reward, terminated, truncated, info)

@@ -477,6 +477,21 @@ class Plan:
         q = self._q(b, pos, removed, remaining)
         return q == q.max()
 
+    def regret(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
+        """(4,) return each action gives up: the best return from the state minus the best after it.
+
+        0 for every action that keeps the optimum in reach (faster or not),
+        0.1 for a step onto a mountain a free route avoids, and so on. What a
+        sampled policy loses by its mass on an action, whatever the route's length.
+        """
+        s = self._state(b, pos, removed)
+        last = len(self.layers) - 1
+        k = min(max(remaining, 1), max(last, 1))
+        g = self.graph
+        after = self.layers[min(k - 1, last)]
+        q = g.reward[:, s] + after.take(g.nxt[:, s])
+        return (int(self.layers[min(k, last)][s]) - q).astype(np.float32) / 10.0
+
     def _q(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
         """(4,) action values toward the best return, on the fewest-step plan that earns it."""
         s = self._state(b, pos, removed)
@@ -523,6 +538,15 @@ class Planner:
             sets.append(plan.action_set(0, *state))
             values.append(plan.value(0, *state))
         return np.stack(sets), np.asarray(values, dtype=np.float32)
+
+    def labels(self, venv: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`action_sets` and (n, 4) float32 each action's :meth:`Plan.regret` per sub-env."""
+        sets, values, regrets = [], [], []
+        for plan, state in self._states(venv):
+            sets.append(plan.action_set(0, *state))
+            values.append(plan.value(0, *state))
+            regrets.append(plan.regret(0, *state))
+        return np.stack(sets), np.asarray(values, dtype=np.float32), np.stack(regrets)
 
     def _states(self, venv: object) -> list[tuple[Plan, tuple[int, int, int]]]:
         env = getattr(venv, "unwrapped", venv)
