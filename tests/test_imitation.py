@@ -238,6 +238,21 @@ def test_regret_names_the_return_each_action_gives_up() -> None:
     assert plan.regret(0, level.start, 0, 2).tolist() == pytest.approx([0.0, 0.0, 1.0, 0.1])
 
 
+def test_regret_lets_the_agent_walk_to_the_farthest_cell_when_time_is_left() -> None:
+    """A corridor: the far end needs every layer of the search, yet with 100 steps left a step
+    onto it gives nothing up (V_99 there is the settled value, not the layer before the last)."""
+    from neurosym.envs.rgw_maps import parse_map
+    from neurosym.envs.rgw_solver import Plan, Rules
+
+    level = parse_map("TA.......\n")
+    plan = Plan(level.cells, np.array([level.start]), level.height, level.width, Rules())
+    far = level.width - 1
+    assert plan.regret(0, far - 1, 0, 100).tolist() == [0.0] * 4
+    assert plan.value(0, far, 0, 99) == pytest.approx(10.0)
+    # with just the steps to the terminal left, any move but the one toward it costs it
+    assert plan.regret(0, far - 1, 0, far - 1).tolist() == pytest.approx([10.0, 10.0, 10.0, 0.0])
+
+
 def test_labels_add_regrets_that_vanish_on_the_optimal_sets() -> None:
     venv = make_batched("rgw-random", 32, seed=5)
     venv.reset(seed=5)

@@ -485,12 +485,12 @@ class Plan:
         sampled policy loses by its mass on an action, whatever the route's length.
         """
         s = self._state(b, pos, removed)
-        last = len(self.layers) - 1
-        k = min(max(remaining, 1), max(last, 1))
+        last = len(self.layers) - 1  # V_i = V_last for every i >= last
+        left = max(remaining, 1)
         g = self.graph
-        after = self.layers[min(k - 1, last)]
+        after = self.layers[min(left - 1, last)]  # V_{remaining - 1}, not the layer before last
         q = g.reward[:, s] + after.take(g.nxt[:, s])
-        return (int(self.layers[min(k, last)][s]) - q).astype(np.float32) / 10.0
+        return (int(self.layers[min(left, last)][s]) - q).astype(np.float32) / 10.0
 
     def _q(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
         """(4,) action values toward the best return, on the fewest-step plan that earns it."""
