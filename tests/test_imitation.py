@@ -262,6 +262,7 @@ def test_labels_add_regrets_that_vanish_on_the_optimal_sets() -> None:
         sets, values, regret = planner.labels(venv)
         same_sets, same_values = planner.action_sets(venv)
         assert (sets == same_sets).all() and (values == same_values).all()
+        assert planner.labels(venv, regret=False)[2] is None
         assert regret.shape == (32, 4) and (regret >= 0).all() and (regret[sets] == 0).all()
         critical += int((regret.max(1) > 0).sum())
         venv.step(sets.argmax(1))

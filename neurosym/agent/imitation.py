@@ -169,6 +169,7 @@ def imitation_learner(
         planner = Planner()
         tracker = EpisodeTracker(venv.num_envs)
         buffer = LabelBuffer(train_config.dagger_buffer, obs.shape[1:], obs.dtype)
+        safe_loss = train_config.safe_coef > 0  # regrets only where the loss reads them
         frames = frames0
         parent = os.getppid()
         while not stop.is_set() and os.getppid() == parent:
@@ -176,7 +177,7 @@ def imitation_learner(
             beta = expert_share(frames, train_config.dagger_beta_frames)
             steps = 0
             for _ in range(train_config.n_steps):
-                optimal, values, regret = planner.labels(venv)
+                optimal, values, regret = planner.labels(venv, regret=safe_loss)
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
@@ -184,7 +185,8 @@ def imitation_learner(
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end
-                buffer.add(obs[real], optimal[real], values[real], regret[real] <= 0)
+                safe = None if regret is None else regret[real] <= 0
+                buffer.add(obs[real], optimal[real], values[real], safe)
                 obs, reward, terminated, truncated, info = venv.step(actions)
                 obs = np.ascontiguousarray(obs)
                 valid, done = tracker.step(venv, reward, terminated, truncated, info)

@@ -533,20 +533,28 @@ class Planner:
 
     def action_sets(self, venv: object) -> tuple[np.ndarray, np.ndarray]:
         """(n, 4) bool optimal actions per sub-env and (n,) the best return still to earn."""
-        sets, values = [], []
-        for plan, state in self._states(venv):
-            sets.append(plan.action_set(0, *state))
-            values.append(plan.value(0, *state))
-        return np.stack(sets), np.asarray(values, dtype=np.float32)
+        sets, values, _ = self.labels(venv, regret=False)
+        return sets, values
 
-    def labels(self, venv: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`action_sets` and (n, 4) float32 each action's :meth:`Plan.regret` per sub-env."""
+    def labels(
+        self, venv: object, regret: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """:meth:`action_sets` and (n, 4) float32 each action's :meth:`Plan.regret` per sub-env.
+
+        ``regret=False`` leaves the regrets out (None): they add about a quarter
+        to the labelling time, which runs on every training step.
+        """
         sets, values, regrets = [], [], []
         for plan, state in self._states(venv):
             sets.append(plan.action_set(0, *state))
             values.append(plan.value(0, *state))
-            regrets.append(plan.regret(0, *state))
-        return np.stack(sets), np.asarray(values, dtype=np.float32), np.stack(regrets)
+            if regret:
+                regrets.append(plan.regret(0, *state))
+        return (
+            np.stack(sets),
+            np.asarray(values, dtype=np.float32),
+            np.stack(regrets) if regret else None,
+        )
 
     def _states(self, venv: object) -> list[tuple[Plan, tuple[int, int, int]]]:
         env = getattr(venv, "unwrapped", venv)
