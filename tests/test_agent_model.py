@@ -281,6 +281,66 @@ def test_learned_queries_are_predinet_only_and_old_configs_read_as_scene() -> No
     assert ModelConfig.from_dict(data).query == "scene"
 
 
+@pytest.mark.parametrize("query", ["scene", "learned"])
+def test_cell_keys_address_cells_by_what_they_hold(query: str) -> None:
+    """ModelConfig.keys "cells": K = c W_K from each cell's observation, no coordinates, so two
+    cells holding the same thing get the same attention weight in every head, while the
+    attended vectors are the encoder's entities; plain autograd reaches W_K."""
+    net = make("predinet", keys="cells", query=query, conv_channels=(8, 8, 8), kernel_size=3)
+    rel = net.relational
+    assert rel.key.weight.shape == (32, RGW[0][0])  # W_K reads a cell's 9 planes
+    obs = torch.zeros((2, *RGW[0]), dtype=torch.uint8)
+    obs[:, 1] = 1  # every cell empty (plane 1) ...
+    obs[:, 1, 2, 3] = obs[:, 1, 7, 7] = obs[:, 1, 5, 1] = 0
+    obs[:, 0, 2, 3] = 1  # ... but the agent's
+    obs[:, 4, 7, 7] = obs[:, 4, 5, 1] = 1  # and two cells of one kind
+    logits, _, intro = net(obs, introspect=True)
+    for att in (intro.attention1[0], intro.attention2[0]):  # (H, N)
+        a = att.reshape(-1, 10, 10)
+        torch.testing.assert_close(a[:, 7, 7], a[:, 5, 1])  # same content, same weight
+        torch.testing.assert_close(a[:, 0, 0], a[:, 9, 9])  # two empty cells
+        assert not torch.allclose(a[:, 2, 3], a[:, 0, 0])  # the agent is told apart
+    # the same with entity keys: the encoder's view (and the coordinates) tell the cells apart
+    plain = make("predinet", query=query, conv_channels=(8, 8, 8), kernel_size=3)
+    a = plain(obs, introspect=True)[2].attention1[0].reshape(-1, 10, 10)
+    assert not torch.allclose(a[:, 0, 0], a[:, 9, 9])
+    logits.sum().backward()
+    assert rel.key.weight.grad is not None and rel.key.weight.grad.abs().sum() > 0
+    # nothing to record for A3C: the queries are recomputed in the update's forward
+    assert net.recording().__enter__() is None
+
+
+def test_cell_keys_are_predinet_only_and_old_configs_read_as_entity_keys() -> None:
+    with pytest.raises(ConfigError, match="unknown keys 'pixels'; expected one of entities, cells"):
+        ModelConfig(module="predinet", obs_shape=(3, 4, 4), keys="pixels")
+    with pytest.raises(ConfigError, match="keys 'cells' is PrediNet's; mhdpa's keys come from"):
+        ModelConfig(module="mhdpa", obs_shape=(3, 4, 4), keys="cells")
+    data = ModelConfig.for_family("rgw", "predinet", RGW[0]).to_dict()
+    del data["keys"]  # a checkpoint from before the switch
+    assert ModelConfig.from_dict(data).keys == "entities"
+
+
+def test_switching_keys_keeps_every_weight_but_w_k() -> None:
+    """checkpoint.build_model(..., keys="cells") (what --init-from --keys cells builds): W_K
+    starts afresh with the cells' width, every other weight is the source's."""
+    from neurosym.agent.checkpoint import build_model
+
+    source = make("predinet", conv_channels=(8, 8, 8), kernel_size=3)
+    payload = {"model_config": source.config, "state_dict": source.state_dict()}
+    torch.manual_seed(5)
+    switched = build_model(payload, "source.pt", keys="cells")
+    assert switched.config.keys == "cells" and source.config.keys == "entities"
+    new = switched.state_dict()
+    assert set(new) == set(payload["state_dict"])
+    for name, weight in payload["state_dict"].items():
+        if name == "relational.key.weight":
+            assert weight.shape == (32, 10) and new[name].shape == (32, 9)  # 8 + 2 coords
+        else:
+            torch.testing.assert_close(new[name], weight, rtol=0, atol=0)
+    same = build_model(payload, "source.pt", keys="entities")  # no switch: a plain load
+    torch.testing.assert_close(same.relational.key.weight, source.relational.key.weight)
+
+
 def test_agent_window_is_the_cells_around_the_agent_zero_off_the_grid() -> None:
     from neurosym.agent.model import agent_window
 

@@ -35,6 +35,7 @@ def metrics(out: Path) -> list[dict[str, str]]:
 
 
 BW1 = ROOT / "checkpoints" / "bw1-predinet.pt"
+MHDPA_RANDOM = ROOT / "checkpoints" / "rgw-random-mhdpa.pt"
 TINY = ("--envs", "4", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2")
 
 
@@ -351,6 +352,30 @@ def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: P
     assert agent.model(obs)[0].shape == (2, 4)
 
 
+@pytest.mark.expensive
+def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: Path) -> None:
+    """--init-from a trained PrediNet with --keys cells: the run's model reads cells in W_K,
+    the switch is in the config and the command, and --resume keeps it."""
+    source = ROOT / "checkpoints" / "rgw-random-predinet-deep.pt"
+    out = tmp_path / "run"
+    proc = neurosym(
+        "train", "--env", "rgw-random", "--init-from", str(source), "--keys", "cells",
+        "--algo", "imitate", "--augment", "--out", str(out), "--frames", "600", "--slim", *TINY,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    agent = load_agent(out / "checkpoint.pt")
+    assert agent.config.keys == "cells" and agent.config.conv_channels == (16, 16, 16, 16, 16, 24)
+    assert agent.model.relational.key.weight.shape == (32, 9)
+    last = agent.meta["command"].split(" && ")[-1]
+    assert f"--init-from {source}" in last and "--keys cells" in last
+    proc = neurosym("train", "--out", str(out), "--resume", "--frames", "1200", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    again = load_agent(out / "checkpoint.pt")
+    assert again.config.keys == "cells" and again.meta["frames"] >= 1200
+    obs = torch.zeros((2, *again.config.obs_shape), dtype=torch.uint8)
+    assert again.model(obs)[0].shape == (2, 4)
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -396,6 +421,14 @@ def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: P
             "expects observations (26, 14, 14), bw2 with these options gives (3, 14, 14)",
         ),
         (("--env", "bw2", "--init-from", str(BW1), "--resume"), "pass one of them"),
+        (
+            ("--env", "rgw2", "--module", "mhdpa", "--keys", "cells"),
+            "keys 'cells' is PrediNet's; mhdpa's keys come from each entity (use keys 'entities')",
+        ),
+        (
+            ("--env", "rgw-random", "--init-from", str(MHDPA_RANDOM), "--keys", "cells"),
+            "keys 'cells' is PrediNet's; mhdpa's keys come from each entity",
+        ),
         (
             ("--env", "bw1", "--module", "predinet", "--critic-warmup", "-5"),
             "critic_warmup must be >= 0 frames, got -5",

@@ -44,7 +44,7 @@ import io
 import os
 import pickle
 import shlex
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -256,11 +256,26 @@ def read_checkpoint(
     return payload
 
 
-def build_model(payload: dict[str, Any], path: str | os.PathLike[str]) -> ActorCritic:
-    """The model of a validated payload with its weights loaded (strict)."""
-    model = ActorCritic(payload["model_config"])
+RESTARTED_BY_KEYS = ("relational.key.weight",)
+"""Weights a switch of ModelConfig.keys replaces (W_K reads cells instead of entities)."""
+
+
+def build_model(
+    payload: dict[str, Any], path: str | os.PathLike[str], keys: str | None = None
+) -> ActorCritic:
+    """The model of a validated payload with its weights loaded (strict).
+
+    ``keys``: build it with that ModelConfig.keys instead (``--init-from`` switching an agent's
+    attention keys): W_K starts afresh, every other weight is the payload's."""
+    config = payload["model_config"]
+    state = payload["state_dict"]
+    if keys is not None and keys != config.keys:
+        config = replace(config, keys=keys)
+        fresh = ActorCritic(config).state_dict()
+        state = {**state, **{k: fresh[k] for k in RESTARTED_BY_KEYS}}
+    model = ActorCritic(config)
     try:
-        model.load_state_dict(payload["state_dict"], strict=True)
+        model.load_state_dict(state, strict=True)
     except RuntimeError as exc:
         msg = " ".join(_one_line(line) for line in str(exc).splitlines()[1:3]) or _one_line(exc)
         raise CheckpointError(f"{path}: the weights do not fit its model config ({msg})") from None

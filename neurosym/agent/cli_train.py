@@ -52,6 +52,7 @@ _OVERRIDES = (
     ("--entity-norm", "entity_norm", "model"),
     ("--init", "init", "model"),
     ("--query", "query", "model"),
+    ("--keys", "keys", "model"),
     ("--heads", "heads", "model"),
     ("--key-size", "key_size", "model"),
     ("--relations", "relations", "model"),
@@ -231,6 +232,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         choices=("scene", "learned"),
         help="PrediNet's queries: from the whole scene (scene, DESIGN and the thesis; default) "
         "or learned vectors, the same for every scene (learned)",
+    )
+    model.add_argument(
+        "--keys",
+        choices=("entities", "cells"),
+        help="what PrediNet's attention compares its queries with: the encoder's entities "
+        "(default, DESIGN and the thesis) or each cell's own observation (cells: a head "
+        "addresses cells by what they hold); --init-from may switch to cells",
     )
     model.add_argument(
         "--init",

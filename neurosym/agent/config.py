@@ -44,6 +44,7 @@ OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
 QUERIES = ("scene", "learned")
+KEYS = ("entities", "cells")
 
 # Table 4 values that differ by env family.
 _MODEL_FAMILY: dict[str, dict[str, Any]] = {
@@ -218,6 +219,18 @@ class ModelConfig:
     1,167 k / none / none in 10 minutes, learned 531 k / 837 k / 705 k (135-205 s). Not yet
     measured on bw2/bw3, whose chains may need a query that depends on the held key, so
     "scene" stays the default."""
+    keys: str = "entities"
+    """what PrediNet's attention compares its queries with: "entities" (K = L W_K, DESIGN.md and
+    the thesis) or "cells" (K = c W_K, c a cell's own observation vector, e.g. RGW's one-hot
+    planes, without coordinates): a head addresses cells by what they hold and reads the
+    encoder's entity there (E = a L, as before). Why it exists: with an encoder whose view is
+    wider than the map (the deep rgw-random PrediNet, six 3x3 layers) every entity carries the
+    whole route, and the heads attended background cells (no head on two different objects on
+    more than 7 % of states); with cell keys a head can only single out a cell by its content,
+    so its two arguments are what it chose to compare. The entity it reads still sees the
+    encoder's window, so a relation names which cells were compared, not that nothing else
+    entered D. ``--init-from`` may switch an agent to "cells": W_K starts afresh, every other
+    weight is copied."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
@@ -277,6 +290,13 @@ class ModelConfig:
             raise ConfigError(
                 f"query {self.query!r} is PrediNet's; {self.module}'s queries come from each "
                 "entity (use query 'scene')"
+            )
+        if self.keys not in KEYS:
+            raise ConfigError(f"unknown keys {self.keys!r}; expected one of {', '.join(KEYS)}")
+        if self.keys != "entities" and self.module != "predinet":
+            raise ConfigError(
+                f"keys {self.keys!r} is PrediNet's; {self.module}'s keys come from each entity "
+                "(use keys 'entities')"
             )
         if self.init not in INITS:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")

@@ -40,6 +40,8 @@ def build_relational(config: ModelConfig) -> nn.Module:
             config.output_size,
             config.attention_gain,
             config.query,
+            config.keys,
+            config.obs_shape[0],
         )
     return MHDPA(
         config.entity_size,
@@ -106,7 +108,7 @@ class ActorCritic(nn.Module):
         """A block whose graph-free forwards the relational module remembers, for a later
         ``forward(..., queries=record)`` over the same observations first (PrediNet's
         queries; other modules record nothing and yield None)."""
-        if isinstance(self.relational, PrediNet):
+        if isinstance(self.relational, PrediNet) and self.config.keys == "entities":
             return self.relational.recording_queries()
         return contextlib.nullcontext()
 
@@ -124,7 +126,11 @@ class ActorCritic(nn.Module):
             )
         x = obs.to(torch.float32) * self.config.obs_scale  # (B, C, H, W)
         entities = self.encoder(x)  # (B, N, F)
-        if queries is not None and isinstance(self.relational, PrediNet):
+        if self.config.keys == "cells":  # keys from what each cell holds (ModelConfig.keys)
+            B, C, H, W = x.shape
+            cells = x.permute(0, 2, 3, 1).reshape(B, H * W, C)  # (B, N, C), row-major
+            features, intro = self.relational(entities, introspect, None, cells)
+        elif queries is not None and isinstance(self.relational, PrediNet):
             features, intro = self.relational(entities, introspect, queries)  # (B, output_size)
         else:
             features, intro = self.relational(entities, introspect)  # (B, output_size)

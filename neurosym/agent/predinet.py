@@ -34,6 +34,11 @@ Choices made here (DESIGN.md leaves them open):
   375 k frames of seed 1, which never took off). A learned query moves by
   about lr per step. It cannot make which lock a head attends to depend on
   the colour of the held key, which bw2/bw3's chains may need.
+* ``keys="cells"`` (ModelConfig.keys; "entities", K = L W_K, is the default):
+  K = c W_K with c the (B, N, C) cells' own observation vectors, so a head
+  addresses a cell by what it holds; the attended entities are still L's.
+  Computed with autograd (the hand-written attention below assumes one L for
+  keys and values) and without recorded queries.
 * The heads' R vectors are concatenated, (B, H * (J + 4)), and a linear layer
   projects them to Table 4's output size (26). It is linear so that the
   output is a plain read-out of R and the R vectors stay the only relational
@@ -156,12 +161,17 @@ class PrediNet(nn.Module):
         output_size: int,
         attention_gain: float = 1.0,
         query: str = "scene",
+        keys: str = "entities",
+        cell_size: int = 0,
     ) -> None:
         super().__init__()
         assert entity_size > 2, "entities need features besides the 2 coordinates"
+        assert keys == "entities" or cell_size > 0, "cell keys need the cells' size"
         self.heads, self.key_size, self.relations = heads, key_size, relations
         self.query_mode = query
-        self.key = nn.Linear(entity_size, key_size, bias=False)  # W_K, shared
+        self.keys = keys
+        key_input = entity_size if keys == "entities" else cell_size
+        self.key = nn.Linear(key_input, key_size, bias=False)  # W_K, shared
         if query == "learned":
             # Q1^h, Q2^h of every head as one (2H D) vector; std 1 gives a fresh attention about
             # as peaked as the scene queries' (bw1, gain 8: largest weight 0.079 against 0.033)
@@ -224,14 +234,37 @@ class PrediNet(nn.Module):
                 recording.parts.append(q)
         return a, e
 
+    def _cell_attention(
+        self, L: torch.Tensor, cells: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Attention whose keys are the cells' observations: a (B, 2H, N), e = a L (B, 2H, F)."""
+        B, N, F = L.shape
+        if self.query_mode == "learned":
+            q = self.queries.view(1, -1, self.key_size).expand(B, -1, -1)  # (B, 2H, D)
+        else:
+            w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
+            q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, self.key_size)  # (B, 2H, D)
+        scores = (q @ self.key.weight) @ cells.transpose(1, 2)  # (B, 2H, N)
+        a = torch.softmax(scores * self.scale, dim=-1)
+        return a, a @ L
+
     def forward(
-        self, L: torch.Tensor, introspect: bool = False, queries: QueryRecord | None = None
+        self,
+        L: torch.Tensor,
+        introspect: bool = False,
+        queries: QueryRecord | None = None,
+        cells: torch.Tensor | None = None,
     ):
         """``queries``: a record of this module's own earlier forwards over the first rows of
-        ``L``, used only while the weights are unchanged (else recomputed)."""
+        ``L``, used only while the weights are unchanged (else recomputed). ``cells``: (B, N, C)
+        each cell's observation, the keys' input when ``keys="cells"`` (needed then)."""
         B, N, F = L.shape
         H = self.heads
-        if self.query_mode == "learned":  # nothing to record or reuse: the queries are weights
+        if self.keys == "cells":
+            if cells is None:
+                raise ValueError("PrediNet with keys='cells' needs the cells' observations")
+            a, e = self._cell_attention(L, cells)
+        elif self.query_mode == "learned":  # nothing to record or reuse: the queries are weights
             a, e, _ = PrediNetAttention.apply(
                 L, None, self.key.weight, self.scale, None, self.queries
             )

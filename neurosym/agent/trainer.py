@@ -530,10 +530,14 @@ def train(
         else:
             init_payload = read_checkpoint(init_from, env=name)
             model_config = init_payload["model_config"]
+            init_keys = model_overrides.get("keys")  # the one model switch a new run may make
             _check_model_fits(
-                init_from, model_config, module, model_overrides, shape,
+                init_from, model_config, module,
+                {k: v for k, v in model_overrides.items() if k != "keys"}, shape,
                 f"{name} with these options",
             )  # fmt: skip
+            if init_keys is not None:
+                model_config = replace(model_config, keys=init_keys)  # validated there
             if init_payload.get("command") and command:
                 command = f"{init_payload['command']} && {command}"
             init_meta = {
@@ -574,7 +578,7 @@ def train(
     if payload is not None:
         shared = build_model(payload, ckpt_path)
     elif init_payload is not None:
-        shared = build_model(init_payload, Path(init_from))  # type: ignore[arg-type]
+        shared = build_model(init_payload, Path(init_from), keys=model_config.keys)  # type: ignore[arg-type]
     else:
         shared = ActorCritic(model_config)
     shared.share_memory()
