@@ -1,7 +1,8 @@
 """The trained agents shipped in checkpoints/: RGW agents take the optimal route, greedily, by the
 env's own events; Box-World and rgw-random agents solve levels they never trained on (reset seeds
 >= 2**31), the rgw-random PrediNet has a head that relates two different objects, and the
-single-cell PrediNet relates the agent and the enemy on rgw2, with a sword-enemy link in Prolog."""
+single-cell PrediNet and the cell-keyed PrediNet relate the agent and the enemy on rgw2, with a
+sword-enemy link in Prolog."""
 
 from __future__ import annotations
 
@@ -56,6 +57,7 @@ EXPECTED = {
     "rgw-random-mhdpa",
     "rgw-random-predinet-deep",
     "rgw-random-predinet-cells",
+    "rgw-random-predinet-cellkeys",
 }
 SHIPPED = sorted(p.stem for p in CHECKPOINTS.glob("*.pt"))
 RGW = [n for n in SHIPPED if n.startswith(("rgw1-", "rgw2-"))]
@@ -72,7 +74,9 @@ UNSEEN = 3_000_000_000
 # --safe-coef 4): 98.7 %, 91.0 % (on these 100: 99 %, 90 %);
 # rgw-random-predinet-deep (DAgger with --augment, 60 + 100 minutes): 99.0 %, 93.3 % (on these 100: 99 %, 90 %);
 # rgw-random-predinet-cells (1 x 1 encoder, 8 heads, DAgger with --augment, 15 + 50 minutes):
-# 40.3 %, 12.3 % (on these 100: 38 %, 10 %); uniformly random actions 4.6 % on rgw-random)
+# 40.3 %, 12.3 % (on these 100: 38 %, 10 %);
+# rgw-random-predinet-cellkeys (the deep agent, --init-from with --keys cells, 60 more minutes):
+# 98.0 %, 93.7 % (on these 100: 97 %, 90 %); uniformly random actions 4.6 % on rgw-random)
 UNSEEN_FLOOR = {
     "bw1-predinet": {"sample": 0.9, "greedy": 0.7},
     "bw1-mhdpa": {"sample": 0.95, "greedy": 0.85},
@@ -84,6 +88,7 @@ UNSEEN_FLOOR = {
     "rgw-random-mhdpa": {"sample": 0.95, "greedy": 0.85},
     "rgw-random-predinet-deep": {"sample": 0.95, "greedy": 0.85},
     "rgw-random-predinet-cells": {"sample": 0.3, "greedy": 0.06},
+    "rgw-random-predinet-cellkeys": {"sample": 0.95, "greedy": 0.85},
 }
 
 
@@ -178,6 +183,37 @@ def test_the_cells_predinet_relates_objects_on_rgw2(tmp_path: Path) -> None:
     folder = rules_dir()
     assert folder is not None, "rules/ is not beside the package"
     rules = [folder / name for name in RULE_FILES["rgw"]]  # the files extract reads
+    kb_path = extract_facts(rec).to_prolog(tmp_path / "kb.pl")
+    with KnowledgeBase(kb_path, rules=rules) as kb:
+        assert kb.once("sword_enemy_link(A)")["A"] == Term("indirect", (("agent",),))
+
+
+def test_the_cell_keys_predinet_plays_rgw2_and_relates_objects(tmp_path: Path) -> None:
+    """The general agent whose heads address cells by what they hold (--keys cells), never
+    trained on rgw2: greedily sword, teleport, enemy, terminal (10.4 of the optimal 10.7), one
+    head relating the agent to the sword and then the enemy on most states, another the
+    teleport and the agent, and sword_enemy_link through the agent in real SWI-Prolog."""
+    from neurosym.export.facts import extract_facts
+    from neurosym.export.heads import head_summary
+    from neurosym.export.recorder import record
+    from neurosym.export.report import RULE_FILES, rules_dir
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+    from neurosym.terms import Term
+
+    path = CHECKPOINTS / "rgw-random-predinet-cellkeys.pt"
+    agent = load_agent(path)
+    assert agent.config.keys == "cells" and agent.meta["metrics"]["init_env"] == "rgw-random"
+    assert "--init-from checkpoints/rgw-random-predinet-deep.pt" in agent.meta["command"]
+    total, events, _ = play(path, ROUTES["rgw2"], "rgw2")
+    assert events == ROUTES["rgw2"] and total >= 10.0, (total, events)
+    rec = record(agent, env="rgw2", episodes=2, seed=0, greedy=True)
+    heads = head_summary(rec).set_index("head")
+    assert heads.loc[0, "two_objects"] > 0.5 and heads.loc[1, "two_objects"] > 0.5, heads
+    assert {heads.loc[0, "pair_1"], heads.loc[0, "pair_2"]} == {"agent-enemy", "agent-sword"}
+    assert heads.loc[1, "pair_1"] == "teleport-agent", heads
+    folder = rules_dir()
+    assert folder is not None, "rules/ is not beside the package"
+    rules = [folder / name for name in RULE_FILES["rgw"]]
     kb_path = extract_facts(rec).to_prolog(tmp_path / "kb.pl")
     with KnowledgeBase(kb_path, rules=rules) as kb:
         assert kb.once("sword_enemy_link(A)")["A"] == Term("indirect", (("agent",),))
