@@ -33,6 +33,7 @@ demo: setup
 	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw-random --episodes 20 --seed 3000000000 --sample --out kb_out/rgw-random
 	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
 	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cells.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cells
+	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
 
 bench: setup
 	$(PY) bench/envs.py
