@@ -229,8 +229,10 @@ class ModelConfig:
     more than 7 % of states); with cell keys a head can only single out a cell by its content,
     so its two arguments are what it chose to compare. The entity it reads still sees the
     encoder's window, so a relation names which cells were compared, not that nothing else
-    entered D. ``--init-from`` may switch an agent to "cells": W_K starts afresh, every other
-    weight is copied."""
+    entered D. Cells that hold the same thing get the same weight: a head on a kind with several
+    cells (rgw's two teleport ends, walls) reads their mean, and the recorded argument (the
+    attention's argmax) is the first of them in row-major order. ``--init-from`` may switch an
+    agent to "cells": W_K starts afresh, every other weight is copied."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
