@@ -271,14 +271,25 @@ def test_learned_queries_are_one_vector_for_every_scene() -> None:
     torch.testing.assert_close(net(obs, queries=record)[0], net(obs)[0])
 
 
-def test_learned_queries_are_predinet_only_and_old_configs_read_as_scene() -> None:
-    with pytest.raises(ConfigError, match="unknown query 'flat'; expected one of scene, learned"):
-        ModelConfig(module="predinet", obs_shape=(3, 4, 4), query="flat")
-    with pytest.raises(ConfigError, match="query 'learned' is PrediNet's; mhdpa's queries"):
-        ModelConfig(module="mhdpa", obs_shape=(3, 4, 4), query="learned")
+@pytest.mark.parametrize(
+    ("name", "unknown", "expected", "switch", "refusal", "default"),
+    [
+        ("query", "flat", "scene, learned", "learned", "mhdpa's queries", "scene"),
+        ("keys", "pixels", "entities, cells", "cells", "mhdpa's keys come from", "entities"),
+    ],
+)
+def test_predinet_switches_are_predinet_only_and_old_configs_read_as_the_default(
+    name: str, unknown: str, expected: str, switch: str, refusal: str, default: str
+) -> None:
+    with pytest.raises(
+        ConfigError, match=f"unknown {name} '{unknown}'; expected one of {expected}"
+    ):
+        ModelConfig(module="predinet", obs_shape=(3, 4, 4), **{name: unknown})
+    with pytest.raises(ConfigError, match=f"{name} '{switch}' is PrediNet's; {refusal}"):
+        ModelConfig(module="mhdpa", obs_shape=(3, 4, 4), **{name: switch})
     data = ModelConfig.for_family("rgw", "predinet", RGW[0]).to_dict()
-    del data["query"]  # a checkpoint from before the switch
-    assert ModelConfig.from_dict(data).query == "scene"
+    del data[name]  # a checkpoint from before the switch
+    assert getattr(ModelConfig.from_dict(data), name) == default
 
 
 @pytest.mark.parametrize("query", ["scene", "learned"])
@@ -308,16 +319,6 @@ def test_cell_keys_address_cells_by_what_they_hold(query: str) -> None:
     assert rel.key.weight.grad is not None and rel.key.weight.grad.abs().sum() > 0
     # nothing to record for A3C: the queries are recomputed in the update's forward
     assert net.recording().__enter__() is None
-
-
-def test_cell_keys_are_predinet_only_and_old_configs_read_as_entity_keys() -> None:
-    with pytest.raises(ConfigError, match="unknown keys 'pixels'; expected one of entities, cells"):
-        ModelConfig(module="predinet", obs_shape=(3, 4, 4), keys="pixels")
-    with pytest.raises(ConfigError, match="keys 'cells' is PrediNet's; mhdpa's keys come from"):
-        ModelConfig(module="mhdpa", obs_shape=(3, 4, 4), keys="cells")
-    data = ModelConfig.for_family("rgw", "predinet", RGW[0]).to_dict()
-    del data["keys"]  # a checkpoint from before the switch
-    assert ModelConfig.from_dict(data).keys == "entities"
 
 
 def test_switching_keys_keeps_every_weight_but_w_k() -> None:

@@ -286,20 +286,16 @@ class ModelConfig:
             raise ConfigError("conv_channels and hidden_sizes must be positive")
         if not self.obs_scale > 0:
             raise ConfigError(f"obs_scale must be positive, got {self.obs_scale}")
-        if self.query not in QUERIES:
-            raise ConfigError(f"unknown query {self.query!r}; expected one of {', '.join(QUERIES)}")
-        if self.query != "scene" and self.module != "predinet":
-            raise ConfigError(
-                f"query {self.query!r} is PrediNet's; {self.module}'s queries come from each "
-                "entity (use query 'scene')"
-            )
-        if self.keys not in KEYS:
-            raise ConfigError(f"unknown keys {self.keys!r}; expected one of {', '.join(KEYS)}")
-        if self.keys != "entities" and self.module != "predinet":
-            raise ConfigError(
-                f"keys {self.keys!r} is PrediNet's; {self.module}'s keys come from each entity "
-                "(use keys 'entities')"
-            )
+        # PrediNet's switches: the first choice is DESIGN's, the only one MHDPA has
+        for name, allowed, plural in (("query", QUERIES, "queries"), ("keys", KEYS, "keys")):
+            value, default = getattr(self, name), allowed[0]
+            if value not in allowed:
+                raise ConfigError(f"unknown {name} {value!r}; expected one of {', '.join(allowed)}")
+            if value != default and self.module != "predinet":
+                raise ConfigError(
+                    f"{name} {value!r} is PrediNet's; {self.module}'s {plural} come from each "
+                    f"entity (use {name} {default!r})"
+                )
         if self.init not in INITS:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
         if not self.attention_gain > 0:
