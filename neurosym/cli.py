@@ -15,6 +15,7 @@ errors exit with status 2.
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
 import sys
 from collections.abc import Sequence
@@ -52,6 +53,41 @@ def add_env_options(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="RGW: play this map file on a fixed-map env (--env rgw1 or rgw2, default rgw2)",
     )
+    parser.add_argument(
+        "--env-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of the env on top of the checkpoint's, e.g. num_mountains=12 on "
+        "rgw-random (repeatable)",
+    )
+
+
+def parse_env_options(items: list[str]) -> dict[str, Any]:
+    """KEY=VALUE strings -> kwargs; values are Python literals when they parse as one, else strings."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key.isidentifier():
+            raise ConfigError(f"--env-option wants KEY=VALUE with KEY a name, got {item!r}")
+        try:
+            out[key] = ast.literal_eval(text)
+        except (ValueError, SyntaxError):
+            out[key] = text
+    return out
+
+
+def play_options(
+    args: argparse.Namespace, trained: str
+) -> tuple[str | None, dict[str, Any] | None]:
+    """(env name or None, the user's env options or None) from ``--env``, ``--map``, ``--env-option``."""
+    env, overrides = map_option(args.env, args.map, trained)
+    extra = parse_env_options(args.env_option)
+    if not extra:
+        return env, overrides
+    if "map" in extra and overrides:
+        raise ConfigError("give the map once: --map FILE or --env-option map=FILE, not both")
+    return env, {**(overrides or {}), **extra}
 
 
 def map_option(

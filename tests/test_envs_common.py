@@ -39,6 +39,19 @@ def test_unknown_names_are_refused_with_the_known_ones() -> None:
         make_batched("rgw2", 0)
 
 
+def test_unknown_options_are_refused_with_the_known_ones() -> None:
+    """One line naming the options the env takes, not gymnasium's TypeError from its factory."""
+    with pytest.raises(
+        ConfigError, match=r"^unknown option 'bogus' for rgw2; expected one of map, classic"
+    ):
+        make("rgw2", bogus=1)
+    with pytest.raises(ConfigError, match=r"^unknown option 'solution' for bw1; .*solution_length"):
+        make_batched("bw1", 2, solution=2)
+    with pytest.raises(ConfigError, match=r"^unknown rgw-random parameter 'bogus'"):
+        make_batched("rgw-random", 2, bogus=1)
+    make("rgw2", classic=True).close()  # known options still pass
+
+
 @pytest.mark.parametrize("name", NAMES)
 def test_gymnasium_check_env(name: str) -> None:
     for render_mode in ("rgb_array", "ansi"):

@@ -16,6 +16,8 @@ from neurosym.agent.cli_eval import evaluate
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.model import ActorCritic
 
+RGW1_MAP = Path(__file__).resolve().parents[1] / "neurosym" / "envs" / "maps" / "rgw1.txt"
+
 
 @pytest.fixture
 def neurosym(
@@ -70,6 +72,10 @@ def test_eval_text_and_sample(neurosym, untrained: Path) -> None:
         (("--episodes", "0"), "--episodes must be a positive integer"),
         (("--env", "bw2"), "bw2 is a boxworld environment: pick one of rgw1, rgw2, rgw-random"),
         (("--env", "rgw-random", "--map", "m.txt"), "--map goes with a fixed-map RGW env"),
+        (("--env-option", "bogus=1"), "unknown option 'bogus' for rgw2; expected one of map,"),
+        (("--env-option", "max_steps"), "--env-option wants KEY=VALUE with KEY a name"),
+        (("--map", str(RGW1_MAP), "--env-option", "map=rgw2"), "give the map once: --map FILE"),
+        (("--env", "rgw-random", "--env-option", "num_mountains=-1"), "num_mountains must be"),
     ],
 )
 def test_eval_errors_are_one_line(
@@ -79,6 +85,21 @@ def test_eval_errors_are_one_line(
     proc = neurosym("eval", *full)
     assert proc.returncode == 1
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
+def test_eval_env_options_change_the_levels(neurosym, untrained: Path) -> None:
+    """--env-option plays rgw-random's levels with other parameters, recorded in the report."""
+    reports = {}
+    for mountains in (0, 12):
+        proc = neurosym(
+            "eval", "--checkpoint", str(untrained), "--env", "rgw-random", "--episodes", "20",
+            "--seed", "3000000000", "--env-option", f"num_mountains={mountains}", "--json",
+        )  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        reports[mountains] = json.loads(proc.stdout)
+        assert reports[mountains]["env_kwargs"] == {"num_mountains": mountains}
+    # the same 20 seeds: without mountains no optimal route pays for one; with 12 some must
+    assert reports[0]["mean_optimal_return"] > reports[12]["mean_optimal_return"]
 
 
 def test_eval_refuses_a_text_file(neurosym, tmp_path: Path) -> None:

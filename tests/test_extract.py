@@ -110,6 +110,8 @@ def test_extract_writes_the_kb_and_prints_the_answers(
         (["--map", "nowhere.txt"], ["map 'nowhere.txt'"]),
         (["--env", "rgw-random", "--map", "x.txt"], ["--map goes with a fixed-map RGW env"]),
         (["--env", "nowhere"], ["nowhere"]),
+        (["--env-option", "bogus=1"], ["unknown option 'bogus' for rgw2", "enemy"]),
+        (["--env", "rgw-random", "--env-option", "width=3"], ["width must be an integer >= 5"]),
         (["--env", "rgw2", "--threshold", "top:5"], ["bad threshold 'top:5'", "quantile:0.9"]),
         (["--env", "rgw2", "--format", "pl,csv"], ["bad --format 'pl,csv'", "pl, parquet"]),
         (["--env", "rgw2", "--episodes", "0"], ["--episodes must be at least 1"]),

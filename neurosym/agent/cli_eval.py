@@ -24,7 +24,7 @@ import json
 from collections import Counter
 from typing import Any
 
-from neurosym.cli import add_action_mode, add_env_options, map_option
+from neurosym.cli import add_action_mode, add_env_options, play_options
 from neurosym.errors import ConfigError
 
 
@@ -124,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.agent.checkpoint import env_for
 
     agent = load_agent(args.checkpoint)
-    env, overrides = map_option(args.env, args.map, agent.env_name)
+    env, overrides = play_options(args, agent.env_name)
     env, kwargs = env_for(agent, env, overrides)
     report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs)
     if args.json:

@@ -11,12 +11,11 @@ writes (:mod:`neurosym.agent.distributed`).
 from __future__ import annotations
 
 import argparse
-import ast
 import os
 import shlex
 from typing import Any
 
-from neurosym.errors import ConfigError
+from neurosym.cli import parse_env_options
 
 # (flag, dest, kind) for the settings passed through as overrides; kind: train | model
 _OVERRIDES = (
@@ -282,20 +281,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="leave the optimizer state out of checkpoints (with --resume: as the run was)",
     )
     watch.add_argument("--quiet", action="store_true", help="no progress bar")
-
-
-def parse_env_options(items: list[str]) -> dict[str, Any]:
-    """KEY=VALUE strings -> kwargs; values are Python literals when they parse as one, else strings."""
-    out: dict[str, Any] = {}
-    for item in items:
-        key, sep, text = item.partition("=")
-        if not sep or not key.isidentifier():
-            raise ConfigError(f"--env-option wants KEY=VALUE with KEY a name, got {item!r}")
-        try:
-            out[key] = ast.literal_eval(text)
-        except (ValueError, SyntaxError):
-            out[key] = text
-    return out
 
 
 def command_line(args: argparse.Namespace) -> str:

@@ -14,6 +14,7 @@ from neurosym.envs.actions import ACTION_NAMES, Action
 from neurosym.envs.registration import (
     ENVS,
     canonical_name,
+    check_options,
     env_family,
     make,
     make_batched,
@@ -27,6 +28,7 @@ __all__ = [
     "ENVS",
     "Action",
     "canonical_name",
+    "check_options",
     "env_family",
     "make",
     "make_batched",

@@ -24,7 +24,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from neurosym.cli import add_action_mode, add_env_options, map_option
+from neurosym.cli import add_action_mode, add_env_options, play_options
 from neurosym.errors import ConfigError
 
 FORMATS = ("pl", "parquet")
@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.export.recorder import record
 
     agent = load_agent(args.checkpoint)
-    env, overrides = map_option(args.env, args.map, agent.env_name)
+    env, overrides = play_options(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once: the default folder needs the checkpoint's env
     out = Path(args.out) if args.out else Path("kb_out") / env
