@@ -53,6 +53,11 @@ def add_env_options(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="RGW: play this map file on a fixed-map env (--env rgw1 or rgw2, default rgw2)",
     )
+    add_env_option(parser)
+
+
+def add_env_option(parser: argparse.ArgumentParser) -> None:
+    """``--env-option KEY=VALUE`` (repeatable): eval, extract, intervene and probe share it."""
     parser.add_argument(
         "--env-option",
         action="append",
@@ -75,6 +80,22 @@ def parse_env_options(items: list[str]) -> dict[str, Any]:
         except (ValueError, SyntaxError):
             out[key] = text
     return out
+
+
+def with_env_options(agent: Any, items: list[str]) -> Any:
+    """The agent with ``--env-option`` items on top of its env options (checked by making the env).
+
+    For the commands that play an agent on its own env only (intervene, probe).
+    """
+    import dataclasses
+
+    extra = parse_env_options(items)
+    if not extra:
+        return agent
+    from neurosym.agent.checkpoint import env_for
+
+    _, kwargs = env_for(agent, None, extra)
+    return dataclasses.replace(agent, env_kwargs=kwargs)
 
 
 def play_options(

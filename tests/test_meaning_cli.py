@@ -110,6 +110,8 @@ def test_intervene_ablates_mhdpa_heads(run_neurosym, tmp_path: Path, swipl: Path
     [
         (["probe", "--episodes", "1"], "--episodes must be at least 2"),
         (["intervene", "--episodes", "0"], "--episodes must be at least 1"),
+        (["intervene", "--env-option", "bogus=1"], "unknown option 'bogus' for rgw2; expected"),
+        (["probe", "--env-option", "max_steps"], "--env-option wants KEY=VALUE"),
     ],
 )
 def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], message: str) -> None:
@@ -120,3 +122,22 @@ def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], me
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], proc.stderr
     assert not out.exists()
+
+
+def test_env_options_reach_the_played_env() -> None:
+    """intervene and probe play the agent on its own env with --env-option on top, checked."""
+    from neurosym.agent.checkpoint import load_agent
+    from neurosym.cli import with_env_options
+    from neurosym.errors import ConfigError
+    from neurosym.export.recorder import record
+
+    agent = load_agent(REPO / "checkpoints" / "rgw2-predinet.pt")
+    assert with_env_options(agent, []) is agent
+    capped = with_env_options(agent, ["max_steps=3"])
+    assert capped.env_kwargs == {**agent.env_kwargs, "max_steps": 3}
+    assert agent.env_kwargs.get("max_steps") != 3  # the loaded agent is left as it was
+    rec = record(capped, episodes=2, seed=0, greedy=True)
+    assert rec.meta["env_kwargs"]["max_steps"] == 3
+    assert int(rec.episodes["steps"].max()) <= 3  # its episodes end at 3 steps
+    with pytest.raises(ConfigError, match="num_mountains"):
+        with_env_options(agent, ["num_mountains=12"])  # rgw2 takes no level parameters

@@ -23,6 +23,7 @@ import argparse
 import json
 from pathlib import Path
 
+from neurosym.cli import add_env_option, with_env_options
 from neurosym.errors import ConfigError
 
 
@@ -32,6 +33,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--env", metavar="NAME", help="environment; must be the checkpoint's (default: it)"
     )
+    add_env_option(parser)
     parser.add_argument(
         "--episodes",
         type=int,
@@ -78,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.meaning.intervene import intervene
 
     env = canonical_name(args.env) if args.env else None
-    agent = load_agent(args.checkpoint, env=env)
+    agent = with_env_options(load_agent(args.checkpoint, env=env), args.env_option)
     report = intervene(
         agent,
         env,

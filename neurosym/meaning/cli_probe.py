@@ -24,6 +24,7 @@ import json
 import sys
 from pathlib import Path
 
+from neurosym.cli import add_env_option, with_env_options
 from neurosym.errors import ConfigError
 
 
@@ -33,6 +34,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--env", metavar="NAME", help="environment; must be the checkpoint's (default: it)"
     )
+    add_env_option(parser)
     parser.add_argument(
         "--episodes", type=int, default=200, metavar="N", help="episodes to record (default: 200)"
     )
@@ -81,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.meaning.probe import probe
 
     env = canonical_name(args.env) if args.env else None
-    agent = load_agent(args.checkpoint, env=env)
+    agent = with_env_options(load_agent(args.checkpoint, env=env), args.env_option)
     report = probe(
         agent,
         env,
