@@ -297,3 +297,18 @@ def test_the_kind_shows_in_every_step_info() -> None:
 def test_bad_parameters_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         RGWRandomEnv(**kwargs)
+
+
+def test_an_unknown_parameter_names_the_env_options_too() -> None:
+    """The message lists the level parameters and the env's own options, which stay in step."""
+    import inspect
+
+    from neurosym.envs.rgw_random import ENV_OPTIONS
+    from neurosym.envs.rgw_vector import RGWRandomVectorEnv
+
+    for cls, skip in ((RGWRandomEnv, set()), (RGWRandomVectorEnv, {"num_envs", "seed", "copy"})):
+        params = inspect.signature(cls.__init__).parameters
+        named = [n for n, p in params.items() if p.kind is p.KEYWORD_ONLY and n not in skip]
+        assert tuple(named) == ENV_OPTIONS, cls
+    with pytest.raises(ConfigError, match=r"num_mountains.*\(or an option of the env: classic, "):
+        RGWRandomEnv(mountains=3)

@@ -467,13 +467,18 @@ class RandomLevels:
         return got
 
 
+ENV_OPTIONS = ("classic", "obs_mode", "max_steps", "render_mode", "enemy")
+"""rgw-random's options besides the level parameters (RGWRandomEnv's and its batched env's own)"""
+
+
 def config_from_kwargs(kwargs: dict[str, Any]) -> RandomLevelConfig:
     """A RandomLevelConfig from keyword arguments, refusing unknown names."""
     known = {f.name for f in fields(RandomLevelConfig)}
     unknown = sorted(set(kwargs) - known)
     if unknown:
         raise ConfigError(
-            f"unknown rgw-random parameter {unknown[0]!r}; expected one of {', '.join(sorted(known))}"
+            f"unknown rgw-random parameter {unknown[0]!r}; expected one of {', '.join(sorted(known))} "
+            f"(or an option of the env: {', '.join(ENV_OPTIONS)})"
         )
     return RandomLevelConfig(**kwargs)
 
