@@ -1,6 +1,6 @@
 """``neurosym intervene``: controlled experiments on the level and on the heads.
 
-    neurosym intervene --checkpoint ckpt.pt [--env rgw2] [--episodes 100] [--seed 0]
+    neurosym intervene --checkpoint ckpt.pt [--env rgw2] [--env-option K=V] [--episodes 100] [--seed 0]
         [--sample|--greedy] --out DIR [--no-levels] [--no-ablations] [--json]
 
 Plays the unchanged level and every experiment of

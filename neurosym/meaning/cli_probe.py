@@ -1,6 +1,6 @@
 """``neurosym probe``: which predicates each head's relations encode, and how selectively.
 
-    neurosym probe --checkpoint ckpt.pt [--env rgw2] [--episodes 200] [--seed 0]
+    neurosym probe --checkpoint ckpt.pt [--env rgw2] [--env-option K=V] [--episodes 200] [--seed 0]
         [--sample|--greedy] --out DIR [--json] [--no-untrained]
 
 Records the episodes (sampled by default: greedy episodes of a fixed map are
