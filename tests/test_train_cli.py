@@ -204,7 +204,7 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
     neurosym, tmp_path: Path
 ) -> None:
     """The same A3C fine-tune of a DAgger agent (the deep-encoder one: DAgger alone, no A3C yet),
-    with docs/results.md's fine-tuning settings but a 10x learning rate, without and with the planner's
+    with the README's fine-tuning settings but a 10x learning rate, without and with the planner's
     loss beside it: A3C alone throws the planner's actions away within a few updates; with the
     planner's loss the policy keeps them (nll on the start states of levels neither run played)."""
     from neurosym.agent.planner_loss import optimal_set_nll
@@ -235,7 +235,7 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
     # the source starts at 0.04 nats. With two workers Hogwild's timing decided how far A3C
     # alone drifted in 4,000 frames (0.57-17 nats; this test failed about one run in five);
     # one worker for 8,000 frames drifts the same way every run: measured 0.13 with the
-    # planner's loss against 1.97-2.03 without
+    # planner's loss against 1.97-2.03 without (2026-11-26)
     assert nll["5"] < 0.4 and nll["5"] < nll["0"] / 3, nll
 
 
