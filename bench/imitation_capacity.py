@@ -16,7 +16,7 @@ probability ``--follow`` (one of its optimal actions, uniformly) and is
 otherwise a uniformly random action, so that they cover the planner's routes
 and the detours a learner makes.
 
-    python bench/imitation_capacity.py                          # the README's table
+    python bench/imitation_capacity.py                          # the table in docs/results.md
     python bench/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
 
 ``cnn`` is a plain CNN reference (not a relational module).
@@ -39,7 +39,7 @@ from neurosym.agent.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
 
-VARIANTS = [  # the README's table (about 35 minutes on 2 cores)
+VARIANTS = [  # the table in docs/results.md (about 35 minutes on 2 cores)
     "predinet",
     "predinet:heads=8",
     "predinet:output_size=64",

@@ -1,7 +1,7 @@
 """Knowledge-base throughput: write, load and query N ground relation/7 facts; JSON lines.
 
 For each N (default 1e4, 1e5, 1e6) it builds a relation/7 table of the
-DESIGN.md schema, ``relation(E, T, Head, J, A, B, Value)`` (500 facts per
+docs/design.md schema, ``relation(E, T, Head, J, A, B, Value)`` (500 facts per
 episode: 16 steps x 4 heads x 8 relations, entity atoms including
 ``key(red)``, normal float values), and measures:
 

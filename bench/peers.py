@@ -27,7 +27,7 @@ and relational modules cost or save::
     python bench/peers.py --frames 5000000 --minutes 15          # each run: 15 minutes at most
     python bench/peers.py --runs neurosym-a3c --a3c-args '--envs 32'   # other train flags
 
-neurosym's fastest learners on bw1 so far (README "Measured", 2026-11-26) have
+neurosym's fastest learners on bw1 (docs/results.md) have
 learned PrediNet queries: A3C 4.5-7.1x SB3's PPO in wall time to 90 % (seeds
 0-2), PPO with short rollouts and a running advantage scale 2.7-4.2x (seeds 0-3)::
 

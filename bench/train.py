@@ -14,7 +14,7 @@ Parts (``--only`` takes a comma-separated list; default: all):
 * ``distributed``: PPO frames per second under ``torchrun --standalone
   --nproc_per_node R`` for R in ``--ranks`` (default 1,2), each rank with the
   default 64 envs (weak scaling: the batch grows with the ranks), and the
-  figures behind the README's plan for N machines: parameters, all-reduce
+  figures behind docs/results.md's plan for N machines: parameters, all-reduce
   bytes per update (DDP reduces every minibatch's gradient), frames per
   update, and seconds per update at each R.
 

@@ -3,7 +3,7 @@
 
     Load it beside a neurosym knowledge base:  swipl kb.pl rules/boxworld.pl
 
-    Expects the facts of DESIGN.md:
+    Expects the facts of docs/design.md:
         object(Id, Type)    Type key(C), lock(C), gem, agent
         at(E, T, Id, R, C)  a box is a lock with its content in the cell to
                             its left; a loose key has no lock to its right

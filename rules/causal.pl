@@ -3,7 +3,7 @@
     Load it beside a KB written by `neurosym intervene`:
         swipl kb_out/intervene/kb.pl rules/causal.pl
 
-    Facts it reads (DESIGN.md, "What the relations mean"):
+    Facts it reads (docs/design.md, "Facts", controlled experiments):
         experiment(X, Kind, Detail)   Kind: baseline, remove(sword), remove(enemy),
                                       move(Obj, R, C), swap(sword, enemy), ablate(head(H)),
                                       ablate(heads)

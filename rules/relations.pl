@@ -2,7 +2,7 @@
 
     Load it beside a knowledge base:  swipl kb.pl rules/relations.pl
 
-    Expects the facts of DESIGN.md (a neurosym KB declares them all dynamic):
+    Expects the facts of docs/design.md (a neurosym KB declares them all dynamic):
         relation(E, T, Head, J, A, B, Value)   PrediNet: D^h_j between the
                                                entities heads attended
         holds(E, T, r(J), A, B)                thresholded, oriented: Value > 0

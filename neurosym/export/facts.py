@@ -1,7 +1,7 @@
 """Ground facts from a Recording: the tables behind a Prolog knowledge base.
 
 :func:`extract_facts` turns a :class:`~neurosym.export.recording.Recording` into a
-:class:`FactSet`, one pandas table per predicate of the schema in DESIGN.md::
+:class:`FactSet`, one pandas table per predicate of the schema in docs/design.md::
 
     kb_meta(Key, Value)            object(Id, Type)
     episode(E, Steps, Return, Outcome)
@@ -234,7 +234,7 @@ class FactSet:
         return (
             "neurosym knowledge base: facts extracted from recorded episodes.\n"
             f"{meta}\nthreshold={self.threshold}\n"
-            "Schema (DESIGN.md): kb_meta/2, object/2, episode/4, step/4, at/5, holding/3, event/3,\n"
+            "Schema (docs/design.md): kb_meta/2, object/2, episode/4, step/4, at/5, holding/3, event/3,\n"
             "attends/8, relation/7, holds/5, threshold/2, attention/6. Heads and relations count from 0."
         )
 

@@ -48,7 +48,7 @@ import numpy as np
 import pandas as pd
 
 BACKGROUND = ("empty", "wall", "mountain")
-"""entities that are terrain, not objects (DESIGN.md: walls and mountains have no at/5)"""
+"""entities that are terrain, not objects (docs/design.md: walls and mountains have no at/5)"""
 
 EVENT_OBJECTS = {"teleported": "teleport"}
 """events without an argument that still name the object met (RGW's teleport)"""

@@ -1,6 +1,6 @@
 """KnowledgeBase: fact files and rule files queried from Python through janus-swi.
 
-Fact files are data, rule files are code (DESIGN.md, "Prolog"). A KB is
+Fact files are data, rule files are code (docs/design.md, "Prolog"). A KB is
 something people pass around, so a fact file is never consulted: it is read
 term by term (:mod:`neurosym.prolog.fact_reader`) and only facts and the
 writer's ``:- encoding``/``:- dynamic`` headers are accepted; anything else
