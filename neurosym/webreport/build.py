@@ -138,7 +138,10 @@ def load_agent_or_note(path: str | None) -> tuple[Any | None, str | None]:
     if not path:
         return None, "The recording names no checkpoint."
     if not Path(path).is_file():
-        return None, f"The checkpoint {path} the recording names is not at hand: its card is partial."
+        return (
+            None,
+            f"The checkpoint {path} the recording names is not at hand: its card is partial.",
+        )
     from neurosym.agent.checkpoint import load_agent
 
     try:

@@ -58,9 +58,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="MHDPA: keep each query cell's N strongest keys (default: 1)",
     )
-    parser.add_argument("--probe", metavar="DIR", help="add the probes `neurosym probe --out DIR` wrote")
     parser.add_argument(
-        "--intervene", metavar="DIR", help="add the experiments `neurosym intervene --out DIR` wrote"
+        "--probe", metavar="DIR", help="add the probes `neurosym probe --out DIR` wrote"
+    )
+    parser.add_argument(
+        "--intervene",
+        metavar="DIR",
+        help="add the experiments `neurosym intervene --out DIR` wrote",
     )
     parser.add_argument(
         "--out",
@@ -85,7 +89,9 @@ def _check(args: argparse.Namespace) -> None:
         given += ["env_option"] if args.env_option else []
         if given:
             flags = ", ".join("--" + g.replace("_", "-") for g in given)
-            raise ConfigError(f"{flags} go(es) with --checkpoint; a recording is reported as recorded")
+            raise ConfigError(
+                f"{flags} go(es) with --checkpoint; a recording is reported as recorded"
+            )
         return
     for name, low in (("episodes", 1), ("seed", 0), ("batch", 1), ("top_keys", 1)):
         value = getattr(args, name)
@@ -171,4 +177,3 @@ def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) ->
 
     written = publish(out, write, folders=("recording",), prefix=".report-")
     return written["index.html"]
-

@@ -21,7 +21,9 @@ PROBES_PER_HEAD = 5
 PROBE_COLUMNS = ("relation", "predicate", "accuracy", "control", "selectivity")
 
 
-def _read(folder: Path, name: str, option: str, command: str, need: tuple[str, ...]) -> pd.DataFrame:
+def _read(
+    folder: Path, name: str, option: str, command: str, need: tuple[str, ...]
+) -> pd.DataFrame:
     path = folder / name
     if not path.is_file():
         raise ConfigError(
@@ -33,7 +35,9 @@ def _read(folder: Path, name: str, option: str, command: str, need: tuple[str, .
         raise ConfigError(f"cannot read {path}: {exc}") from None
     missing = [c for c in need if c not in df.columns]
     if missing:
-        raise ConfigError(f"{path} lacks column(s) {', '.join(missing)}; expected {', '.join(need)}")
+        raise ConfigError(
+            f"{path} lacks column(s) {', '.join(missing)}; expected {', '.join(need)}"
+        )
     return df
 
 
@@ -75,12 +79,19 @@ def intervene_section(folder: Path) -> dict[str, Any]:
     measures = _read(folder, "measures.parquet", "--intervene", "intervene", need)
     effects = _read(folder, "effects.parquet", "--intervene", "intervene", need)
     names = list(dict.fromkeys(str(m) for m in measures["measure"]))
-    value = {(str(r["experiment"]), str(r["measure"])): r["value"] for r in measures.to_dict("records")}
-    effect = {(str(r["experiment"]), str(r["measure"])): r["value"] for r in effects.to_dict("records")}
+    value = {
+        (str(r["experiment"]), str(r["measure"])): r["value"] for r in measures.to_dict("records")
+    }
+    effect = {
+        (str(r["experiment"]), str(r["measure"])): r["value"] for r in effects.to_dict("records")
+    }
     rows = []
     for experiment in dict.fromkeys(str(x) for x in measures["experiment"]):
         cells = [
-            {"value": _number(value.get((experiment, m))), "effect": _number(effect.get((experiment, m)))}
+            {
+                "value": _number(value.get((experiment, m))),
+                "effect": _number(effect.get((experiment, m))),
+            }
             for m in names
         ]
         rows.append({"experiment": experiment, "cells": cells})

@@ -67,8 +67,10 @@ def render(context: dict[str, Any]) -> str:
     """The page's HTML for ``context`` (see :func:`neurosym.webreport.build.report_context`)."""
     script = _text("report.js")
     digest = base64.b64encode(hashlib.sha256(script.encode("utf-8")).digest()).decode("ascii")
-    return environment().get_template(TEMPLATE).render(
-        **context, css=_text("report.css"), script=script, script_hash=f"sha256-{digest}"
+    return (
+        environment()
+        .get_template(TEMPLATE)
+        .render(**context, css=_text("report.css"), script=script, script_hash=f"sha256-{digest}")
     )
 
 
