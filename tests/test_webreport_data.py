@@ -114,18 +114,31 @@ def test_page_tables_are_extracts_figures(predinet_page: tuple[Recording, Path, 
     assert html.count('<a href="#e=') >= len(rec.episodes)
 
 
-def test_row_links_name_states_that_count(predinet_page: tuple[Recording, Path, str]) -> None:
-    rec, _, html = predinet_page
-    facts = extract_facts(rec, threshold="quantile:0.9")
+def test_row_links_name_states_that_count(
+    predinet_page: tuple[Recording, Path, str], tmp_path: Path
+) -> None:
+    rec, folder, _ = predinet_page
+    out = tmp_path / "page"
+    # abs:0: every relation between two objects holds, so the scripted agent has strongest rows
+    args = ["--threshold", "abs:0", "--out", str(out)]
+    assert main(["report", "--recording", str(folder), "--quiet", *args]) == 0
+    html = (out / "index.html").read_text(encoding="utf-8")
+    facts = extract_facts(rec, threshold="abs:0")
     strongest = facts.strongest_relations(5)
+    assert len(strongest) == 3
     section = html[html.index('id="relations"') : html.index('id="rules"')]
-    links = re.findall(r'href="#e=(\d+)&amp;t=(\d+)"', section)
-    assert len(links) == len(strongest) or len(strongest) == 0 or links
     holds = facts["holds"]
     for r in strongest.to_dict("records"):
         match = holds[(holds["j"] == r["j"]) & (holds["a"] == r["a"]) & (holds["b"] == r["b"])]
         first = match.sort_values(["episode", "t"]).iloc[0]
         assert f'href="#e={first.episode}&amp;t={first.t}"' in section
+    # head 1's top pair agent-teleport: its first state is the first where a1, a2 are on them
+    att = rec.attends[rec.attends["head"] == 1]
+    a1 = att[(att["arg"] == 1) & (att["entity"] == "agent")][["episode", "t"]]
+    a2 = att[(att["arg"] == 2) & (att["entity"] == "teleport")][["episode", "t"]]
+    e, t = a1.merge(a2).sort_values(["episode", "t"]).iloc[0]
+    heads = html[html.index('id="heads"') : html.index('id="relations"')]
+    assert f'agent-teleport</span> 1 %: <a href="#e={e}&amp;t={t}">' in heads
 
 
 def test_report_from_a_checkpoint_writes_extracts_products(run_neurosym, tmp_path: Path) -> None:  # noqa: ANN001
