@@ -257,3 +257,18 @@ def test_hostile_text_stays_text(tmp_path: Path) -> None:
     }
     csp = re.search(r"script-src '(sha256-[A-Za-z0-9+/=]+)'", html)
     assert csp is not None  # only the page's own script, by hash, may run
+
+
+def test_recording_subfolder_and_a_missing_checkpoint(
+    predinet_page: tuple[Recording, Path, str], tmp_path: Path
+) -> None:
+    _, folder, html = predinet_page
+    out = tmp_path / "page"
+    args = ["--recording", str(folder / "recording"), "--out", str(out), "--quiet"]
+    assert main(["report", *args]) == 0
+    again = (out / "index.html").read_text(encoding="utf-8")
+    assert embedded(again) == embedded(html)
+    assert "sword before enemy" in again  # kb.pl found beside recording/
+    # the recording names scripted.pt, which is not a file: the card says so
+    assert "The checkpoint scripted.pt the recording names is not at hand" in again
+    assert "none: the checkpoint is not at hand" in again

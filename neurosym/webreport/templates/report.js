@@ -109,7 +109,7 @@
     const main = $("map"); main.textContent = "";
     mainMap = makeMap(main, Math.max(18, Math.min(36, Math.floor(380 / Math.max(h, w)))), true);
     const box = $("panels"); box.textContent = "";
-    const cell = Math.max(10, Math.min(22, Math.floor(210 / Math.max(h, w))));
+    const cell = Math.max(10, Math.min(24, Math.floor(256 / Math.max(h, w))));
     panels = P.heads.map((head, i) => {
       const fig = document.createElement("figure");
       fig.className = "panel"; fig.dataset.head = head;
