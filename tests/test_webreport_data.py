@@ -272,3 +272,27 @@ def test_recording_subfolder_and_a_missing_checkpoint(
     # the recording names scripted.pt, which is not a file: the card says so
     assert "The checkpoint scripted.pt the recording names is not at hand" in again
     assert "none: the checkpoint is not at hand" in again
+
+
+def test_card_prefers_the_checkpoints_own_card() -> None:
+    from types import SimpleNamespace
+
+    from neurosym.webreport.card import agent_card
+
+    meta = {"frames": 1200, "metrics": {"greedy_return": 10.7}, "train_config": {"algo": "ppo"}}
+    agent = SimpleNamespace(env_name="rgw-random", env_kwargs={}, meta=meta)
+    rec_meta = {"env": "rgw2", "module": "mhdpa", "heads": 2, "seed": 0, "checkpoint": "a.pt"}
+    plain = agent_card(rec_meta, agent)
+    assert plain["figures"] == [("greedy_return", "10.7")]
+    assert plain["figures_from"].startswith("the last figures of training (not held out")
+    assert ("learner", "ppo") in plain["rows"] and ("frames", "1,200") in plain["rows"]
+    held = {"held_out": {"levels": 1000, "success": 0.9512}, "env": "rgw-random"}
+    card = agent_card(
+        rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "meta": {"card": held}}})
+    )
+    assert card["figures"] == [
+        ("held_out.levels", "1000"),
+        ("held_out.success", "0.9512"),
+        ("env", "rgw-random"),
+    ]
+    assert card["figures_from"] == "the checkpoint's card (held-out evaluation)"
