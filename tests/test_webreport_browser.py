@@ -200,3 +200,52 @@ def test_hostile_kb_text_runs_nothing(browser: Any, tmp_path: Path) -> None:
     open_page(browser, folder / "index.html", f"#e={first.episode}&t={first.t}")
     assert TAG in browser.find_element("id", "s-events").text  # shown as text
     assert SCRIPT in browser.find_element("tag name", "body").text
+
+
+@pytest.fixture(scope="module")
+def other_pages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Recording, Path]]:
+    """An MHDPA page and a Box-World page."""
+    from test_recorder_scripted import explorer_recording
+
+    pages = {}
+    for name, rec in (
+        ("mhdpa", scripted_recording("mhdpa")),
+        ("boxworld", explorer_recording("bw2", episodes=3)),
+    ):
+        folder = extract_folder(rec, tmp_path_factory.mktemp(name) / "out")
+        report(folder)
+        pages[name] = (rec, folder / "index.html")
+    return pages
+
+
+@pytest.mark.parametrize("name", ["mhdpa", "boxworld"])
+def test_every_state_plays_without_console_errors(
+    name: str, browser: Any, other_pages: dict
+) -> None:
+    rec, page = other_pages[name]
+    for episode in rec.episodes["episode"]:
+        open_page(browser, page, f"#e={episode}&t=0")
+        steps = int(rec.episodes.loc[rec.episodes["episode"] == episode, "steps"].iloc[0])
+        last = browser.execute_script(
+            "const r = window.neurosymReport;"
+            f"for (let t = 0; t <= {steps}; t++) r.setStep(t); return [r.episode, r.t];"
+        )
+        assert last == [int(episode), steps]
+    assert errors(browser) == []
+
+
+def test_mhdpa_marks_the_agents_strongest_key(browser: Any, other_pages: dict) -> None:
+    rec, page = other_pages["mhdpa"]
+    att, pos = rec.attention, rec.positions
+    for t in (2, 9):
+        open_page(browser, page, f"#e=1&t={t}")
+        agent = pos[(pos["episode"] == 1) & (pos["t"] == t) & (pos["type"] == "agent")].iloc[0]
+        rows = att[(att["episode"] == 1) & (att["t"] == t)]
+        mine = rows[(rows["query_row"] == agent["row"]) & (rows["query_col"] == agent["col"])]
+        # the heaviest key, the first in the table's order on a tie (as the page picks)
+        best = mine.sort_values("weight", ascending=False, kind="stable").groupby("head").head(1)
+        want = {
+            (int(r.head), "att focus", int(r.key_row), int(r.key_col)) for r in best.itertuples()
+        }
+        shown = {(m["head"], m["cls"], m["row"], m["col"]) for m in markers(browser)}
+        assert shown == want and want, f"[{t}]"
