@@ -296,3 +296,5 @@ def test_card_prefers_the_checkpoints_own_card() -> None:
         ("env", "rgw-random"),
     ]
     assert card["figures_from"] == "the checkpoint's card (held-out evaluation)"
+    top = agent_card(rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "card": held}}))
+    assert top["figures"] == card["figures"]  # a card at the payload's top level reads the same

@@ -39,6 +39,15 @@ def _flat(prefix: str, value: Any) -> list[tuple[str, str]]:
     return [(prefix, _text(value))]
 
 
+def _card(meta: dict[str, Any]) -> dict[str, Any] | None:
+    """The checkpoint's card: ``payload["meta"]["card"]`` or ``payload["card"]``, else None."""
+    inner = meta.get("meta")
+    for card in ((inner or {}).get("card") if isinstance(inner, dict) else None, meta.get("card")):
+        if isinstance(card, dict) and card:
+            return card
+    return None
+
+
 def agent_card(rec_meta: dict[str, Any], agent: Any | None, note: str | None = None) -> dict:
     """``{"rows": [(label, text)], "figures": [(label, text)], "figures_from": text, "note"}``.
 
@@ -72,8 +81,8 @@ def agent_card(rec_meta: dict[str, Any], agent: Any | None, note: str | None = N
             ("neurosym version", _text(meta.get("version", "-"))),
             ("command", _text(meta.get("command", "-"))),
         ]
-        card = (meta.get("meta") or {}).get("card") if isinstance(meta.get("meta"), dict) else None
-        if isinstance(card, dict) and card:
+        card = _card(meta)
+        if card is not None:
             figures = _flat("", card)
             source = "the checkpoint's card (held-out evaluation)"
         else:
