@@ -26,6 +26,7 @@ $(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
 	@echo "neurosym: set up in $(VENV) (swipl: $$(cat $(SWIPL_PATH_FILE)))"
 
 test: setup
+	@bash scripts/setup_browser.sh
 	$(PY) -m pytest -q
 
 demo: setup

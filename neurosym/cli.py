@@ -168,6 +168,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "neurosym.viz.cli_plot",
         "Draw attention maps, R-vector heat maps and episode renderings.",
     ),
+    "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
 }
 

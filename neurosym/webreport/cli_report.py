@@ -1,0 +1,179 @@
+"""``neurosym report``: one self-contained HTML page about an agent, opened from disk.
+
+    neurosym report --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--env-option K=V]
+        [--episodes 20] [--seed 0] [--greedy|--sample] [--threshold quantile:0.9]
+        [--probe DIR] [--intervene DIR] [--out DIR]
+    neurosym report --recording DIR [--probe DIR] [--intervene DIR] [--out DIR]
+
+With ``--checkpoint`` it records episodes as ``neurosym extract`` does and
+writes, into ``--out`` (default ``kb_out/<env>``), what extract writes
+(``kb.pl``, ``recording/``) plus ``index.html``; everything is staged first
+and moved in by one rename each (:mod:`neurosym.publish`). With
+``--recording`` it reports a folder extract wrote (or its ``recording/``
+folder) and writes ``index.html`` there (or into ``--out``) atomically.
+``--probe`` and ``--intervene`` add the tables of the folders ``neurosym
+probe`` and ``neurosym intervene`` wrote.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from neurosym.cli import add_action_mode, add_env_options, play_options
+from neurosym.errors import ConfigError
+from neurosym.publish import check_out
+
+CHECKPOINT_ONLY = ("env", "map", "episodes", "seed", "batch", "top_keys")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the report options."""
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--checkpoint", metavar="FILE", help="trained agent (.pt) to record")
+    source.add_argument(
+        "--recording", metavar="DIR", help="report the folder `neurosym extract --out DIR` wrote"
+    )
+    add_env_options(parser)
+    parser.add_argument(
+        "--episodes", type=int, default=None, metavar="N", help="episodes to record (default: 20)"
+    )
+    parser.add_argument(
+        "--seed", type=int, default=None, metavar="S", help="episode k uses seed S + k (default: 0)"
+    )
+    add_action_mode(parser)
+    parser.add_argument(
+        "--threshold",
+        default=None,
+        metavar="SPEC",
+        help="threshold for holds/5: quantile:Q, abs:X or z:K (default: the extract's, "
+        "else quantile:0.9)",
+    )
+    parser.add_argument("--batch", type=int, default=None, metavar="B", help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--top-keys",
+        type=int,
+        default=None,
+        metavar="N",
+        help="MHDPA: keep each query cell's N strongest keys (default: 1)",
+    )
+    parser.add_argument(
+        "--probe", metavar="DIR", help="add the probes `neurosym probe --out DIR` wrote"
+    )
+    parser.add_argument(
+        "--intervene",
+        metavar="DIR",
+        help="add the experiments `neurosym intervene --out DIR` wrote",
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: --recording's folder, or kb_out/<env> with --checkpoint)",
+    )
+    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+
+def _extras(args: argparse.Namespace) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
+    """The probe and experiment sections, read before anything is recorded (bad folders fail fast)."""
+    from neurosym.webreport.extras import intervene_section, probe_section
+
+    probes = probe_section(Path(args.probe)) if args.probe else None
+    experiments = intervene_section(Path(args.intervene)) if args.intervene else None
+    return probes, experiments
+
+
+def _check(args: argparse.Namespace) -> None:
+    if args.recording is not None:
+        given = [name for name in CHECKPOINT_ONLY if getattr(args, name) is not None]
+        given += ["env_option"] if args.env_option else []
+        if given:
+            flags = ", ".join("--" + g.replace("_", "-") for g in given)
+            raise ConfigError(
+                f"{flags} go(es) with --checkpoint; a recording is reported as recorded"
+            )
+        return
+    for name, low in (("episodes", 1), ("seed", 0), ("batch", 1), ("top_keys", 1)):
+        value = getattr(args, name)
+        if value is not None and value < low:
+            flag = "--" + name.replace("_", "-")
+            raise ConfigError(f"{flag} must be at least {low}, got {value}")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate, then report a recording or record the checkpoint and report it."""
+    _check(args)
+    if args.out is not None:
+        check_out(Path(args.out))
+    if args.threshold is not None:
+        from neurosym.export.thresholds import parse_threshold
+
+        parse_threshold(args.threshold)
+    probes, experiments = _extras(args)
+    if args.recording is not None:
+        page = _from_recording(args, probes, experiments)
+    else:
+        page = _from_checkpoint(args, probes, experiments)
+    if not args.quiet:
+        print(f"wrote {page}")
+    return 0
+
+
+def _from_recording(args: argparse.Namespace, probes: Any, experiments: Any) -> Path:
+    from neurosym.webreport.build import (
+        load_agent_or_note,
+        load_extract,
+        recording_folder,
+        report_context,
+        write_report,
+    )
+    from neurosym.webreport.card import agent_card
+
+    _, folder = recording_folder(Path(args.recording))
+    rec, facts, kb_path = load_extract(Path(args.recording), args.threshold)
+    agent, note = load_agent_or_note(rec.meta.get("checkpoint"))
+    card = agent_card(rec.meta, agent, note)
+    context = report_context(
+        rec, facts, kb_path, card, probes, experiments, source=f"the recording in {folder}"
+    )
+    return write_report(Path(args.out) if args.out else folder, context)
+
+
+def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) -> Path:
+    from neurosym.agent.checkpoint import env_for, load_agent
+    from neurosym.export.facts import DEFAULT_THRESHOLD, extract_facts
+    from neurosym.export.recorder import record
+    from neurosym.publish import publish
+    from neurosym.webreport.build import report_context
+    from neurosym.webreport.card import agent_card
+    from neurosym.webreport.page import render
+
+    agent = load_agent(args.checkpoint)
+    env, overrides = play_options(args, agent.env_name)
+    env, env_kwargs = env_for(agent, env, overrides)
+    out = Path(args.out) if args.out else Path("kb_out") / env
+    check_out(out)
+    rec = record(
+        agent,
+        env,
+        episodes=20 if args.episodes is None else args.episodes,
+        seed=args.seed or 0,
+        greedy=args.greedy,
+        batch=args.batch,
+        progress=False,
+        top_keys=args.top_keys or 1,
+        env_kwargs=env_kwargs,
+    )
+    facts = extract_facts(rec, threshold=args.threshold or DEFAULT_THRESHOLD)
+    card = agent_card(rec.meta, agent)
+
+    def write(stage: Path) -> None:
+        facts.to_prolog(stage / "kb.pl")
+        rec.save(stage / "recording")
+        context = report_context(
+            rec, facts, stage / "kb.pl", card, probes, experiments, source=f"{args.checkpoint}"
+        )
+        (stage / "index.html").write_text(render(context), encoding="utf-8")
+
+    written = publish(out, write, folders=("recording",), prefix=".report-")
+    return written["index.html"]

@@ -1,0 +1,123 @@
+"""The episode player's data: the recording's tables, split per episode, as JSON-ready columns.
+
+Every table the player draws from (``positions``, ``holding``, ``events``,
+``attends``, ``relations``, ``attention``) is embedded as it was recorded,
+one column list per schema column without ``episode``, floats at full
+precision: the page shows the recording's own values, and
+``tests/test_webreport_data.py`` checks that the embedded columns put back
+together equal the recording's tables. The map's terrain (walls, mountains,
+pits: cells the recording does not list) comes from the environment's layout
+after ``reset(seed)``, as :func:`neurosym.viz.recorded.trace_from_recording`
+rebuilds it; equal layouts are stored once.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import pandas as pd
+
+from neurosym.export.recording import SCHEMA, Recording
+
+PLAYER_TABLES = ("positions", "holding", "events", "attends", "relations", "attention")
+"""recording tables embedded per episode"""
+
+
+def columns(df: pd.DataFrame, drop: tuple[str, ...] = ("episode",)) -> dict[str, list[Any]]:
+    """``{column: values}`` of ``df`` without ``drop``; NaN becomes None (JSON has no NaN)."""
+    out: dict[str, list[Any]] = {}
+    for name in df.columns:
+        if name in drop:
+            continue
+        values = df[name].tolist()
+        if df[name].dtype.kind == "f":
+            values = [None if math.isnan(v) else v for v in values]
+        elif df[name].dtype.kind not in "iub":
+            values = [str(v) for v in values]
+        out[name] = values
+    return out
+
+
+def _terrain(rec: Recording, episode: int) -> list[list[str]]:
+    """(H, W) entity names of the episode's map without the recorded objects and the agent."""
+    from neurosym.viz.recorded import trace_from_recording
+
+    grid = trace_from_recording(rec, episode).grids[0].copy()
+    first = rec.positions.loc[(rec.positions["episode"] == episode) & (rec.positions["t"] == 0)]
+    h, w = grid.shape
+    for r, c in zip(first["row"], first["col"], strict=True):
+        if 0 <= r < h and 0 <= c < w:
+            grid[r, c] = "empty"
+    return [[str(x) for x in row] for row in grid]
+
+
+def player_data(rec: Recording) -> dict[str, Any]:
+    """Module, heads, grid shape, terrains and the episodes, each with its tables as columns."""
+    meta = rec.meta
+    heads = sorted({int(h) for name in ("attends", "attention") for h in rec.tables[name]["head"]})
+    if not heads:
+        heads = list(range(int(meta.get("heads") or 0)))
+    terrains: list[list[list[str]]] = []
+    by_episode = {name: dict(tuple(rec.tables[name].groupby("episode"))) for name in PLAYER_TABLES}
+    steps = dict(tuple(rec.steps.groupby("episode")))
+    episodes = []
+    for row in rec.episodes.sort_values("episode").to_dict("records"):
+        e = int(row["episode"])
+        terrain = _terrain(rec, e)
+        if terrain not in terrains:
+            terrains.append(terrain)
+        own = steps.get(e, pd.DataFrame(columns=["t", "action", "reward"])).sort_values("t")
+        episodes.append(
+            {
+                "episode": e,
+                "steps": int(row["steps"]),
+                "return": float(row["return"]),
+                "outcome": str(row["outcome"]),
+                "seed": int(row["seed"]),
+                "terrain": terrains.index(terrain),
+                "actions": [str(a) for a in own["action"]],
+                "rewards": [float(r) for r in own["reward"]],
+                "tables": {
+                    name: columns(by_episode[name].get(e, _empty(name))) for name in PLAYER_TABLES
+                },
+            }
+        )
+    shape = [len(terrains[0]), len(terrains[0][0])] if terrains else [0, 0]
+    return {
+        "module": str(meta.get("module", "")),
+        "heads": heads,
+        "relations": int(meta.get("relations") or 0),
+        "shape": shape,
+        "terrains": terrains,
+        "episodes": episodes,
+    }
+
+
+def _empty(name: str) -> pd.DataFrame:
+    if name not in _EMPTY:
+        _EMPTY[name] = pd.DataFrame({c: pd.Series([], dtype=d) for c, d in SCHEMA[name]})
+    return _EMPTY[name]
+
+
+_EMPTY: dict[str, pd.DataFrame] = {}
+
+
+def entity_styles(names: set[str]) -> dict[str, dict[str, str]]:
+    """Fill, text colour and label of every entity name on the page (the viz style's)."""
+    from neurosym.viz.style import entity_colour, entity_label, text_colour_on
+
+    out = {}
+    for name in sorted(names):
+        fill = entity_colour(name)
+        out[name] = {"fill": fill, "text": text_colour_on(fill), "label": entity_label(name)}
+    return out
+
+
+def names_in(player: dict[str, Any]) -> set[str]:
+    """Every entity name the player draws: terrain cells and recorded object types."""
+    names = {x for terrain in player["terrains"] for row in terrain for x in row}
+    for ep in player["episodes"]:
+        names.update(ep["tables"]["positions"].get("type", []))
+    names.add("agent")
+    return names
