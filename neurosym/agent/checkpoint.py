@@ -57,6 +57,7 @@ from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
 from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
+from neurosym.shipped import checkpoint_file
 
 CARRIED_OPTIONS = ("obs_mode",)
 """env options a checkpoint brings to another env of its family: they decide the observation"""
@@ -208,9 +209,10 @@ def read_checkpoint(
 
     ``env``: refuse a checkpoint that cannot run there (another family or
     observation shape, see :func:`env_for`). ``config``: refuse one whose
-    model config differs (named field by field).
+    model config differs (named field by field). A shipped agent's bare name
+    (``rgw2-predinet``) reads the shipped file (:func:`neurosym.shipped.checkpoint_file`).
     """
-    path = Path(path)
+    path = checkpoint_file(path)
     payload = _load_raw(path)
     if not isinstance(payload, dict):
         raise CheckpointError(
@@ -372,6 +374,7 @@ def load_agent(
 
     ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
     """
+    path = checkpoint_file(path)
     payload = read_checkpoint(path, env=env, config=config)
     model = build_model(payload, path)
     model.eval()

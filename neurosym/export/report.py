@@ -38,11 +38,10 @@ RULE_FILES: dict[str, tuple[str, ...]] = {
 
 
 def rules_dir() -> Path | None:
-    """The repository's rules/ folder (beside the package), or None when it is not there."""
-    import neurosym
+    """The shipped rule files' folder (:func:`neurosym.shipped.rules_dir`), or None."""
+    from neurosym.shipped import rules_dir as shipped_rules
 
-    path = Path(neurosym.__file__).resolve().parent.parent / "rules"
-    return path if (path / "relations.pl").is_file() else None
+    return shipped_rules()
 
 
 def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]:
@@ -220,6 +219,6 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
                 qt.add_row(title, escape(_short(values, of=of)))
             say(qt)
         else:
-            say("rule answers: none (rules/ is not beside the package)")
+            say("rule answers: none (neurosym's rule files are missing: no rules/ in the clone or the package)")
     for path in written.values():
         say(f"wrote {escape(str(path))}")
