@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | plot | envs.
+"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | plot | envs | agents.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -169,6 +169,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "Draw attention maps, R-vector heat maps and episode renderings.",
     ),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
+    "agents": (
+        "neurosym.cli_agents",
+        "List the shipped agents: env, module, learner, held-out success, what each is for.",
+    ),
 }
 
 
