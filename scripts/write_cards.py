@@ -33,7 +33,10 @@ def rgw(sampled: tuple[float, ...], greedy: tuple[float, ...]) -> dict[str, dict
 
 def bw(sampled: int, greedy: int) -> dict[str, dict[str, float]]:
     """Successes of 300 episodes, sampled and greedy."""
-    return {m: {"success_rate": round(n / 300, 4)} for m, n in (("sampled", sampled), ("greedy", greedy))}
+    return {
+        m: {"success_rate": round(n / 300, 4)}
+        for m, n in (("sampled", sampled), ("greedy", greedy))
+    }
 
 
 FIXED_MAP = "thesis agent: plays its one map optimally"
@@ -43,23 +46,41 @@ FIXED_MAP = "thesis agent: plays its one map optimally"
 CARDS: dict[str, tuple[str, str, str, dict[str, Any]]] = {
     "rgw-random-predinet-cellkeys": (
         "general PrediNet: best player, relates objects",
-        "rgw-random", " --env-option num_mountains=6",
+        "rgw-random",
+        " --env-option num_mountains=6",
         rgw((98.7, 93.3, 100.0, 98.0), (92.3, 90.3, 97.3, 92.1)),
     ),
     "rgw-random-mhdpa": (
         "general MHDPA: best player",
-        "rgw-random", "",
+        "rgw-random",
+        "",
         rgw((98.7, 93.7, 98.7, 98.7), (91.0, 89.7, 96.6, 89.4)),
     ),
     # measured for the card (the fixed-map agents on rgw-random, zero-shot)
-    "rgw1-predinet": (FIXED_MAP, "rgw-random", " --env rgw-random",
-                      rgw((1.33, 0.33, 9.40, 2.65), (1.0, 0.0, 4.03, 1.32))),
-    "rgw1-mhdpa": (FIXED_MAP, "rgw-random", " --env rgw-random",
-                   rgw((1.0, 0.0, 10.07, 1.99), (1.0, 0.33, 6.71, 1.32))),
-    "rgw2-predinet": (FIXED_MAP, "rgw-random", " --env rgw-random",
-                      rgw((1.0, 0.0, 6.71, 1.32), (0.67, 0.0, 4.70, 0.66))),
-    "rgw2-mhdpa": (FIXED_MAP, "rgw-random", " --env rgw-random",
-                   rgw((1.67, 0.0, 12.08, 1.99), (0.67, 0.0, 1.34, 1.32))),
+    "rgw1-predinet": (
+        FIXED_MAP,
+        "rgw-random",
+        " --env rgw-random",
+        rgw((1.33, 0.33, 9.40, 2.65), (1.0, 0.0, 4.03, 1.32)),
+    ),
+    "rgw1-mhdpa": (
+        FIXED_MAP,
+        "rgw-random",
+        " --env rgw-random",
+        rgw((1.0, 0.0, 10.07, 1.99), (1.0, 0.33, 6.71, 1.32)),
+    ),
+    "rgw2-predinet": (
+        FIXED_MAP,
+        "rgw-random",
+        " --env rgw-random",
+        rgw((1.0, 0.0, 6.71, 1.32), (0.67, 0.0, 4.70, 0.66)),
+    ),
+    "rgw2-mhdpa": (
+        FIXED_MAP,
+        "rgw-random",
+        " --env rgw-random",
+        rgw((1.67, 0.0, 12.08, 1.99), (0.67, 0.0, 1.34, 1.32)),
+    ),
     "bw1-predinet": ("thesis agent", "bw1", "", bw(300, 289)),
     "bw2-predinet": ("thesis agent; relates the agent to locks", "bw2", "", bw(300, 293)),
     "bw3-predinet": ("thesis agent", "bw3", "", bw(297, 259)),
@@ -76,8 +97,13 @@ def card(name: str) -> dict[str, Any]:
     return {
         "role": role,
         "eval_command": EVAL.format(name=name, env=flags),
-        "held_out": {"env": env, "env_options": options, "episodes": 300, "seed": 3_000_000_000,
-                     **figures},  # fmt: skip
+        "held_out": {
+            "env": env,
+            "env_options": options,
+            "episodes": 300,
+            "seed": 3_000_000_000,
+            **figures,
+        },  # fmt: skip
     }
 
 

@@ -26,7 +26,9 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
     assert rule_file("rgw") == REPO / "rules" / "rgw.pl"
     assert rule_file("boxworld.pl") == REPO / "rules" / "boxworld.pl"
     assert rule_file("mine.pl") == Path("mine.pl")  # not there: the loader says so
-    with pytest.raises(ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw\)"):
+    with pytest.raises(
+        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw\)"
+    ):
         rule_file("rgx")
     (tmp_path / "rgw").write_text("my_rule.\n")  # a file of the user's wins over the shipped name
     assert rule_file("rgw") == Path("rgw")
@@ -55,8 +57,9 @@ def test_query_takes_a_shipped_rule_file_by_name(run_neurosym, tmp_path: Path) -
 def test_write_card_keeps_the_weights_and_the_agent_replays(tmp_path: Path) -> None:
     """A card written into a copy of a shipped agent: every other entry and every weight as they
     were, and the agent still plays rgw2 by the optimal route."""
-    from neurosym.cards import write_card
     from test_checkpoint_shipped import OPTIMAL, ROUTES, play
+
+    from neurosym.cards import write_card
 
     path = tmp_path / "agent.pt"
     shutil.copy(CHECKPOINTS / "rgw2-predinet.pt", path)
@@ -79,7 +82,9 @@ def test_write_card_keeps_the_weights_and_the_agent_replays(tmp_path: Path) -> N
     total, events, _ = play(path, ROUTES["rgw2"])
     assert events == ROUTES["rgw2"] and total == pytest.approx(OPTIMAL["rgw2"])
     with pytest.raises(CheckpointError, match="held_out.greedy.success_rate must be in"):
-        write_card(path, {**card, "held_out": {**card["held_out"], "greedy": {"success_rate": 2.0}}})
+        write_card(
+            path, {**card, "held_out": {**card["held_out"], "greedy": {"success_rate": 2.0}}}
+        )
     with pytest.raises(CheckpointError, match="lacks role"):
         write_card(path, {"eval_command": "", "held_out": {}})
     assert load_agent(path).meta["card"] == card  # a refused card changes nothing
@@ -95,7 +100,9 @@ def test_every_shipped_agent_carries_its_card() -> None:
     shipped = sorted(p.stem for p in CHECKPOINTS.glob("*.pt"))
     assert sorted(write_cards.CARDS) == shipped
     for name in shipped:
-        assert torch.load(CHECKPOINTS / f"{name}.pt", weights_only=True)["card"] == write_cards.card(name)
+        assert torch.load(CHECKPOINTS / f"{name}.pt", weights_only=True)[
+            "card"
+        ] == write_cards.card(name)
     assert write_cards.main(["--check"]) == 0
 
 
@@ -103,7 +110,10 @@ def test_learner_from_the_train_config_or_the_command() -> None:
     from neurosym.cards import learner
 
     assert learner({"train_config": {"algo": "imitate"}, "command": ""}) == "imitate"
-    assert learner({"train_config": None, "command": "neurosym train --env rgw2 --module predinet"}) == "a3c"
+    assert (
+        learner({"train_config": None, "command": "neurosym train --env rgw2 --module predinet"})
+        == "a3c"
+    )
     cmd = "neurosym train --env rgw2 --algo ppo && neurosym compact a.pt --out a.pt"
     assert learner({"train_config": None, "command": cmd}) == "ppo"
 
@@ -115,7 +125,11 @@ def test_agents_lists_the_shipped_agents(run_neurosym) -> None:
     assert sorted(agents) == sorted(p.stem for p in CHECKPOINTS.glob("*.pt"))
     cellkeys = agents["rgw-random-predinet-cellkeys"]
     assert cellkeys["file"] == str(CHECKPOINTS / "rgw-random-predinet-cellkeys.pt")
-    assert (cellkeys["env"], cellkeys["module"], cellkeys["learner"]) == ("rgw-random", "predinet", "imitate")
+    assert (cellkeys["env"], cellkeys["module"], cellkeys["learner"]) == (
+        "rgw-random",
+        "predinet",
+        "imitate",
+    )
     assert cellkeys["env_options"] == {"num_mountains": 12} and cellkeys["frames"] == 1_399_959
     assert cellkeys["card"]["held_out"]["sampled"]["success_rate"] == 0.987
     assert agents["rgw2-predinet"]["learner"] == "a3c"
