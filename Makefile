@@ -28,12 +28,21 @@ $(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
 test: setup
 	$(PY) -m pytest -q
 
+# One story in three steps (about 30 s once set up); `neurosym extract --verbose` prints the full tables.
+NS := $(VENV)/bin/neurosym
 demo: setup
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw2-predinet.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw-random --episodes 20 --seed 3000000000 --sample --out kb_out/rgw-random
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cells.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cells
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
+	@echo "== 1/3 The general PrediNet (trained on random levels) plays rgw2, a map it never saw: its route,"
+	@echo "==     its relation heads (head 0 relates the agent to what it is after) and the rules' answers"
+	@$(NS) extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
+	@echo
+	@echo "== 2/3 A Box-World agent (bw2-predinet) on 20 unseen bw2 levels: head 0 relates the agent to locks"
+	@$(NS) extract --checkpoint checkpoints/bw2-predinet.pt --episodes 20 --seed 3000000000 --out kb_out/bw2
+	@echo
+	@echo "== 3/3 The contrast: rgw2-predinet learnt one map (it plays rgw2 optimally); on 100 random levels:"
+	@$(NS) eval --checkpoint checkpoints/rgw2-predinet.pt --env rgw-random --episodes 100 --seed 3000000000 --json \
+	  | $(PY) -c 'import json, sys; r = json.load(sys.stdin); print("success %.0f %% (the general PrediNet: 92 %%), mean return %.2f" % (100 * r["success_rate"], r["mean_return"]))'
+	@echo
+	@echo "Next: neurosym query --kb kb_out/rgw2-cellkeys/kb.pl --rules rgw 'visit_order(E, Order)'; neurosym agents"
 
 bench: setup
 	$(PY) bench/envs.py
