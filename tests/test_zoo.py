@@ -41,6 +41,16 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
         load_agent("rgw9-predinet")
 
 
+def test_a_knowledge_base_loads_a_shipped_rule_file_by_name(tmp_path: Path) -> None:
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    kb = tmp_path / "kb.pl"
+    kb.write_text("episode(0, 3, 11.0, terminal).\nevent(0, 1, picked(sword)).\n"
+                  "event(0, 2, defeated(enemy)).\n")  # fmt: skip
+    with KnowledgeBase(kb, rules=["rgw", "relations"]) as base:
+        assert [row["E"] for row in base.query("sword_before_enemy(E)")] == [0]
+
+
 def test_query_takes_a_shipped_rule_file_by_name(run_neurosym, tmp_path: Path) -> None:
     kb = tmp_path / "kb.pl"
     kb.write_text("episode(0, 3, 11.0, terminal).\nevent(0, 1, picked(sword)).\n"
