@@ -168,3 +168,17 @@ def test_agents_in_a_folder_of_ones_own(run_neurosym, tmp_path: Path) -> None:
     empty.mkdir()
     proc = run_neurosym("agents", "--dir", empty)
     assert proc.stderr == f"neurosym agents: error: no agents (*.pt files) in {empty}\n"
+
+
+def test_compact_takes_a_shipped_agent_by_name_and_drops_its_card(tmp_path: Path) -> None:
+    """The card's figures were measured on the float32 weights, not on the compacted ones."""
+    from neurosym.agent.checkpoint import compact_checkpoint
+
+    out = tmp_path / "small.pt"
+    compact_checkpoint("rgw2-mhdpa", out)
+    assert "card" in load_agent("rgw2-mhdpa").meta
+    small = load_agent(out)
+    assert "card" not in small.meta and small.meta["weights_dtype"] == "float16"
+    assert small.meta["command"].endswith(
+        f"neurosym compact {CHECKPOINTS / 'rgw2-mhdpa.pt'} --out {out} --dtype float16"
+    )

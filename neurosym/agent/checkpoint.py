@@ -295,13 +295,14 @@ def compact_checkpoint(
     moments, and half precision halves its size (the Box-World PrediNet's
     1.36 M parameters take 5.4 MB in float32). The model still computes in
     float32: the weights are cast back when loaded. Everything else (config,
-    env, frames, metrics) is kept; the command gets `` && neurosym compact ...``.
+    env, frames, metrics) is kept but the agent card (its figures are the old weights'); the
+    command gets `` && neurosym compact ...``.
     ``dst`` may be ``src``: the file is replaced atomically. Returns the sizes
     in bytes and the largest absolute change of a weight.
     """
     if dtype not in COMPACT_DTYPES:
         raise ConfigError(f"--dtype {dtype!r} is not one of {', '.join(COMPACT_DTYPES)}")
-    src, dst = Path(src), Path(dst)
+    src, dst = checkpoint_file(src), Path(dst)
     payload = read_checkpoint(src)
     target = COMPACT_DTYPES[dtype]
     state: dict[str, torch.Tensor] = {}
@@ -325,6 +326,7 @@ def compact_checkpoint(
     out["state_dict"] = state
     out["optimizer"] = None
     out["weights_dtype"] = dtype
+    out.pop("card", None)  # its figures were measured on the weights before
     step = shlex.join(["neurosym", "compact", str(src), "--out", str(dst), "--dtype", dtype])
     out["command"] = f"{payload['command']} && {step}" if payload.get("command") else step
     _write_payload(dst, out)
