@@ -49,3 +49,16 @@ def test_extract_verbose_flag(run_neurosym, tmp_path: Path) -> None:
     assert "steps, return and how each episode ended" not in short.stdout
     assert "steps, return and how each episode ended" in full.stdout
     assert "1 of 1 episodes" in short.stdout and "0  (1 of 1 episodes)" in full.stdout
+
+
+def test_missing_rule_files_are_said_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import neurosym.shipped
+
+    monkeypatch.setattr(neurosym.shipped, "rules_dir", lambda: None)
+    text = report(tmp_path, capsys, False)
+    assert (
+        "rule answers: none (neurosym's rule files are missing: no rules/ folder found)\n" in text
+    )
+    assert "rules/rgw.pl" not in text

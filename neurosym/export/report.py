@@ -253,6 +253,6 @@ def print_report(
             say(qt)
             say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
         else:
-            say("rule answers: none (neurosym's rule files are missing: no rules/ in the clone or the package)")
+            say("rule answers: none (neurosym's rule files are missing: no rules/ folder found)")
     for path in written.values():
         say(f"wrote {escape(str(path))}")
