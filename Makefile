@@ -12,7 +12,7 @@ export PYTHONHASHSEED := 0
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
+$(STAMP): pyproject.toml setup.py scripts/setup_swipl.sh Makefile
 	@test -x $(PY) || python3 -m venv $(VENV)
 	@# torch first, pinned, so that the package's range never pulls the CUDA wheels.
 	@$(PY) -m pip show torch >/dev/null 2>&1 || $(PY) -m pip install -q "$(TORCH_SPEC)"
