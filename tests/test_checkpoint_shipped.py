@@ -2,7 +2,7 @@
 env's own events; Box-World and rgw-random agents solve levels they never trained on (reset seeds
 >= 2**31); the cell-keyed rgw-random PrediNet has a head that relates two different objects on
 rgw-random and plays rgw2 by the optimal route, relating the agent to the sword and the enemy,
-with a sword-enemy link in Prolog; every shipped agent carries its card."""
+with a sword-enemy link in Prolog. (Each agent's card: tests/test_zoo.py.)"""
 
 from __future__ import annotations
 
