@@ -17,6 +17,7 @@ setup(
     package_dir={"neurosym.rules": "rules", "neurosym.checkpoints": "checkpoints"},
     package_data={
         "neurosym.envs": ["maps/*.txt"],
+        "neurosym.webreport": ["templates/*"],
         "neurosym.rules": ["*.pl"],
         "neurosym.checkpoints": ["*.pt"],
     },
