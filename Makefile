@@ -12,7 +12,7 @@ export PYTHONHASHSEED := 0
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
+$(STAMP): pyproject.toml setup.py scripts/setup_swipl.sh Makefile
 	@test -x $(PY) || python3 -m venv $(VENV)
 	@# torch first, pinned, so that the package's range never pulls the CUDA wheels.
 	@$(PY) -m pip show torch >/dev/null 2>&1 || $(PY) -m pip install -q "$(TORCH_SPEC)"
@@ -29,12 +29,24 @@ test: setup
 	@bash scripts/setup_browser.sh
 	$(PY) -m pytest -q
 
+# One story in three steps (under a minute once set up); `neurosym extract --verbose` prints the full tables.
+NS := $(VENV)/bin/neurosym
 demo: setup
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw2-predinet.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw-random --episodes 20 --seed 3000000000 --sample --out kb_out/rgw-random
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cells.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cells
-	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
+	@echo "== 1/3 The general PrediNet (trained on random levels) plays rgw2, a map it never saw: its route,"
+	@echo "==     its relation heads (head 0 relates the agent to what it is after) and the rules' answers"
+	@$(NS) extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
+	@echo
+	@echo "== 2/3 A Box-World agent (bw2-predinet) on 20 unseen bw2 levels: head 0 relates the agent to locks"
+	@$(NS) extract --checkpoint checkpoints/bw2-predinet.pt --episodes 20 --seed 3000000000 --out kb_out/bw2
+	@echo
+	@echo "== 3/3 The contrast: rgw2-predinet learnt one map (it plays rgw2 optimally); on 100 random levels:"
+	@$(NS) eval --checkpoint checkpoints/rgw2-predinet.pt --env rgw-random --episodes 100 --seed 3000000000 --json > kb_out/contrast.json
+	@$(PY) -c 'import json, neurosym; r = json.load(open("kb_out/contrast.json")); \
+	  g = neurosym.load_agent("rgw-random-predinet-cellkeys").meta["card"]["held_out"]["greedy"]; \
+	  print("success %.0f %%, mean return %.2f (the general PrediNet: %.0f %% on 300 such levels)" \
+	  % (100 * r["success_rate"], r["mean_return"], 100 * g["success_rate"]))'
+	@echo
+	@echo "Next: neurosym query --kb kb_out/rgw2-cellkeys/kb.pl --rules rgw 'visit_order(E, Order)'; neurosym agents"
 
 bench: setup
 	$(PY) bench/envs.py

@@ -16,7 +16,7 @@ one JSON line per discount:
 
 Usage::
 
-    python bench/critic_fit.py checkpoints/rgw-random-predinet-deep.pt
+    python bench/critic_fit.py checkpoints/rgw-random-predinet-cellkeys.pt
     python bench/critic_fit.py runs/x/checkpoint.pt --gammas 0.99
 """
 

@@ -9,7 +9,7 @@ two numbers when each state's two arguments are drawn uniformly from the grid
 (an object's cell names that object, any other cell is terrain), over the same
 states and object positions as a recording::
 
-    neurosym extract --checkpoint checkpoints/rgw-random-predinet.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
+    neurosym extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
     python bench/heads_chance.py kb_out/rgw2-general/recording
 
 Prints one JSON line per recording: the mean over ``--draws`` random heads.

@@ -5,7 +5,8 @@
 Records greedy episodes of the agent on the environment it was trained on,
 thresholds each relation at the 0.9 quantile of its |values|, writes the
 knowledge base and asks the rules what the agent did and what its network
-relates. Defaults: checkpoints/rgw2-predinet.pt, kb_out/example.
+relates. Defaults: the shipped agent rgw2-predinet, kb_out/example. Shipped
+agents and rule files go by name (``neurosym agents`` lists the agents).
 """
 
 import sys
@@ -14,8 +15,7 @@ from pathlib import Path
 import neurosym
 from neurosym.envs import env_family
 
-root = Path(__file__).resolve().parents[1]
-checkpoint = sys.argv[1] if len(sys.argv) > 1 else root / "checkpoints" / "rgw2-predinet.pt"
+checkpoint = sys.argv[1] if len(sys.argv) > 1 else "rgw2-predinet"
 out = Path(sys.argv[2] if len(sys.argv) > 2 else "kb_out/example")
 
 agent = neurosym.load_agent(checkpoint)
@@ -25,8 +25,7 @@ print(facts.summary())
 kb_path = facts.to_prolog(out / "kb.pl")
 
 family = env_family(agent.env_name)  # "rgw" or "boxworld"
-rules = [root / "rules" / f"{family}.pl", root / "rules" / "relations.pl"]
-with neurosym.KnowledgeBase(kb_path, rules=rules) as kb:
+with neurosym.KnowledgeBase(kb_path, rules=[family, "relations"]) as kb:  # shipped rule files
     if family == "rgw":
         print(
             "sword before enemy in episodes:", [a["E"] for a in kb.query("sword_before_enemy(E)")]

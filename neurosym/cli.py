@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | plot | envs.
+"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | plot | envs | agents.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -170,6 +170,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
+    "agents": (
+        "neurosym.cli_agents",
+        "List the shipped agents: env, module, learner, held-out success, what each is for.",
+    ),
 }
 
 

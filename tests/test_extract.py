@@ -54,7 +54,8 @@ def test_extract_writes_the_kb_and_prints_the_answers(
     out.mkdir()
     (out / "notes.txt").write_text("mine")  # not neurosym's: must survive
     args = ["extract", "--checkpoint", checkpoint, "--env", "rgw2", "--episodes", 3, "--seed", 5,
-            "--sample", "--threshold", "z:1", "--out", out, "--format", "pl,parquet", "--qlf"]  # fmt: skip
+            "--sample", "--threshold", "z:1", "--out", out, "--format", "pl,parquet", "--qlf",
+            "--verbose"]  # fmt: skip
     proc = run_neurosym(*args)
     assert proc.returncode == 0, proc.stderr
     text = proc.stdout

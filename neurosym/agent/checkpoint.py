@@ -57,6 +57,7 @@ from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
 from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
+from neurosym.shipped import checkpoint_file
 
 CARRIED_OPTIONS = ("obs_mode",)
 """env options a checkpoint brings to another env of its family: they decide the observation"""
@@ -208,9 +209,10 @@ def read_checkpoint(
 
     ``env``: refuse a checkpoint that cannot run there (another family or
     observation shape, see :func:`env_for`). ``config``: refuse one whose
-    model config differs (named field by field).
+    model config differs (named field by field). A shipped agent's bare name
+    (``rgw2-predinet``) reads the shipped file (:func:`neurosym.shipped.checkpoint_file`).
     """
-    path = Path(path)
+    path = checkpoint_file(path)
     payload = _load_raw(path)
     if not isinstance(payload, dict):
         raise CheckpointError(
@@ -293,13 +295,14 @@ def compact_checkpoint(
     moments, and half precision halves its size (the Box-World PrediNet's
     1.36 M parameters take 5.4 MB in float32). The model still computes in
     float32: the weights are cast back when loaded. Everything else (config,
-    env, frames, metrics) is kept; the command gets `` && neurosym compact ...``.
+    env, frames, metrics) is kept but the agent card (its figures are the old weights'); the
+    command gets `` && neurosym compact ...``.
     ``dst`` may be ``src``: the file is replaced atomically. Returns the sizes
     in bytes and the largest absolute change of a weight.
     """
     if dtype not in COMPACT_DTYPES:
         raise ConfigError(f"--dtype {dtype!r} is not one of {', '.join(COMPACT_DTYPES)}")
-    src, dst = Path(src), Path(dst)
+    src, dst = checkpoint_file(src), Path(dst)
     payload = read_checkpoint(src)
     target = COMPACT_DTYPES[dtype]
     state: dict[str, torch.Tensor] = {}
@@ -323,6 +326,7 @@ def compact_checkpoint(
     out["state_dict"] = state
     out["optimizer"] = None
     out["weights_dtype"] = dtype
+    out.pop("card", None)  # its figures were measured on the weights before
     step = shlex.join(["neurosym", "compact", str(src), "--out", str(dst), "--dtype", dtype])
     out["command"] = f"{payload['command']} && {step}" if payload.get("command") else step
     _write_payload(dst, out)
@@ -372,6 +376,7 @@ def load_agent(
 
     ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
     """
+    path = checkpoint_file(path)
     payload = read_checkpoint(path, env=env, config=config)
     model = build_model(payload, path)
     model.eval()

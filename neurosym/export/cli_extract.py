@@ -2,7 +2,7 @@
 
     neurosym extract --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--episodes 20] [--seed 0]
         [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
-        [--format pl,parquet] [--qlf]
+        [--format pl,parquet] [--qlf] [--verbose]
 
 Writes into ``--out`` (default ``kb_out/<env>``):
 
@@ -75,6 +75,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="MHDPA: keep each query cell's N strongest keys as attention/6 facts (default: 1)",
     )
+    parser.add_argument(
+        "--verbose",
+        action="store_true",
+        help="print the full report: episodes, fact counts, thresholds, relation tables, "
+        "every answer",
+    )
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -132,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     if show:
         from neurosym.export.report import print_report
 
-        print_report(rec, facts, written, kb=written.get("kb.pl"))
+        print_report(rec, facts, written, kb=written.get("kb.pl"), verbose=args.verbose)
     return 0
 
 

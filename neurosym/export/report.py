@@ -38,11 +38,10 @@ RULE_FILES: dict[str, tuple[str, ...]] = {
 
 
 def rules_dir() -> Path | None:
-    """The repository's rules/ folder (beside the package), or None when it is not there."""
-    import neurosym
+    """The shipped rule files' folder (:func:`neurosym.shipped.rules_dir`), or None."""
+    from neurosym.shipped import rules_dir as shipped_rules
 
-    path = Path(neurosym.__file__).resolve().parent.parent / "rules"
-    return path if (path / "relations.pl").is_file() else None
+    return shipped_rules()
 
 
 def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]:
@@ -94,8 +93,30 @@ def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
     return head if len(values) == 1 else f"{head}  ({len(values)})"
 
 
-def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
-    """The per-head table of :func:`neurosym.export.heads.head_summary` (PrediNet only)."""
+def _brief(values: list[str], of: int | None) -> str:
+    """The short report's answer cell: episode answers as a count, others the first three."""
+    if of is not None:
+        return f"{len(values)} of {of} episodes"
+    return _short(values, limit=3)
+
+
+def _print_episodes(ep: Any, say: Any, escape: Any, table_type: Any) -> None:
+    """The first 20 episodes, a row each (the verbose report)."""
+    table = table_type(title="episodes", show_edge=False)
+    for col in ("episode", "steps", "return", "outcome"):
+        table.add_column(col, justify="left" if col == "outcome" else "right")
+    shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
+    for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
+        table.add_row(str(e), str(steps), f"{ret:.2f}", escape(str(outcome)))
+    say(table)
+    say("  (steps, return and how each episode ended)")
+    if len(ep) > 20:
+        say(f"... {len(ep) - 20} more episodes")
+
+
+def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any, verbose: bool = True) -> None:
+    """The per-head table of :func:`neurosym.export.heads.head_summary` (PrediNet only);
+    ``verbose`` adds the table that counts arguments beside objects."""
     from neurosym.export.heads import head_summary
 
     heads = head_summary(rec)
@@ -110,7 +131,7 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
     for row in heads.to_dict("records"):
         pairs = [
             f"{row[f'pair_{k}']} {100 * row[f'share_{k}']:.0f} %"
-            for k in (1, 2, 3)
+            for k in ((1, 2, 3) if verbose else (1, 2))
             if row.get(f"pair_{k}") is not None
         ]
         table.add_row(
@@ -121,7 +142,8 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
             escape(", ".join(pairs) or "none"),
         )
     say(table)
-    if heads["beside_objects"].isna().all():
+    say("  (share of states with the head's two arguments on two objects; top pairs)")
+    if not verbose or heads["beside_objects"].isna().all():
         return
     beside = table_type(
         title="heads: arguments on or beside two different objects",
@@ -138,13 +160,19 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
             "none" if pair is None else escape(f"{pair} {100 * row['beside_share']:.0f} %"),
         )
     say(beside)
+    say("  (the same, with an argument beside an object counted as on it)")
 
 
-def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
+def print_report(
+    rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None, verbose: bool = True
+) -> None:
     """Print the summary of an extract run with rich (plain text when not a terminal).
 
     Every value printed is escaped: Prolog lists such as ``[sword,enemy]`` would
-    otherwise be read as rich markup and vanish.
+    otherwise be read as rich markup and vanish. Without ``verbose`` it is the
+    short report: the episodes in one line, the heads and the rule answers
+    (episode lists as counts); ``verbose`` adds the episodes, fact counts,
+    thresholds and relation tables and every answer.
     """
     from rich.console import Console
     from rich.markup import escape
@@ -162,15 +190,8 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
         f"of {escape(str(meta.get('checkpoint')))} ({meta.get('module')}, {meta.get('heads')} heads, "
         f"{meta.get('relations')} relations)"
     )
-    table = Table(title="episodes", show_edge=False)
-    for col in ("episode", "steps", "return", "outcome"):
-        table.add_column(col, justify="left" if col == "outcome" else "right")
-    shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
-    for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
-        table.add_row(str(e), str(steps), f"{ret:.2f}", escape(str(outcome)))
-    say(table)
-    if len(ep) > 20:
-        say(f"... {len(ep) - 20} more episodes")
+    if verbose:
+        _print_episodes(ep, say, escape, Table)
     if len(ep):
         outcomes = ", ".join(
             f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
@@ -180,20 +201,26 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {escape(outcomes)}"
         )
 
-    counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
-    say(f"facts: {counts}  ({facts.n_facts} in all)")
+    if not verbose:
+        say(f"facts: {facts.n_facts} (--verbose: by predicate, and the relation tables)")
+    else:
+        counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
+        say(f"facts: {counts}  ({facts.n_facts} in all)")
     thr = facts.thresholds()
-    if len(thr):
+    if verbose and len(thr):
         say(
             f"thresholds ({facts.threshold}): "
             + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
         )
 
-    _print_heads(rec, say, escape, Table)
+    _print_heads(rec, say, escape, Table, verbose)
 
-    strongest = facts.strongest_relations(5)
+    strongest = facts.strongest_relations(5) if verbose else []
     if len(strongest):
-        st = Table(title="strongest relations between object types (holds/5)", show_edge=False)
+        st = Table(
+            title="strongest relations between object types (holds/5)",
+            show_edge=False,
+        )
         for col in ("relation", "from", "to", "states", "mean value"):
             st.add_column(col)
         for r in strongest.itertuples(index=False):
@@ -201,9 +228,10 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
                 f"r({r.j})", escape(str(r.a)), escape(str(r.b)), str(r.held), f"{r.mean_value:.4g}"
             )
         say(st)
+        say("  (r(j) above threshold from one object type to another: states, mean value)")
     elif not facts["attention"].empty:
         say("MHDPA: attention/6 holds the strongest key of every query cell (no relation values)")
-    elif not facts["relation"].empty:
+    elif verbose and not facts["relation"].empty:
         say("strongest relations between object types: none held above threshold")
 
     if kb is None:
@@ -212,14 +240,19 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
         family = env_family(str(meta.get("env")))
         answers = rule_answers(kb, family)
         if answers:
-            qt = Table(title=f"rules/{RULE_FILES[family][0]}", show_edge=False)
+            qt = Table(
+                title=f"rules/{RULE_FILES[family][0]}",
+                show_edge=False,
+            )
             qt.add_column("question")
             qt.add_column("answers")
             for title, goal, values in answers:
                 of = len(ep) if goal.endswith("(E)") else None
-                qt.add_row(title, escape(_short(values, of=of)))
+                text = _short(values, of=of) if verbose else _brief(values, of)
+                qt.add_row(title, escape(text))
             say(qt)
+            say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
         else:
-            say("rule answers: none (rules/ is not beside the package)")
+            say("rule answers: none (neurosym's rule files are missing: no rules/ folder found)")
     for path in written.values():
         say(f"wrote {escape(str(path))}")

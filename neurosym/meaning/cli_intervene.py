@@ -108,15 +108,21 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def cause_answer(kb_path: Path) -> str | None:
-    """``sword_enemy_cause/1``'s answer over the written KB, as Prolog text (None without rules)."""
+def _causal_rules() -> Path | None:
     from neurosym.export.report import rules_dir
-    from neurosym.prolog.knowledge_base import KnowledgeBase
 
     folder = rules_dir()
-    if folder is None or not (folder / "causal.pl").is_file():
+    return folder / "causal.pl" if folder and (folder / "causal.pl").is_file() else None
+
+
+def cause_answer(kb_path: Path) -> str | None:
+    """``sword_enemy_cause/1``'s answer over the written KB, as Prolog text (None without rules)."""
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    rules = _causal_rules()
+    if rules is None:
         return None
-    with KnowledgeBase(kb_path, rules=[folder / "causal.pl"]) as kb:
+    with KnowledgeBase(kb_path, rules=[rules]) as kb:
         rows = kb.query("sword_enemy_cause(A), format(atom(T), '~q', [A])")
     return str(rows[0]["T"]) if rows else None
 
@@ -150,5 +156,7 @@ def print_summary(report, written: dict[str, Path]) -> None:  # noqa: ANN001 (an
         answer = cause_answer(written["kb.pl"])
         if answer is not None:
             print(f"sword_enemy_cause: {answer}")
+        elif _causal_rules() is None:
+            print("sword_enemy_cause: not asked (the shipped rule file causal.pl is missing)")
     for name, path in written.items():
         print(f"wrote {path}" if name == "kb.pl" else f"      {path}")

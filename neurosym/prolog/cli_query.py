@@ -1,6 +1,6 @@
 """``neurosym query``: run a Prolog goal against knowledge base files and print the answers.
 
-    neurosym query --kb kb_out/rgw2/kb.pl --rules rules/rgw.pl "holds(E, T, R, agent, B)"
+    neurosym query --kb kb_out/rgw2/kb.pl --rules rgw "holds(E, T, R, agent, B)"
     neurosym query --kb kb.pl --bind A=sword --format json "holds(E, T, R, A, B)"
 
 One column per output variable (names starting with ``_`` are left out);
@@ -13,9 +13,9 @@ Fact files (``--kb``) are data: they are read term by term and only facts
 are accepted, so a KB someone sent you runs nothing when it loads; ``--trust
 FILE`` loads that one file as code (directives run), and a ``.qlf`` is
 loaded only when neurosym compiled it on this account or it is trusted.
-Rule files (``--rules``) are code. ``--timeout``, ``--max-inferences`` and
-``--stack-limit`` stop a runaway goal with one line (no limit by default,
-beyond SWI-Prolog's own 1 GB stack).
+Rule files (``--rules``) are code; a bare name (``rgw``) is a shipped one.
+``--timeout``, ``--max-inferences`` and ``--stack-limit`` stop a runaway goal
+with one line (no limit by default, beyond SWI-Prolog's own 1 GB stack).
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--rules", action="append", default=[], metavar="FILE",
-        help="Rule file to load as code, before the facts; repeatable.",
+        help="Rule file to load as code, before the facts, or a shipped one by name "
+        "(rgw, boxworld, relations, causal, meaning); repeatable.",
     )  # fmt: skip
     parser.add_argument(
         "--trust", action="append", default=[], metavar="FILE",
@@ -156,6 +157,7 @@ def print_answers(names: list[str], answers: list[dict[str, Any]], fmt: str) -> 
 
 def run(args: argparse.Namespace) -> int:
     from neurosym.prolog.knowledge_base import KnowledgeBase
+    from neurosym.shipped import rule_file
 
     if args.limit is not None and args.limit < 1:
         raise ConfigError(f"--limit must be at least 1, not {args.limit}")
@@ -169,7 +171,8 @@ def run(args: argparse.Namespace) -> int:
             )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        kb = KnowledgeBase(args.kb, rules=args.rules, qlf=args.qlf, trusted=args.trust)
+        rules = [rule_file(name) for name in args.rules]
+        kb = KnowledgeBase(args.kb, rules=rules, qlf=args.qlf, trusted=args.trust)
     for w in caught:
         print(f"neurosym query: warning: {w.message}", file=sys.stderr)
     with kb:

@@ -268,12 +268,15 @@ class KnowledgeBase:
     def load_rules(self, path: PathArg) -> None:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
 
+        A bare name (``"rgw"``) is a shipped rule file (:func:`neurosym.shipped.rule_file`).
         Syntax and other load errors raise :class:`PrologError` naming the
         file and line, and the file's clauses are unloaded again; warnings
         become :class:`PrologWarning`.
         """
+        from neurosym.shipped import rule_file
+
         self._check_open()
-        path = _existing(path)
+        path = _existing(rule_file(path))
         fmt = "qlf" if path.suffix == ".qlf" else "source"
         before = len(self._source_ids)
         self._finish(path, *self._load_file(path, fmt))

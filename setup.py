@@ -1,0 +1,25 @@
+"""Packages and package data of the wheel (the rest of the metadata is in pyproject.toml).
+
+The repository's rules/ (the source of truth, beside its plunit files) and
+checkpoints/ (the curated agents) are mapped into the package as
+``neurosym.rules`` and ``neurosym.checkpoints``: an installed neurosym finds its
+rule files and agents without a clone, and nothing is copied in the repository.
+"""
+
+from setuptools import find_packages, setup
+
+setup(
+    packages=[
+        *find_packages(include=["neurosym", "neurosym.*"]),
+        "neurosym.rules",
+        "neurosym.checkpoints",
+    ],
+    package_dir={"neurosym.rules": "rules", "neurosym.checkpoints": "checkpoints"},
+    package_data={
+        "neurosym.envs": ["maps/*.txt"],
+        "neurosym.webreport": ["templates/*"],
+        "neurosym.rules": ["*.pl"],
+        "neurosym.checkpoints": ["*.pt"],
+    },
+    exclude_package_data={"neurosym.rules": ["tests/*"]},
+)
