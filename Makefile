@@ -35,6 +35,8 @@ demo: setup
 	@echo "== 1/3 The general PrediNet (trained on random levels) plays rgw2, a map it never saw: its route,"
 	@echo "==     its relation heads (head 0 relates the agent to what it is after) and the rules' answers"
 	@$(NS) extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
+	@echo "   The same episodes on one page (open it in a browser: episode player, heads, rule answers):"
+	@$(NS) report --recording kb_out/rgw2-cellkeys
 	@echo
 	@echo "== 2/3 A Box-World agent (bw2-predinet) on 20 unseen bw2 levels: head 0 relates the agent to locks"
 	@$(NS) extract --checkpoint checkpoints/bw2-predinet.pt --episodes 20 --seed 3000000000 --out kb_out/bw2
