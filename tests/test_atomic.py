@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 import resource
 import signal
+import socket
+import stat
 import subprocess
 import sys
 import textwrap
@@ -115,3 +117,37 @@ def test_a_write_that_fails_part_way_leaves_the_old_file(
     assert f"cannot write {tmp_path / name}: File too large" in proc.stderr
     assert (tmp_path / name).read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # no temporary file left
+
+
+@pytest.mark.parametrize("how", ["bytes", "callback", "context"])
+def test_a_target_that_is_not_a_regular_file_is_refused(tmp_path: Path, how: str) -> None:
+    from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
+    from neurosym.errors import OutputError
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    sock = tmp_path / "sock"
+    server = socket.socket(socket.AF_UNIX)
+    server.bind(str(sock))
+    device = tmp_path / "null"
+    device.symlink_to("/dev/null")  # a rename would replace the link, never /dev/null itself
+    cases = ((fifo, "a FIFO"), (sock, "a socket"), (device, "a character device"))
+    try:
+        for target, kind in cases:
+            with pytest.raises(OutputError) as err:
+                if how == "bytes":
+                    write_bytes_atomic(target, b"x")
+                elif how == "callback":
+                    atomic_write(target, lambda p: p.write_bytes(b"x"))
+                else:
+                    with open_atomic(target, "wb") as fh:
+                        fh.write(b"x")
+            assert str(err.value) == (
+                f"cannot write {target}: it exists and is {kind}, not a regular file; "
+                "nothing was written"
+            )
+    finally:
+        server.close()
+    assert stat.S_ISFIFO(fifo.lstat().st_mode) and stat.S_ISSOCK(sock.lstat().st_mode)
+    assert device.is_symlink() and stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "null", "sock"]
