@@ -174,9 +174,13 @@ class Recording:
 
     @classmethod
     def load(cls, directory: str | os.PathLike[str]) -> Recording:
-        """Read a recording written by :meth:`save`; ConfigError if it is not one."""
+        """Read a recording written by :meth:`save`; ConfigError if it is not one.
+
+        A folder published by ``neurosym extract`` is a link that the next run
+        re-points; it is resolved once, so every table comes from the same run.
+        """
         src = Path(directory)
-        meta_path = src / "meta.json"
+        meta_path = src.resolve() / "meta.json"
         try:
             head = json.loads(meta_path.read_text())
         except (OSError, ValueError) as exc:
@@ -189,11 +193,11 @@ class Recording:
             )
         tables: dict[str, pd.DataFrame] = {}
         for name in SCHEMA:
-            path = src / f"{name}.parquet"
+            path = meta_path.parent / f"{name}.parquet"
             try:
                 tables[name] = pd.read_parquet(path)
             except (OSError, ValueError) as exc:
-                raise ConfigError(f"cannot read {path}: {exc}") from None
+                raise ConfigError(f"cannot read {src / path.name}: {exc}") from None
         return cls(**tables, meta=head.get("meta", {}))
 
     def __eq__(self, other: object) -> bool:
