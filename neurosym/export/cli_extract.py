@@ -29,6 +29,7 @@ from typing import Any
 
 from neurosym.cli import add_action_mode, add_env_options, play_options
 from neurosym.errors import ConfigError
+from neurosym.seeds import check_seed
 
 FORMATS = ("pl", "parquet")
 PRODUCTS = ("kb.pl", "kb.qlf", "kb.qlf.sig", "facts", "recording")
@@ -102,8 +103,7 @@ def run(args: argparse.Namespace) -> int:
     threshold = parse_threshold(args.threshold)
     if args.episodes < 1:
         raise ConfigError(f"--episodes must be at least 1, got {args.episodes}")
-    if args.seed < 0:
-        raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
+    check_seed(args.seed, args.episodes)
     if args.batch is not None and args.batch < 1:
         raise ConfigError(f"--batch must be at least 1, got {args.batch}")
     if args.top_keys < 1:
