@@ -59,7 +59,7 @@ _claims: dict[Path, _Claim] = {}
 
 
 def _error(out: Path, exc: OSError) -> OutputError:
-    return OutputError(f"cannot write into {out}: {exc.strerror or exc}; it was left as it was")
+    return OutputError(f"cannot write into {out}: {exc.strerror or exc}")
 
 
 def check_out(out: Path) -> Path:
