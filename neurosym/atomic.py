@@ -102,6 +102,16 @@ def check_target(path: str | os.PathLike[str]) -> Path:
     return Path(path)
 
 
+def make_folder(path: str | os.PathLike[str]) -> Path:
+    """``mkdir -p path``, or one OutputError line naming it (read-only file system, a file in the way)."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot make folder {path}: {exc.strerror or exc}") from None
+    return path
+
+
 def atomic_write(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> Path:
     """Call ``write(tmp_path)`` and move the result onto ``path`` in one rename.
 

@@ -151,3 +151,29 @@ def test_a_target_that_is_not_a_regular_file_is_refused(tmp_path: Path, how: str
     assert stat.S_ISFIFO(fifo.lstat().st_mode) and stat.S_ISSOCK(sock.lstat().st_mode)
     assert device.is_symlink() and stat.S_ISCHR(os.stat("/dev/null").st_mode)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "null", "sock"]
+
+
+def test_a_folder_that_cannot_be_made_is_one_line(tmp_path: Path) -> None:
+    import pandas as pd
+
+    from neurosym.agent.checkpoint import save_checkpoint
+    from neurosym.agent.config import ModelConfig
+    from neurosym.agent.model import ActorCritic
+    from neurosym.errors import OutputError
+    from neurosym.export.prolog_writer import write_prolog
+    from neurosym.export.recording import Recording
+
+    (tmp_path / "file").write_text("in the way\n")
+    below = tmp_path / "file" / "sub"
+    config = ModelConfig.for_family("rgw", "predinet", (9, 10, 10), 1.0)
+    writers = (
+        lambda: save_checkpoint(below / "a.pt", model=ActorCritic(config), config=config,
+                                env_name="rgw2"),
+        lambda: write_prolog(below / "kb.pl", {"p": pd.DataFrame({"x": [1]})}),
+        lambda: Recording().save(below),
+    )  # fmt: skip
+    for write in writers:
+        with pytest.raises(OutputError) as err:
+            write()
+        assert str(err.value) == f"cannot make folder {below}: Not a directory"
+    assert (tmp_path / "file").read_text() == "in the way\n"

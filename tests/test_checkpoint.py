@@ -279,3 +279,16 @@ def test_a_checkpoint_edited_to_another_env_names_the_file(tmp_path: Path, run_n
     assert error_of(path).startswith(f"checkpoint {path} names an env this neurosym lacks: ")
     torch.save({**raw, "env_kwargs": {"max_steps": 100, "map": str(tmp_path / "moved.txt")}}, path)
     assert load_agent(path).env_kwargs["map"].endswith("moved.txt")  # checked where it is played
+
+
+def test_a_checkpoint_that_cannot_be_opened_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+
+    def refuse(self: Path, *args: object, **kwargs: object) -> None:
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "open", refuse)
+    assert error_of(path) == f"cannot read {path}: Permission denied"

@@ -55,7 +55,7 @@ from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.introspection import Introspection
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
-from neurosym.atomic import write_bytes_atomic
+from neurosym.atomic import make_folder, write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 
 CARRIED_OPTIONS = ("obs_mode",)
@@ -141,7 +141,7 @@ def save_checkpoint(
 def _write_payload(path: Path, payload: dict[str, Any]) -> Path:
     """Check that ``payload`` holds only tensors and plain values, then write it atomically."""
     _check_plain(payload, "checkpoint")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     # Serialised in memory first: torch reports a failed file write as a
     # RuntimeError, a plain write reports it as the OSError it is.
     buf = io.BytesIO()
@@ -154,8 +154,11 @@ def _load_raw(path: Path) -> Any:
         raise CheckpointError(f"checkpoint not found: {path}")
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} is not a file")
-    with path.open("rb") as fh:
-        head = fh.read(4)
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(4)
+    except OSError as exc:
+        raise CheckpointError(f"cannot read {path}: {exc.strerror or exc}") from None
     if not head:
         raise CheckpointError(f"cannot read {path}: the file is empty")
     if not (

@@ -23,7 +23,7 @@ from typing import Any
 
 import pandas as pd
 
-from neurosym.atomic import atomic_write
+from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 
 # table -> ordered (column, dtype); "str" columns hold Prolog text (atoms or terms).
@@ -163,8 +163,7 @@ class Recording:
         Each file is written to a temporary name and renamed into place, so a
         reader never sees a half-written table.
         """
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        out = make_folder(directory)
         for name, df in self.tables.items():
             atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         meta = {"format": _FORMAT, "format_version": _FORMAT_VERSION, "meta": self.meta}
