@@ -177,3 +177,16 @@ def test_a_folder_that_cannot_be_made_is_one_line(tmp_path: Path) -> None:
             write()
         assert str(err.value) == f"cannot make folder {below}: Not a directory"
     assert (tmp_path / "file").read_text() == "in the way\n"
+
+
+def test_plot_refuses_an_output_that_is_not_a_regular_file(run_neurosym, tmp_path: Path) -> None:
+    fifo = tmp_path / "fig.png"
+    os.mkfifo(fifo)
+    proc = run_neurosym("plot", "predinet", "--checkpoint", REPO / "checkpoints" /
+                        "rgw2-predinet.pt", "--out", fifo)  # fmt: skip
+    assert (proc.returncode, proc.stdout) == (1, "")
+    assert proc.stderr == (
+        f"neurosym plot: error: cannot write {fifo}: it exists and is a FIFO, not a regular file; "
+        "nothing was written\n"
+    )
+    assert stat.S_ISFIFO(fifo.lstat().st_mode)
