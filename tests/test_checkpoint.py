@@ -292,3 +292,18 @@ def test_a_checkpoint_that_cannot_be_opened_is_one_line(
 
     monkeypatch.setattr(Path, "open", refuse)
     assert error_of(path) == f"cannot read {path}: Permission denied"
+
+
+def test_a_small_model_on_a_small_map_loads_whatever_its_unused_sizes(tmp_path: Path) -> None:
+    """PrediNet has no value_size layer: its default (64) may exceed every weight of a tiny net."""
+    config = ModelConfig.for_family(
+        "rgw", "predinet", (9, 1, 4), heads=2, key_size=4, relations=3,
+        conv_channels=(4, 8), hidden_sizes=(16,),
+    )  # fmt: skip
+    path = tmp_path / "tiny.pt"
+    save_checkpoint(path, model=ActorCritic(config), config=config, env_name="rgw2",
+                    env_kwargs={"map": "A.ST\n"})  # fmt: skip
+    agent = load_agent(path)
+    assert (
+        agent.config.value_size == 64 > max(max(t.shape) for t in agent.model.state_dict().values())
+    )

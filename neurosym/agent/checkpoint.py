@@ -263,8 +263,11 @@ def read_checkpoint(
 
 
 SIZE_FIELDS = ("conv_channels", "hidden_sizes", "kernel_size", "heads", "key_size",
-               "relations", "value_size", "output_size", "n_actions", "local_view")  # fmt: skip
+               "output_size", "n_actions", "local_view")  # fmt: skip
 """ModelConfig fields that size a layer: none can exceed every dimension of the weights"""
+
+MODULE_SIZE_FIELDS = {"predinet": ("relations",), "mhdpa": ("value_size",)}
+"""the same, for the fields only one relational module uses"""
 
 
 def _check_sizes(path: Path, config: ModelConfig, state: dict[str, torch.Tensor]) -> None:
@@ -276,7 +279,7 @@ def _check_sizes(path: Path, config: ModelConfig, state: dict[str, torch.Tensor]
     to fit.
     """
     largest = max((max(t.shape, default=1) for t in state.values()), default=0)
-    for name in SIZE_FIELDS:
+    for name in (*SIZE_FIELDS, *MODULE_SIZE_FIELDS.get(config.module, ())):
         value = getattr(config, name)
         for v in value if isinstance(value, tuple) else (value,):
             if int(v) > largest:
