@@ -115,7 +115,14 @@ def conform(name: str, df: pd.DataFrame | None) -> pd.DataFrame:
     out = df.loc[:, columns]
     dtypes = {c: d for c, d in SCHEMA[name] if str(out[c].dtype) != d}
     if dtypes:
-        out = out.astype(dtypes)
+        try:
+            out = out.astype(dtypes)
+        except (TypeError, ValueError, OverflowError) as exc:
+            wanted = ", ".join(f"{c} {d}" for c, d in dtypes.items())
+            raise ConfigError(
+                f"recording table {name!r} has columns of the wrong type (expected {wanted}: "
+                f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+            ) from None
     return out.reset_index(drop=True)
 
 
@@ -197,7 +204,15 @@ class Recording:
                 tables[name] = pd.read_parquet(path)
             except (OSError, ValueError) as exc:
                 raise ConfigError(f"cannot read {src / path.name}: {exc}") from None
-        return cls(**tables, meta=head.get("meta", {}))
+        meta = head.get("meta", {})
+        if not isinstance(meta, dict):
+            raise ConfigError(
+                f"{src} is not a neurosym recording (its meta.json 'meta' is not an object)"
+            )
+        try:
+            return cls(**tables, meta=meta)
+        except ConfigError as exc:
+            raise ConfigError(f"{src}: {exc}") from None
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Recording):
