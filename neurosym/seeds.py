@@ -20,6 +20,10 @@ def check_seed(seed: object, episodes: int = 1, name: str = "--seed") -> int:
     Otherwise a one-line ConfigError stating the valid range for this many episodes.
     """
     last = MAX_SEED - max(int(episodes), 1) + 1
+    if last < 0:
+        raise ConfigError(
+            f"--episodes must be at most 2**63 (one seed each, at most 2**63 - 1), got {episodes}"
+        )
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= last:
         many = f" with {episodes} episodes" if episodes > 1 else ""
         raise ConfigError(

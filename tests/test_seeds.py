@@ -22,6 +22,12 @@ def test_the_range_depends_on_the_number_of_episodes() -> None:
         "--seed must be an integer from 0 to 9223372036854775798 with 10 episodes "
         "(episode k plays seed SEED + k, at most 2**63 - 1), got 9223372036854775799"
     )
+    with pytest.raises(ConfigError) as err:
+        check_seed(0, episodes=10**20)
+    assert str(err.value) == (
+        "--episodes must be at most 2**63 (one seed each, at most 2**63 - 1), "
+        "got 100000000000000000000"
+    )
     for bad in (-1, 2**64, True, 1.0):
         with pytest.raises(ConfigError, match="--seed must be an integer from 0 to "):
             check_seed(bad)
