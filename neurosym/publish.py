@@ -129,6 +129,9 @@ def publish(
     out: Path,
     write: Callable[[Path], object],
     owned: Iterable[str] | None = None,
+    *,
+    folders: Iterable[str] = (),
+    prefix: str = "",
 ) -> dict[str, Path]:
     """Call ``write(run)`` on a new run folder, then publish every product it left there at once.
 
@@ -136,6 +139,8 @@ def publish(
     write (kb.qlf without --qlf) is dropped, so no product of an earlier run
     stays beside the new ones. Other products of the previous run are
     carried over. Default: the names written. Returns name -> path in ``out``.
+    ``folders`` and ``prefix`` are accepted from callers written for the
+    older layout (a staging folder per run) and no longer needed.
     """
     claim(out)
     key = Path(os.path.abspath(out))
@@ -165,6 +170,17 @@ def publish(
         raise _error(out, exc) from None
     finally:
         release(out)
+
+
+def published(folder: Path) -> Path:
+    """The folder holding the products last published into ``folder``, resolved once.
+
+    A reader that opens several products of one run (kb.pl, facts/,
+    recording/) reads them all from here, so a run published meanwhile cannot
+    give it a mix. A folder of the older layout (no ``.neurosym``) is itself.
+    """
+    name = _current(folder / STORE)
+    return (folder / STORE / name).resolve() if name is not None else folder
 
 
 def _current(store: Path) -> str | None:

@@ -222,3 +222,16 @@ def test_a_recording_is_read_from_one_run_while_another_is_published(
     rec = Recording.load(out / "recording")
     assert rec.meta == {"seed": 1} and rec.episodes["seed"].tolist() == [1]
     assert Recording.load(out / "recording").episodes["seed"].tolist() == [2]
+
+
+def test_published_names_the_run_folder_readers_read_from(tmp_path: Path) -> None:
+    from neurosym.publish import published
+
+    out = tmp_path / "out"
+    assert published(out) == out  # nothing published: the folder itself (older layout too)
+    publish(out, lambda run: (run / "kb.pl").write_text("one"), owned=OWNED)
+    first = published(out)
+    assert first.parent == (out / STORE).resolve() and (first / "kb.pl").read_text() == "one"
+    publish(out, lambda run: (run / "kb.pl").write_text("two"), folders=("x",), prefix=".old-")
+    assert (first / "kb.pl").read_text() == "one"  # kept for a reader still reading it
+    assert (published(out) / "kb.pl").read_text() == "two"
