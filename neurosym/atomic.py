@@ -11,12 +11,17 @@ file under that name. Two details every writer needs and used to get wrong:
 * failure: a write that fails part-way (a full disk, a quota, a file-size
   limit) removes the temporary file and raises :class:`OutputError`, one line
   naming the file; whatever was at the final name is left untouched.
+* the target: a rename replaces whatever has the name, so ``--out /dev/null``
+  would turn the device into a regular file. A target that exists and is not
+  a regular file (a device, FIFO, socket or folder) is refused before
+  anything is written (:func:`check_target`).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 import threading
 from collections.abc import Callable, Iterator
@@ -57,13 +62,63 @@ def _error(path: Path, exc: OSError) -> OutputError:
     return OutputError(f"cannot write {path}: {reason}; it was left as it was")
 
 
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def file_kind(path: str | os.PathLike[str]) -> str | None:
+    """What ``path`` is when it exists and is not a regular file (``"a FIFO"``), else None.
+
+    A symbolic link counts as what it points to; a dangling one as absent.
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError:
+        return None  # unreadable: the write itself will say why
+    if stat.S_ISREG(mode):
+        return None
+    return next((kind for test, kind in _KINDS if test(mode)), "not a regular file")
+
+
+def check_target(path: str | os.PathLike[str]) -> Path:
+    """Refuse, with one OutputError line, a target that exists and is not a regular file.
+
+    A rename onto a device, FIFO or socket would replace it with a regular
+    file (``--out /dev/null`` run as root); onto a folder it fails late.
+    """
+    kind = file_kind(path)
+    if kind is not None:
+        raise OutputError(
+            f"cannot write {os.fspath(path)}: it exists and is {kind}, not a regular file; "
+            "nothing was written"
+        )
+    return Path(path)
+
+
+def make_folder(path: str | os.PathLike[str]) -> Path:
+    """``mkdir -p path``, or one OutputError line naming it (read-only file system, a file in the way)."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot make folder {path}: {exc.strerror or exc}") from None
+    return path
+
+
 def atomic_write(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> Path:
     """Call ``write(tmp_path)`` and move the result onto ``path`` in one rename.
 
     ``write`` must create or fill the file at ``tmp_path`` (it exists, empty).
     Raises :class:`OutputError` when writing or renaming fails with an OSError.
     """
-    path = Path(path)
+    path = check_target(path)
     folder = path.parent if str(path.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
@@ -86,7 +141,7 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> 
 @contextlib.contextmanager
 def open_atomic(path: str | os.PathLike[str], mode: str = "wb", **kwargs: Any) -> Iterator[IO[Any]]:
     """``with open_atomic(p, "w") as fh: ...``: the file appears at ``p`` only if the block succeeds."""
-    path = Path(path)
+    path = check_target(path)
     folder = path.parent if str(path.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)

@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 import resource
 import signal
+import socket
+import stat
 import subprocess
 import sys
 import textwrap
@@ -115,3 +117,76 @@ def test_a_write_that_fails_part_way_leaves_the_old_file(
     assert f"cannot write {tmp_path / name}: File too large" in proc.stderr
     assert (tmp_path / name).read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # no temporary file left
+
+
+@pytest.mark.parametrize("how", ["bytes", "callback", "context"])
+def test_a_target_that_is_not_a_regular_file_is_refused(tmp_path: Path, how: str) -> None:
+    from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
+    from neurosym.errors import OutputError
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    sock = tmp_path / "sock"
+    server = socket.socket(socket.AF_UNIX)
+    server.bind(str(sock))
+    device = tmp_path / "null"
+    device.symlink_to("/dev/null")  # a rename would replace the link, never /dev/null itself
+    cases = ((fifo, "a FIFO"), (sock, "a socket"), (device, "a character device"))
+    try:
+        for target, kind in cases:
+            with pytest.raises(OutputError) as err:
+                if how == "bytes":
+                    write_bytes_atomic(target, b"x")
+                elif how == "callback":
+                    atomic_write(target, lambda p: p.write_bytes(b"x"))
+                else:
+                    with open_atomic(target, "wb") as fh:
+                        fh.write(b"x")
+            assert str(err.value) == (
+                f"cannot write {target}: it exists and is {kind}, not a regular file; "
+                "nothing was written"
+            )
+    finally:
+        server.close()
+    assert stat.S_ISFIFO(fifo.lstat().st_mode) and stat.S_ISSOCK(sock.lstat().st_mode)
+    assert device.is_symlink() and stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "null", "sock"]
+
+
+def test_a_folder_that_cannot_be_made_is_one_line(tmp_path: Path) -> None:
+    import pandas as pd
+
+    from neurosym.agent.checkpoint import save_checkpoint
+    from neurosym.agent.config import ModelConfig
+    from neurosym.agent.model import ActorCritic
+    from neurosym.errors import OutputError
+    from neurosym.export.prolog_writer import write_prolog
+    from neurosym.export.recording import Recording
+
+    (tmp_path / "file").write_text("in the way\n")
+    below = tmp_path / "file" / "sub"
+    config = ModelConfig.for_family("rgw", "predinet", (9, 10, 10), 1.0)
+    writers = (
+        lambda: save_checkpoint(below / "a.pt", model=ActorCritic(config), config=config,
+                                env_name="rgw2"),
+        lambda: write_prolog(below / "kb.pl", {"p": pd.DataFrame({"x": [1]})}),
+        lambda: Recording().save(below),
+    )  # fmt: skip
+    for write in writers:
+        with pytest.raises(OutputError) as err:
+            write()
+        assert str(err.value) == f"cannot make folder {below}: Not a directory"
+    assert (tmp_path / "file").read_text() == "in the way\n"
+
+
+def test_plot_refuses_an_output_that_is_not_a_regular_file(run_neurosym, tmp_path: Path) -> None:
+    fifo = tmp_path / "fig.png"
+    os.mkfifo(fifo)
+    proc = run_neurosym("plot", "predinet", "--checkpoint", REPO / "checkpoints" /
+                        "rgw2-predinet.pt", "--out", fifo)  # fmt: skip
+    assert (proc.returncode, proc.stdout) == (1, "")
+    assert proc.stderr == (
+        f"neurosym plot: error: cannot write {fifo}: it exists and is a FIFO, not a regular file; "
+        "nothing was written\n"
+    )
+    assert stat.S_ISFIFO(fifo.lstat().st_mode)

@@ -216,3 +216,94 @@ def test_save_refuses_objects(tmp_path: Path) -> None:
             metrics={"when": object()},
         )
     assert not os.listdir(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        ({"hidden_sizes": [10**6, 10**6]}, "hidden_sizes (1000000, 1000000)"),
+        ({"heads": 10**9}, "heads 1000000000"),
+        ({"conv_channels": [12, 10**7]}, "conv_channels (12, 10000000)"),
+    ],
+)
+def test_a_config_far_larger_than_its_weights_is_refused_before_building(
+    tmp_path: Path, run_neurosym, edit: dict, message: str
+) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    raw = torch.load(path, weights_only=True)
+    torch.save({**raw, "model_config": {**raw["model_config"], **edit}}, path)
+    expected = (
+        f"checkpoint {path} is damaged: its model config has {message}, "
+        "larger than any dimension of its weights (2600)"
+    )
+    assert error_of(path) == expected
+    proc = run_neurosym("eval", "--checkpoint", path, "--episodes", 1)
+    assert (proc.returncode, proc.stderr) == (1, f"neurosym eval: error: {expected}\n")
+
+
+def test_a_model_that_cannot_be_allocated_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import neurosym.agent.checkpoint as checkpoint
+
+    def no_memory(config: ModelConfig) -> ActorCritic:
+        raise RuntimeError(
+            "[enforce fail at alloc_cpu.cpp:117] data. DefaultCPUAllocator: not enough memory: "
+            "you tried to allocate 416000000000 bytes.\nmore detail"
+        )
+
+    path = tmp_path / "a.pt"
+    write(path)
+    monkeypatch.setattr(checkpoint, "ActorCritic", no_memory)
+    assert error_of(path) == (
+        f"{path}: its model config does not fit in memory ([enforce fail at alloc_cpu.cpp:117] "
+        "data. DefaultCPUAllocator: not enough memory: you tried to allocate 416000000000 bytes.)"
+    )
+
+
+def test_a_checkpoint_edited_to_another_env_names_the_file(tmp_path: Path, run_neurosym) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    raw = torch.load(path, weights_only=True)
+    torch.save({**raw, "env": "bw1", "env_kwargs": {}}, path)
+    expected = (
+        f"checkpoint {path} is damaged: its env bw1 gives observations (3, 14, 14), "
+        "its model takes (9, 10, 10)"
+    )
+    assert error_of(path) == expected
+    for command, *more in (("eval",), ("extract", "--out", tmp_path / "o")):
+        proc = run_neurosym(command, "--checkpoint", path, "--episodes", 1, *more)
+        assert (proc.returncode, proc.stderr) == (1, f"neurosym {command}: error: {expected}\n")
+    torch.save({**raw, "env": "rgw9"}, path)
+    assert error_of(path).startswith(f"checkpoint {path} names an env this neurosym lacks: ")
+    torch.save({**raw, "env_kwargs": {"max_steps": 100, "map": str(tmp_path / "moved.txt")}}, path)
+    assert load_agent(path).env_kwargs["map"].endswith("moved.txt")  # checked where it is played
+
+
+def test_a_checkpoint_that_cannot_be_opened_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+
+    def refuse(self: Path, *args: object, **kwargs: object) -> None:
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "open", refuse)
+    assert error_of(path) == f"cannot read {path}: Permission denied"
+
+
+def test_a_small_model_on_a_small_map_loads_whatever_its_unused_sizes(tmp_path: Path) -> None:
+    """PrediNet has no value_size layer: its default (64) may exceed every weight of a tiny net."""
+    config = ModelConfig.for_family(
+        "rgw", "predinet", (9, 1, 4), heads=2, key_size=4, relations=3,
+        conv_channels=(4, 8), hidden_sizes=(16,),
+    )  # fmt: skip
+    path = tmp_path / "tiny.pt"
+    save_checkpoint(path, model=ActorCritic(config), config=config, env_name="rgw2",
+                    env_kwargs={"map": "A.ST\n"})  # fmt: skip
+    agent = load_agent(path)
+    assert (
+        agent.config.value_size == 64 > max(max(t.shape) for t in agent.model.state_dict().values())
+    )

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import os
+import stat
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
@@ -116,3 +118,22 @@ def test_cli(neurosym, original: Path, tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     bad = neurosym("compact", tmp_path / "none.pt", "--out", small)
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "not found" in bad.stderr
+
+
+def test_cli_refuses_a_target_that_is_not_a_regular_file(
+    neurosym, original: Path, tmp_path: Path
+) -> None:
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    device = tmp_path / "null"
+    device.symlink_to("/dev/null")  # a rename would replace the link, never /dev/null itself
+    for target, kind in ((fifo, "a FIFO"), (device, "a character device"), (tmp_path, "a folder")):
+        proc = neurosym("compact", original, "--out", target)
+        assert proc.returncode == 1, proc.stderr
+        assert proc.stderr == (
+            f"neurosym compact: error: cannot write {target}: it exists and is {kind}, "
+            "not a regular file; nothing was written\n"
+        )
+    assert stat.S_ISFIFO(fifo.lstat().st_mode)
+    assert device.is_symlink() and stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.pt", "fifo", "null"]

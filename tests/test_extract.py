@@ -65,6 +65,7 @@ def test_extract_writes_the_kb_and_prints_the_answers(
     # Prolog lists such as [sword,enemy] survive rich markup
     assert re.search(r"visit orders \(most common\)\s+│ \[", text)
     assert sorted(p.name for p in out.iterdir()) == [
+        ".neurosym",  # the published run, its links and the writers' lock
         "facts",
         "kb.pl",
         "kb.qlf",
@@ -85,7 +86,8 @@ def test_extract_writes_the_kb_and_prints_the_answers(
     )
     assert (load.returncode, load.stdout, load.stderr) == (0, "", "")
 
-    # Run again with only pl: kb.pl is replaced, the earlier facts/ stay, nothing half-written remains.
+    # Run again with only pl: kb.pl is replaced; the earlier run's facts/, kb.qlf and its
+    # signature go with it, so the folder holds one run; nothing half-written remains.
     again = run_neurosym(
         "extract",
         "--checkpoint",
@@ -101,7 +103,11 @@ def test_extract_writes_the_kb_and_prints_the_answers(
     assert again.returncode == 0, again.stderr
     assert again.stdout == ""
     assert "episode(1," not in (out / "kb.pl").read_text()
-    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+    assert sorted(p.name for p in out.iterdir()) == [".neurosym", "kb.pl", "notes.txt", "recording"]
+    assert Recording.load(out / "recording").episodes["seed"].tolist() == [0]
+    store = sorted(p.name for p in (out / ".neurosym").iterdir())
+    assert store[:2] == ["current", "lock"] and len(store) == 4  # this run and the one before
+    assert all(name.startswith("run-") for name in store[2:])
 
 
 @pytest.mark.parametrize(

@@ -61,11 +61,14 @@ def _kill_9(proc: subprocess.Popen[str]) -> None:
 
 
 def _snapshot(folder: Path) -> dict[str, str]:
-    return {
-        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-        for p in sorted(folder.rglob("*"))
-        if p.is_file()
-    }
+    """Path -> SHA-256 of every file, read as a reader would (through the products' links)."""
+    found = {}
+    for root, _, files in os.walk(folder, followlinks=True):
+        for name in files:
+            p = Path(root) / name
+            if p.is_file():
+                found[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
+    return dict(sorted(found.items()))
 
 
 @pytest.mark.expensive
@@ -139,14 +142,14 @@ def test_kill_9_of_extract_leaves_the_previous_output_intact(
         "--quiet", "--format", "pl,parquet",
     )  # fmt: skip
     try:
-        stages = lambda: [p for p in out.iterdir() if p.name.startswith(".extract-")]  # noqa: E731
-        _wait_for(lambda: bool(stages()), 120, "extract to start writing")
+        runs = lambda: [p for p in (out / ".neurosym").iterdir() if p.name.startswith("run-")]  # noqa: E731
+        _wait_for(lambda: len(runs()) > 1, 120, "extract to start writing")
         _kill_9(proc)  # while the new outputs are being written
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
     visible = {k: v for k, v in _snapshot(out).items() if not k.startswith(".")}
-    assert visible == before
+    assert visible == {k: v for k, v in before.items() if not k.startswith(".")}
 
     # the next run finishes, replaces the products, and removes what the killed run left
     proc2 = run_neurosym(
@@ -155,7 +158,7 @@ def test_kill_9_of_extract_leaves_the_previous_output_intact(
     )  # fmt: skip
     assert proc2.returncode == 0, proc2.stderr
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["facts", "kb.pl", "notes.txt", "recording"]
+    assert names == [".neurosym", "facts", "kb.pl", "notes.txt", "recording"]
     assert (out / "notes.txt").read_text() == "mine\n"
     assert _snapshot(out)["kb.pl"] != before["kb.pl"]
 
@@ -186,3 +189,61 @@ def test_a_full_disk_during_extract_gives_one_line_and_no_half_written_file(
     assert proc.stderr.startswith("neurosym extract: error: cannot write ")
     assert "File too large" in proc.stderr
     assert _snapshot(out) == before  # nothing replaced, no staging folder or temporary file left
+
+
+READ_ONLY = """
+import builtins, errno, io, os, runpy, sys
+
+ro = os.path.abspath(sys.argv[1])  # everything under it behaves as on a read-only file system
+
+
+def _under(path) -> bool:
+    if isinstance(path, int):
+        return False
+    path = os.path.abspath(os.fsdecode(path))
+    return path == ro or path.startswith(ro + os.sep)
+
+
+def _refuse(fn, *positions, writes=None):
+    def guarded(*args, **kwargs):
+        if (writes is None or writes(*args, **kwargs)) and any(
+            len(args) > i and _under(args[i]) for i in positions
+        ):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), args[positions[-1]])
+        return fn(*args, **kwargs)
+    return guarded
+
+
+write_flags = os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_TRUNC | os.O_APPEND
+os.open = _refuse(os.open, 0, writes=lambda path, flags, *a, **k: flags & write_flags)
+for name in ("mkdir", "rmdir", "unlink", "remove", "chmod"):
+    setattr(os, name, _refuse(getattr(os, name), 0))
+for name in ("replace", "rename", "link", "symlink"):
+    setattr(os, name, _refuse(getattr(os, name), 0, 1))
+mode_writes = lambda file, mode="r", *a, **k: any(c in mode for c in "wax+")
+builtins.open = io.open = _refuse(io.open, 0, writes=mode_writes)
+sys.argv = ["neurosym", *sys.argv[2:]]
+runpy.run_module("neurosym", run_name="__main__")
+"""
+
+
+@pytest.mark.parametrize("command", ["extract", "probe"])
+def test_a_read_only_output_folder_is_one_line_and_left_as_it_was(
+    run_neurosym, tmp_path: Path, command: str
+) -> None:
+    old = tmp_path / "old"
+    made = run_neurosym(command, "--checkpoint", CHECKPOINT, "--episodes", 2, "--out", old)
+    assert made.returncode == 0, made.stderr
+    before = _snapshot(old)
+    for out in (old, tmp_path / "new"):
+        proc = subprocess.run(
+            [sys.executable, "-c", READ_ONLY, tmp_path, command, "--checkpoint", CHECKPOINT,
+             "--episodes", "2", "--out", out],
+            cwd=REPO, env=_env(), capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert (proc.returncode, proc.stdout) == (1, ""), proc.stderr
+        assert proc.stderr == (
+            f"neurosym {command}: error: cannot write into {out}: Read-only file system\n"
+        )
+    assert _snapshot(old) == before
+    assert not (tmp_path / "new").exists()

@@ -223,7 +223,12 @@ def test_an_agent_records_on_other_envs_of_its_family() -> None:
     ("kwargs", "message"),
     [
         ({"episodes": 0}, "episodes must be a positive integer"),
-        ({"seed": -1}, "seed must be a non-negative integer"),
+        ({"seed": -1}, r"seed must be an integer from 0 to \d+ .*got -1"),
+        (
+            {"seed": 2**63 - 1, "episodes": 2},
+            r"seed must be an integer from 0 to 9223372036854775806 "
+            r"with 2 episodes \(episode k plays seed SEED \+ k",
+        ),
         ({"batch": 0}, "batch must be a positive integer"),
         ({"threads": 0}, "threads must be a positive integer or None"),
     ],

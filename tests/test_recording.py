@@ -125,3 +125,30 @@ def test_counts() -> None:
     rec = small_recording()
     assert rec.n_episodes == 2
     assert rec.n_steps == 3
+
+
+def test_load_names_the_folder_of_a_damaged_table_or_meta(tmp_path: Path) -> None:
+    rec = tmp_path / "rec"
+    small_recording().save(rec)
+    pd.DataFrame({"x": [1]}).to_parquet(rec / "steps.parquet")
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert str(err.value) == (
+        f"{rec}: recording table 'steps' lacks column(s) episode, t, action, reward; "
+        "expected episode, t, action, reward"
+    )
+    steps = small_recording().steps.assign(episode=["a", "b", "c"])
+    steps.to_parquet(rec / "steps.parquet")
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert str(err.value).startswith(
+        f"{rec}: recording table 'steps' has columns of the wrong type (expected episode int64: "
+    )
+    small_recording().save(rec)
+    (rec / "meta.json").write_text('{"format": "neurosym-recording", "meta": 5}')
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert (
+        str(err.value)
+        == f"{rec} is not a neurosym recording (its meta.json 'meta' is not an object)"
+    )

@@ -112,3 +112,39 @@ def test_bad_maps_name_row_and_column(text: str, message: str) -> None:
 def test_unknown_map_name_is_refused() -> None:
     with pytest.raises(MapError, match="not a shipped map"):
         load_map("rgw9")
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ("# café\nA.ST\n".encode("latin-1"), "not UTF-8 text (byte 0xe9 at offset 5)"),
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "not UTF-8 text (byte 0x89 at offset 0)"),
+    ],
+)
+def test_a_map_file_that_is_not_utf8_is_one_line_naming_it(
+    tmp_path, run_neurosym, data: bytes, message: str
+) -> None:
+    path = tmp_path / "map.txt"
+    path.write_bytes(data)
+    with pytest.raises(MapError) as err:
+        load_map(str(path))
+    assert str(err.value) == f"map {str(path)!r}: {message}; a map is lines of .AWMPSETOQ"
+    proc = run_neurosym(
+        "eval", "--checkpoint", "checkpoints/rgw2-predinet.pt", "--map", path, "--episodes", 1
+    )
+    assert (proc.returncode, proc.stdout) == (1, "")
+    assert proc.stderr == f"neurosym eval: error: {err.value}\n"
+
+
+def test_a_utf8_map_with_a_byte_order_mark_loads(tmp_path) -> None:
+    path = tmp_path / "bom.txt"
+    path.write_bytes("\ufeffA.ST\n".encode())
+    assert load_map(str(path)).text() == "A.ST\n"
+
+
+def test_a_map_file_too_large_for_a_map_is_refused_unread(tmp_path) -> None:
+    path = tmp_path / "huge.txt"
+    with path.open("wb") as fh:
+        fh.truncate(1 << 30)  # sparse: a GiB that takes no disk
+    with pytest.raises(MapError, match=r"1,073,741,824 bytes, more than a map's 1,048,576"):
+        load_map(str(path))

@@ -55,7 +55,7 @@ from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.introspection import Introspection
 from neurosym.agent.model import ActorCritic
 from neurosym.agent.rollout import select_actions
-from neurosym.atomic import write_bytes_atomic
+from neurosym.atomic import make_folder, write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 from neurosym.shipped import checkpoint_file
 
@@ -142,7 +142,7 @@ def save_checkpoint(
 def _write_payload(path: Path, payload: dict[str, Any]) -> Path:
     """Check that ``payload`` holds only tensors and plain values, then write it atomically."""
     _check_plain(payload, "checkpoint")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     # Serialised in memory first: torch reports a failed file write as a
     # RuntimeError, a plain write reports it as the OSError it is.
     buf = io.BytesIO()
@@ -155,8 +155,11 @@ def _load_raw(path: Path) -> Any:
         raise CheckpointError(f"checkpoint not found: {path}")
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} is not a file")
-    with path.open("rb") as fh:
-        head = fh.read(4)
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(4)
+    except OSError as exc:
+        raise CheckpointError(f"cannot read {path}: {exc.strerror or exc}") from None
     if not head:
         raise CheckpointError(f"cannot read {path}: the file is empty")
     if not (
@@ -245,8 +248,11 @@ def read_checkpoint(
         model_config = ModelConfig.from_dict(raw_config)
     except ConfigError as exc:
         raise CheckpointError(f"checkpoint {path} has a bad model config: {exc}") from None
+    _check_sizes(path, model_config, state)
     if env is not None:
         check_env_fits(str(path), env_name, model_config.obs_shape, env, env_options(payload, env))
+    else:
+        _check_own_env(path, env_name, payload["env_kwargs"], model_config.obs_shape)
     if config is not None:
         expected = config if isinstance(config, ModelConfig) else ModelConfig.from_dict(config)
         mine, theirs = model_config.to_dict(), expected.to_dict()
@@ -256,6 +262,66 @@ def read_checkpoint(
     payload = dict(payload)
     payload["model_config"] = model_config
     return payload
+
+
+SIZE_FIELDS = ("conv_channels", "hidden_sizes", "kernel_size", "heads", "key_size",
+               "output_size", "n_actions", "local_view")  # fmt: skip
+"""ModelConfig fields that size a layer: none can exceed every dimension of the weights"""
+
+MODULE_SIZE_FIELDS = {"predinet": ("relations",), "mhdpa": ("value_size",)}
+"""the same, for the fields only one relational module uses"""
+
+
+def _check_sizes(path: Path, config: ModelConfig, state: dict[str, torch.Tensor]) -> None:
+    """Refuse a model config (an edited file) that would build a network far larger than its weights.
+
+    Every layer size of a config that fits its weights is at most the largest
+    dimension of one of them; a larger one would allocate its layers (hundreds
+    of GB for a hidden size in the millions) before the weights were found not
+    to fit.
+    """
+    largest = max((max(t.shape, default=1) for t in state.values()), default=0)
+    for name in (*SIZE_FIELDS, *MODULE_SIZE_FIELDS.get(config.module, ())):
+        value = getattr(config, name)
+        for v in value if isinstance(value, tuple) else (value,):
+            if int(v) > largest:
+                raise CheckpointError(
+                    f"checkpoint {path} is damaged: its model config has {name} {value!r}, "
+                    f"larger than any dimension of its weights ({largest})"
+                )
+
+
+def _check_own_env(
+    path: Path, env: str, env_kwargs: dict[str, Any], shape: tuple[int, ...]
+) -> None:
+    """Refuse a checkpoint whose env is unknown or gives observations its model cannot take.
+
+    Its options are the ones it was trained with; where they no longer make an
+    env (a user's map moved), the check is left to whoever plays it, with the
+    user's own options.
+    """
+    from neurosym.envs import canonical_name, make
+    from neurosym.errors import NeurosymError
+
+    try:
+        name = canonical_name(env)
+    except NeurosymError as exc:
+        raise CheckpointError(
+            f"checkpoint {path} names an env this neurosym lacks: {exc}"
+        ) from None
+    try:
+        probe = make(name, **env_kwargs)
+    except (NeurosymError, TypeError, ValueError):
+        return
+    try:
+        got = tuple(int(v) for v in probe.observation_space.shape)
+    finally:
+        probe.close()
+    if got != tuple(shape):
+        raise CheckpointError(
+            f"checkpoint {path} is damaged: its env {name} {_options_text(env_kwargs)}gives "
+            f"observations {got}, its model takes {tuple(shape)}"
+        )
 
 
 RESTARTED_BY_KEYS = ("relational.key.weight",)
@@ -275,7 +341,12 @@ def build_model(
         config = replace(config, keys=keys)
         fresh = ActorCritic(config).state_dict()
         state = {**state, **{k: fresh[k] for k in RESTARTED_BY_KEYS}}
-    model = ActorCritic(config)
+    try:
+        model = ActorCritic(config)
+    except (RuntimeError, MemoryError) as exc:  # a config that passed _check_sizes, yet too large
+        raise CheckpointError(
+            f"{path}: its model config does not fit in memory ({_one_line(exc)})"
+        ) from None
     try:
         model.load_state_dict(state, strict=True)
     except RuntimeError as exc:

@@ -26,6 +26,7 @@ from typing import Any
 
 from neurosym.cli import add_action_mode, add_env_options, play_options
 from neurosym.errors import ConfigError
+from neurosym.seeds import check_seed
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -58,8 +59,7 @@ def evaluate(
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ConfigError(f"--seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed, episodes)
     env, kwargs = env_for(agent, env, env_kwargs)
     generator = None if greedy else torch.Generator().manual_seed(seed)
     report = score(

@@ -53,6 +53,9 @@ SHIPPED = ("rgw1", "rgw2")
 # Room for the removable objects' bits in the uint64 'removed' mask.
 MAX_REMOVABLE = 64
 
+MAX_MAP_BYTES = 1 << 20
+"""largest map file read (a 1000 x 1000 map is under 1 MiB)"""
+
 
 @dataclass(frozen=True, eq=False)
 class GridMap:
@@ -144,4 +147,26 @@ def load_map(source: str | os.PathLike[str]) -> GridMap:
             f"map {str(source)!r}: not a shipped map ({', '.join(SHIPPED)}), "
             "not a file, and not map text (which has one line per row)"
         )
-    return parse_map(path.read_text(), name=path.name)
+    return parse_map(read_map_file(path), name=path.name)
+
+
+def read_map_file(path: Path) -> str:
+    """The text of a map file, or a MapError naming it: unreadable, too large, not UTF-8."""
+    try:
+        size = path.stat().st_size
+        if size > MAX_MAP_BYTES:
+            raise MapError(
+                f"map {str(path)!r}: {size:,} bytes, more than a map's {MAX_MAP_BYTES:,}; "
+                "a map is lines of the legend's characters"
+            )
+        with path.open("rb") as fh:
+            data = fh.read(MAX_MAP_BYTES + 1)
+    except OSError as exc:
+        raise MapError(f"map {str(path)!r}: cannot read it ({exc.strerror or exc})") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise MapError(
+            f"map {str(path)!r}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+            f"{exc.start}); a map is lines of {''.join(SYMBOLS)}"
+        ) from None

@@ -11,9 +11,12 @@ Writes into ``--out`` (default ``kb_out/<env>``):
 * ``facts/<predicate>.parquet`` (format ``parquet``) -- the same fact tables;
 * ``recording/`` -- the Recording itself, for ``neurosym plot --recording``.
 
-Everything is computed in memory first and then moved into place, each file
-or folder by one rename, so a failed run writes nothing and a reader never
-sees half a KB. A checkpoint that cannot be read, or that cannot play
+The products are written beside the previous ones and published together
+by one rename (:mod:`neurosym.publish`), so a failed or killed run writes
+nothing, a reader never sees half a KB or a KB beside another run's
+recording, and a second run into the same ``--out`` is refused while one
+is writing. A product the run does not make (``kb.qlf`` without ``--qlf``)
+is removed with the previous run's others. A checkpoint that cannot be read, or that cannot play
 ``--env`` (another env family or observation shape), is refused before
 anything is recorded; any env of its family with its shape is fine.
 """
@@ -26,8 +29,11 @@ from typing import Any
 
 from neurosym.cli import add_action_mode, add_env_options, play_options
 from neurosym.errors import ConfigError
+from neurosym.seeds import check_seed
 
 FORMATS = ("pl", "parquet")
+PRODUCTS = ("kb.pl", "kb.qlf", "kb.qlf.sig", "facts", "recording")
+"""what an extract run writes into --out; one run's set replaces the previous run's"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -103,8 +109,7 @@ def run(args: argparse.Namespace) -> int:
     threshold = parse_threshold(args.threshold)
     if args.episodes < 1:
         raise ConfigError(f"--episodes must be at least 1, got {args.episodes}")
-    if args.seed < 0:
-        raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
+    check_seed(args.seed, args.episodes)
     if args.batch is not None and args.batch < 1:
         raise ConfigError(f"--batch must be at least 1, got {args.batch}")
     if args.top_keys < 1:
@@ -113,14 +118,13 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.agent.checkpoint import env_for, load_agent
     from neurosym.export.facts import extract_facts
     from neurosym.export.recorder import record
+    from neurosym.publish import check_out
 
     agent = load_agent(args.checkpoint)
     env, overrides = play_options(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once: the default folder needs the checkpoint's env
-    out = Path(args.out) if args.out else Path("kb_out") / env
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out} exists and is not a folder")
+    out = check_out(Path(args.out) if args.out else Path("kb_out") / env)
     show = not args.quiet
     rec = record(
         agent,
@@ -154,8 +158,8 @@ def write_outputs(
     """Write the products into ``out`` through :func:`neurosym.publish.publish`.
 
     Only neurosym's own names (kb.pl, kb.qlf, kb.qlf.sig, facts/, recording/)
-    are replaced in ``out``; a killed run leaves the previous products as they
-    were. Returns name -> final path.
+    change in ``out``, all in one step; a killed run leaves the previous
+    products as they were. Returns name -> final path.
     """
     from neurosym.publish import publish
 
@@ -166,4 +170,4 @@ def write_outputs(
             facts.to_parquet(stage / "facts")
         rec.save(stage / "recording")
 
-    return publish(out, write, folders=("facts", "recording"), prefix=".extract-")
+    return publish(out, write, owned=PRODUCTS)

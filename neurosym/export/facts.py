@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from neurosym.atomic import atomic_write
+from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 from neurosym.export.recording import META_KEYS, Recording
 from neurosym.export.thresholds import Threshold, parse_threshold
@@ -216,8 +216,7 @@ class FactSet:
 
     def to_parquet(self, directory: str | os.PathLike[str]) -> Path:
         """Write one Parquet file per predicate and ``meta.json``, each file atomically."""
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        out = make_folder(directory)
         for name, df in self.tables.items():
             if name == "kb_meta":  # atoms and numbers: Parquet needs one type per column
                 df = df.assign(value=df["value"].map(str))

@@ -42,7 +42,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from neurosym.atomic import open_atomic
+from neurosym.atomic import make_folder, open_atomic
 from neurosym.errors import FactError
 from neurosym.terms import atom_text, float_text, format_value, parse_term
 
@@ -265,7 +265,7 @@ def write_prolog(
         if len(df) == 0:
             declared[(name, df.shape[1])] = None
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     with open_atomic(path, "wb") as out:
         lines = [f"% {line}".rstrip() for line in (header or "").splitlines()]
         lines.append(":- encoding(utf8).")

@@ -27,6 +27,7 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
+from neurosym.seeds import check_seed
 
 DEFAULT_BATCH = 64
 """Sub-environments stepped together (fewer when fewer episodes are asked for)."""
@@ -193,8 +194,7 @@ def record(
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed, episodes, name="seed")
     if batch is not None and (isinstance(batch, bool) or not isinstance(batch, int) or batch < 1):
         raise ConfigError(f"batch must be a positive integer, got {batch!r}")
     if top_keys < 1:

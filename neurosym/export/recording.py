@@ -23,7 +23,7 @@ from typing import Any
 
 import pandas as pd
 
-from neurosym.atomic import atomic_write
+from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 
 # table -> ordered (column, dtype); "str" columns hold Prolog text (atoms or terms).
@@ -115,7 +115,14 @@ def conform(name: str, df: pd.DataFrame | None) -> pd.DataFrame:
     out = df.loc[:, columns]
     dtypes = {c: d for c, d in SCHEMA[name] if str(out[c].dtype) != d}
     if dtypes:
-        out = out.astype(dtypes)
+        try:
+            out = out.astype(dtypes)
+        except (TypeError, ValueError, OverflowError) as exc:
+            wanted = ", ".join(f"{c} {d}" for c, d in dtypes.items())
+            raise ConfigError(
+                f"recording table {name!r} has columns of the wrong type (expected {wanted}: "
+                f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+            ) from None
     return out.reset_index(drop=True)
 
 
@@ -163,8 +170,7 @@ class Recording:
         Each file is written to a temporary name and renamed into place, so a
         reader never sees a half-written table.
         """
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        out = make_folder(directory)
         for name, df in self.tables.items():
             atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         meta = {"format": _FORMAT, "format_version": _FORMAT_VERSION, "meta": self.meta}
@@ -174,9 +180,13 @@ class Recording:
 
     @classmethod
     def load(cls, directory: str | os.PathLike[str]) -> Recording:
-        """Read a recording written by :meth:`save`; ConfigError if it is not one."""
+        """Read a recording written by :meth:`save`; ConfigError if it is not one.
+
+        A folder published by ``neurosym extract`` is a link that the next run
+        re-points; it is resolved once, so every table comes from the same run.
+        """
         src = Path(directory)
-        meta_path = src / "meta.json"
+        meta_path = src.resolve() / "meta.json"
         try:
             head = json.loads(meta_path.read_text())
         except (OSError, ValueError) as exc:
@@ -189,12 +199,20 @@ class Recording:
             )
         tables: dict[str, pd.DataFrame] = {}
         for name in SCHEMA:
-            path = src / f"{name}.parquet"
+            path = meta_path.parent / f"{name}.parquet"
             try:
                 tables[name] = pd.read_parquet(path)
             except (OSError, ValueError) as exc:
-                raise ConfigError(f"cannot read {path}: {exc}") from None
-        return cls(**tables, meta=head.get("meta", {}))
+                raise ConfigError(f"cannot read {src / path.name}: {exc}") from None
+        meta = head.get("meta", {})
+        if not isinstance(meta, dict):
+            raise ConfigError(
+                f"{src} is not a neurosym recording (its meta.json 'meta' is not an object)"
+            )
+        try:
+            return cls(**tables, meta=meta)
+        except ConfigError as exc:
+            raise ConfigError(f"{src}: {exc}") from None
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Recording):

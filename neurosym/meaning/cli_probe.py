@@ -74,8 +74,9 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"--episodes must be at least 2 (probes hold episodes out), got {args.episodes}"
         )
-    if args.seed < 0:
-        raise ConfigError(f"--seed must be 0 or more, got {args.seed}")
+    from neurosym.seeds import check_seed
+
+    check_seed(args.seed, args.episodes)
     out = check_out(Path(args.out))
 
     from neurosym.agent.checkpoint import load_agent
