@@ -149,13 +149,13 @@ def test_report_from_a_checkpoint_writes_extracts_products(run_neurosym, tmp_pat
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == f"wrote {out / 'index.html'}"
-    assert sorted(p.name for p in out.iterdir()) == ["index.html", "kb.pl", "recording"]
+    assert sorted(p.name for p in out.iterdir()) == [".neurosym", "index.html", "kb.pl", "recording"]
     html = (out / "index.html").read_text(encoding="utf-8")
     rec = Recording.load(out / "recording")
     assert tables_back(embedded(html), "attends").equals(rec.attends)
     assert "rgw2-predinet.pt on rgw2" in html
     assert "<dt>learner</dt><dd>a3c</dd>" in html and "<dt>frames</dt><dd>505,601</dd>" in html
-    assert "the last figures of training (not held out" in html
+    assert "the checkpoint&#39;s card (held-out evaluation)" in html
 
 
 def test_boxworld_page(tmp_path: Path) -> None:

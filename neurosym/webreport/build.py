@@ -154,7 +154,16 @@ def load_extract(path: Path, threshold: str | None = None) -> tuple[Recording, A
     """(recording, facts, kb.pl or None) of an extract folder; facts at the extract's threshold."""
     from neurosym.export.facts import DEFAULT_THRESHOLD, extract_facts
 
+    from neurosym.publish import published
+
     rec_dir, folder = recording_folder(path)
+    # Every product from one published run (a run published meanwhile cannot give a mix).
+    if rec_dir == folder / "recording":
+        folder = published(folder)
+        rec_dir = folder / "recording"
+    else:
+        rec_dir = rec_dir.resolve()
+        folder = rec_dir.parent
     rec = Recording.load(rec_dir)
     kb = folder / "kb.pl"
     kb_path = kb if kb.is_file() else None
