@@ -684,6 +684,7 @@ def train(
 
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.table import Column
 
     total = (
         options.frames - frames0
@@ -691,9 +692,10 @@ def train(
         else (options.minutes * 60 if options.minutes else None)
     )
     progress = Progress(
-        TextColumn("[bold]{task.description}"),
+        # text columns never wrap (a value split over two lines, "29 / %"): the bar shrinks
+        TextColumn("[bold]{task.description}", table_column=Column(no_wrap=True)),
         BarColumn(),
-        TextColumn("{task.fields[stats]}"),
+        TextColumn("{task.fields[stats]}", markup=False, table_column=Column(no_wrap=True)),
         TimeElapsedColumn(),
         console=Console(stderr=True),
         disable=not options.progress,

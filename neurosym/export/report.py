@@ -12,6 +12,8 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from neurosym.display import show
+
 # (title, goal, variable): goals answered for every KB of a family. Each
 # variable's value is printed as Prolog text; a goal with no answer prints "none".
 QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
@@ -94,7 +96,7 @@ def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
     return head if len(values) == 1 else f"{head}  ({len(values)})"
 
 
-def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
+def _print_heads(rec: Any, say: Any, table_type: Any) -> None:
     """The per-head table of :func:`neurosym.export.heads.head_summary` (PrediNet only)."""
     from neurosym.export.heads import head_summary
 
@@ -106,7 +108,8 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
         show_edge=False,
     )
     for col in ("head", "states", "two objects", "next object", "top pairs (share of states)"):
-        table.add_column(col, justify="left" if col.startswith("top") else "right")
+        top = col.startswith("top")
+        table.add_column(col, justify="left" if top else "right", no_wrap=not top)
     for row in heads.to_dict("records"):
         pairs = [
             f"{row[f'pair_{k}']} {100 * row[f'share_{k}']:.0f} %"
@@ -114,11 +117,11 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
             if row.get(f"pair_{k}") is not None
         ]
         table.add_row(
-            str(row["head"]),
-            str(row["states"]),
+            show(row["head"]),
+            show(row["states"]),
             f"{100 * row['two_objects']:.0f} %",
             "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
-            escape(", ".join(pairs) or "none"),
+            show(", ".join(pairs) or "none"),
         )
     say(table)
     if heads["beside_objects"].isna().all():
@@ -128,14 +131,15 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
         show_edge=False,
     )
     for col in ("head", "on or beside two objects", "top pair (share of states)"):
-        beside.add_column(col, justify="left" if col.startswith("top") else "right")
+        top = col.startswith("top")
+        beside.add_column(col, justify="left" if top else "right", no_wrap=not top)
     for row in heads.to_dict("records"):
         share = row["beside_objects"]
         pair = row["beside_pair"]
         beside.add_row(
-            str(row["head"]),
+            show(row["head"]),
             "-" if share is None else f"{100 * share:.0f} %",
-            "none" if pair is None else escape(f"{pair} {100 * row['beside_share']:.0f} %"),
+            "none" if pair is None else show(f"{pair} {100 * row['beside_share']:.0f} %"),
         )
     say(beside)
 
@@ -143,11 +147,12 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any) -> None:
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
     """Print the summary of an extract run with rich (plain text when not a terminal).
 
-    Every value printed is escaped: Prolog lists such as ``[sword,enemy]`` would
-    otherwise be read as rich markup and vanish.
+    Every value printed from the recording, the facts or the KB goes through
+    :func:`neurosym.display.show`: Prolog lists such as ``[sword,enemy]`` would
+    otherwise be read as rich markup and vanish, and an atom holding escape
+    codes would style the terminal. Columns of numbers never wrap.
     """
     from rich.console import Console
-    from rich.markup import escape
     from rich.table import Table
 
     from neurosym.envs import env_family
@@ -158,16 +163,16 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
     ep = rec.episodes
     mode = "greedy" if meta.get("greedy", True) else "sampled"
     say(
-        f"[bold]{escape(str(meta.get('env')))}[/]: {len(ep)} episodes ({mode}, seed {meta.get('seed')}) "
-        f"of {escape(str(meta.get('checkpoint')))} ({meta.get('module')}, {meta.get('heads')} heads, "
-        f"{meta.get('relations')} relations)"
+        f"[bold]{show(meta.get('env'))}[/]: {len(ep)} episodes ({mode}, seed {show(meta.get('seed'))}) "
+        f"of {show(meta.get('checkpoint'))} ({show(meta.get('module'))}, "
+        f"{show(meta.get('heads'))} heads, {show(meta.get('relations'))} relations)"
     )
     table = Table(title="episodes", show_edge=False)
     for col in ("episode", "steps", "return", "outcome"):
-        table.add_column(col, justify="left" if col == "outcome" else "right")
+        table.add_column(col, justify="left" if col == "outcome" else "right", no_wrap=True)
     shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
     for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
-        table.add_row(str(e), str(steps), f"{ret:.2f}", escape(str(outcome)))
+        table.add_row(show(e), show(steps), f"{ret:.2f}", show(outcome))
     say(table)
     if len(ep) > 20:
         say(f"... {len(ep) - 20} more episodes")
@@ -177,28 +182,28 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
         )
         r = ep["return"]
         say(
-            f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {escape(outcomes)}"
+            f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {show(outcomes)}"
         )
 
     counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
-    say(f"facts: {counts}  ({facts.n_facts} in all)")
+    say(f"facts: {show(counts)}  ({facts.n_facts} in all)")
     thr = facts.thresholds()
     if len(thr):
         say(
-            f"thresholds ({facts.threshold}): "
-            + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
+            f"thresholds ({show(facts.threshold)}): "
+            + show(", ".join(f"r({j}) {v:.4g}" for j, v in thr.items()))
         )
 
-    _print_heads(rec, say, escape, Table)
+    _print_heads(rec, say, Table)
 
     strongest = facts.strongest_relations(5)
     if len(strongest):
         st = Table(title="strongest relations between object types (holds/5)", show_edge=False)
         for col in ("relation", "from", "to", "states", "mean value"):
-            st.add_column(col)
+            st.add_column(col, no_wrap=col in ("relation", "states", "mean value"))
         for r in strongest.itertuples(index=False):
             st.add_row(
-                f"r({r.j})", escape(str(r.a)), escape(str(r.b)), str(r.held), f"{r.mean_value:.4g}"
+                show(f"r({r.j})"), show(r.a), show(r.b), show(r.held), f"{r.mean_value:.4g}"
             )
         say(st)
     elif not facts["attention"].empty:
@@ -217,9 +222,9 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             qt.add_column("answers")
             for title, goal, values in answers:
                 of = len(ep) if goal.endswith("(E)") else None
-                qt.add_row(title, escape(_short(values, of=of)))
+                qt.add_row(show(title), show(_short(values, of=of)))
             say(qt)
         else:
             say("rule answers: none (rules/ is not beside the package)")
     for path in written.values():
-        say(f"wrote {escape(str(path))}")
+        say(f"wrote {show(path)}")

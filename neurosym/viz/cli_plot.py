@@ -149,6 +149,7 @@ def _cell(text: str) -> tuple[int, int]:
 
 def run(args: argparse.Namespace) -> int:
     """Load the source, draw the requested picture and write it."""
+    from neurosym.display import plain
     from neurosym.errors import ConfigError
     from neurosym.viz.output import ANIMATION_FORMATS, IMAGE_FORMATS, image_format
 
@@ -164,11 +165,11 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(f"--top must be at least 1, got {args.top}")
         fig = probes_figure(load_probe_table(args.probes), args.relation, args.top)
         path = save_figure(fig, args.out, dpi=args.dpi)
-        print(f"wrote {args.out} ({_pixels(path) if fmt == 'png' else 'svg'})")
+        print(f"wrote {plain(args.out)} ({_pixels(path) if fmt == 'png' else 'svg'})")
         return 0
     source = _load_source(args)
     written = _draw(args, source, fmt)
-    print(f"wrote {args.out} ({written})")
+    print(f"wrote {plain(args.out)} ({written})")
     return 0
 
 
