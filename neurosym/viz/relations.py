@@ -22,6 +22,7 @@ from neurosym.errors import ConfigError
 from neurosym.export.facts import DEFAULT_THRESHOLD
 from neurosym.export.recording import Recording
 from neurosym.viz.live import trace_from_agent
+from neurosym.viz.panels import widen_for_text
 from neurosym.viz.sources import EnvLike, Source, require_source_module
 from neurosym.viz.style import head_colour
 from neurosym.viz.trace import EpisodeTrace
@@ -153,8 +154,9 @@ def relations_figure(
         ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7)
     axes[0, 0].set_ylabel("steps x heads", fontsize=7)
     axes[0, 0].legend(fontsize=6, frameon=False, loc="upper left")
-    fig.suptitle(
+    title = fig.suptitle(
         f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}",
         fontsize=10,
     )
+    widen_for_text(fig, [title])
     return fig
