@@ -109,20 +109,24 @@ def _print_heads(rec: Any, say: Any, table_type: Any) -> None:
     )
     for col in ("head", "states", "two objects", "next object", "top pairs (share of states)"):
         top = col.startswith("top")
-        table.add_column(col, justify="left" if top else "right", no_wrap=not top)
+        table.add_column(col, justify="left" if col.startswith("top") else "right")
+    rows = []
     for row in heads.to_dict("records"):
         pairs = [
             f"{row[f'pair_{k}']} {100 * row[f'share_{k}']:.0f} %"
             for k in (1, 2, 3)
             if row.get(f"pair_{k}") is not None
         ]
-        table.add_row(
-            show(row["head"]),
-            show(row["states"]),
-            f"{100 * row['two_objects']:.0f} %",
-            "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
-            show(", ".join(pairs) or "none"),
+        rows.append(
+            (
+                show(row["head"]),
+                show(row["states"]),
+                f"{100 * row['two_objects']:.0f} %",
+                "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
+                show(", ".join(pairs) or "none"),
+            )
         )
+    add_rows(table, rows, whole=(0, 1, 2, 3))
     say(table)
     if heads["beside_objects"].isna().all():
         return
@@ -132,16 +136,33 @@ def _print_heads(rec: Any, say: Any, table_type: Any) -> None:
     )
     for col in ("head", "on or beside two objects", "top pair (share of states)"):
         top = col.startswith("top")
-        beside.add_column(col, justify="left" if top else "right", no_wrap=not top)
-    for row in heads.to_dict("records"):
-        share = row["beside_objects"]
-        pair = row["beside_pair"]
-        beside.add_row(
+        beside.add_column(col, justify="left" if col.startswith("top") else "right")
+    rows = [
+        (
             show(row["head"]),
-            "-" if share is None else f"{100 * share:.0f} %",
-            "none" if pair is None else show(f"{pair} {100 * row['beside_share']:.0f} %"),
+            "-" if row["beside_objects"] is None else f"{100 * row['beside_objects']:.0f} %",
+            "none"
+            if row["beside_pair"] is None
+            else show(f"{row['beside_pair']} {100 * row['beside_share']:.0f} %"),
         )
+        for row in heads.to_dict("records")
+    ]
+    add_rows(beside, rows, whole=(0, 1))
     say(beside)
+
+
+def add_rows(table: Any, rows: list[tuple[str, ...]], whole: tuple[int, ...]) -> None:
+    """Add ``rows`` (rich markup) to a rich table; the columns ``whole`` are never made
+    narrower than their widest cell, so that a narrow terminal wraps the text columns
+    and the headers, never a value such as ``29 %`` over two lines."""
+    from rich.text import Text
+
+    for row in rows:
+        table.add_row(*row)
+    for i in whole:
+        column = table.columns[i]
+        widest = max((Text.from_markup(row[i]).cell_len for row in rows), default=0)
+        column.min_width = max(column.min_width or 0, widest)
 
 
 def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None) -> None:
@@ -150,7 +171,7 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
     Every value printed from the recording, the facts or the KB goes through
     :func:`neurosym.display.show`: Prolog lists such as ``[sword,enemy]`` would
     otherwise be read as rich markup and vanish, and an atom holding escape
-    codes would style the terminal. Columns of numbers never wrap.
+    codes would style the terminal. Values never wrap (:func:`add_rows`).
     """
     from rich.console import Console
     from rich.table import Table
@@ -169,10 +190,13 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
     )
     table = Table(title="episodes", show_edge=False)
     for col in ("episode", "steps", "return", "outcome"):
-        table.add_column(col, justify="left" if col == "outcome" else "right", no_wrap=True)
+        table.add_column(col, justify="left" if col == "outcome" else "right")
     shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
-    for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
-        table.add_row(show(e), show(steps), f"{ret:.2f}", show(outcome))
+    rows = [
+        (show(e), show(steps), f"{ret:.2f}", show(outcome))
+        for e, steps, ret, outcome in shown.itertuples(index=False, name=None)
+    ]
+    add_rows(table, rows, whole=(0, 1, 2, 3))
     say(table)
     if len(ep) > 20:
         say(f"... {len(ep) - 20} more episodes")
@@ -200,11 +224,12 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
     if len(strongest):
         st = Table(title="strongest relations between object types (holds/5)", show_edge=False)
         for col in ("relation", "from", "to", "states", "mean value"):
-            st.add_column(col, no_wrap=col in ("relation", "states", "mean value"))
-        for r in strongest.itertuples(index=False):
-            st.add_row(
-                show(f"r({r.j})"), show(r.a), show(r.b), show(r.held), f"{r.mean_value:.4g}"
-            )
+            st.add_column(col)
+        rows = [
+            (show(f"r({r.j})"), show(r.a), show(r.b), show(r.held), f"{r.mean_value:.4g}")
+            for r in strongest.itertuples(index=False)
+        ]
+        add_rows(st, rows, whole=(0, 3, 4))
         say(st)
     elif not facts["attention"].empty:
         say("MHDPA: attention/6 holds the strongest key of every query cell (no relation values)")
