@@ -68,7 +68,7 @@ def test_eval_shows_a_checkpoint_name_as_text(run_neurosym, tmp_path: Path) -> N
     assert "[red]x\\e[31m.pt (rgw1, predinet" in proc.stdout
 
 
-def _on_a_terminal(*args: object) -> tuple[int, str]:
+def _on_a_terminal(*args: object, columns: int = 100) -> tuple[int, str]:
     """Run neurosym with stderr a terminal (a pty); (exit status, what it wrote there)."""
     import pty
 
@@ -76,7 +76,7 @@ def _on_a_terminal(*args: object) -> tuple[int, str]:
     proc = subprocess.Popen(
         [sys.executable, "-m", "neurosym", *map(str, args)],
         stdout=subprocess.DEVNULL, stderr=slave, cwd=REPO,
-        env={**_env(), "TERM": "xterm", "COLUMNS": "100"},
+        env={**_env(), "TERM": "xterm", "COLUMNS": str(columns)},
     )  # fmt: skip
     os.close(slave)
     chunks: list[bytes] = []
@@ -118,3 +118,30 @@ def test_no_progress_when_stderr_is_not_a_terminal(run_neurosym, tmp_path: Path)
     proc = run_neurosym("intervene", "--checkpoint", CHECKPOINTS / "rgw2-predinet.pt",
                         "--episodes", 2, "--no-levels", "--out", tmp_path / "i")  # fmt: skip
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+
+
+
+def test_fields_are_shown_whole_or_left_out() -> None:
+    import io
+
+    from rich.console import Console
+
+    from neurosym.progress import Fields
+
+    console = Console(width=20, file=io.StringIO(), color_system=None)
+    console.print(Fields("320 frames  254/s  0 ep  success 29 %"))
+    assert console.file.getvalue() == "320 frames  254/s\n"
+
+
+def test_the_training_bar_never_cuts_a_figure(tmp_path: Path) -> None:
+    """In a narrow terminal the figures that do not fit are left out, never cut ("succes…")."""
+    import re
+
+    code, text = _on_a_terminal(
+        "train", "--env", "rgw1", "--module", "predinet", "--frames", 300, "--workers", 1,
+        "--out", tmp_path / "run", columns=60,
+    )  # fmt: skip
+    assert code == 0, text
+    plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)
+    assert "rgw1 predinet" in plain and re.search(r"\d+ frames  ", plain), plain
+    assert "…" not in plain, plain

@@ -686,16 +686,17 @@ def train(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Column
 
+    from neurosym.progress import FieldsColumn
+
     total = (
         options.frames - frames0
         if options.frames
         else (options.minutes * 60 if options.minutes else None)
     )
     progress = Progress(
-        # text columns never wrap (a value split over two lines, "29 / %"): the bar shrinks
         TextColumn("[bold]{task.description}", table_column=Column(no_wrap=True)),
         BarColumn(),
-        TextColumn("{task.fields[stats]}", markup=False, table_column=Column(no_wrap=True)),
+        FieldsColumn("stats"),  # whole figures only, those that fit
         TimeElapsedColumn(),
         console=Console(stderr=True),
         disable=not options.progress,

@@ -475,7 +475,7 @@ def intervene(
     from neurosym.envs import canonical_name, env_family
     from neurosym.envs.rgw_maps import load_map
     from neurosym.export.recorder import _resolve_env, record
-    from neurosym.meaning.progress import Stages
+    from neurosym.progress import Stages
     from neurosym.meaning.features import (
         ablate_heads,
         head_means,

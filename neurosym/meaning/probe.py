@@ -43,7 +43,7 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 from neurosym.meaning.predicates import StateLabels
-from neurosym.meaning.progress import Stages
+from neurosym.progress import Stages
 
 DEFAULT_EPISODES = 200
 """probe episodes by default: sampled, seeds S..S+199 (about 4k states on rgw2)"""
