@@ -27,6 +27,10 @@ _SUBCOMMANDS = {
 }
 
 
+MIN_DPI, MAX_DPI = 1, 1200
+"""--dpi range: a 4-head figure at 1200 dpi is about 12,700 pixels wide (matplotlib's limit: 65,536)"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the plot subcommands and their options."""
     sub = parser.add_subparsers(dest="plot", metavar="PLOT", required=True)
@@ -155,8 +159,10 @@ def run(args: argparse.Namespace) -> int:
 
     allowed = IMAGE_FORMATS + (ANIMATION_FORMATS if args.plot == "episode" else ())
     fmt = image_format(args.out, allowed)
-    if args.dpi <= 0:
-        raise ConfigError(f"--dpi must be positive, got {args.dpi:g}")
+    if not MIN_DPI <= args.dpi <= MAX_DPI:  # NaN fails too
+        raise ConfigError(f"--dpi must be a number from {MIN_DPI} to {MAX_DPI}, got {args.dpi:g}")
+    if getattr(args, "step", 0) < 0:
+        raise ConfigError(f"--step must be 0 or more, got {args.step}")
     if args.plot == "probes":
         from neurosym.viz.output import save_figure
         from neurosym.viz.probes import load_probe_table, probes_figure
