@@ -396,3 +396,26 @@ def test_bad_requests_are_one_line_errors(pn: Recording, mh: Recording, call, me
         call(pn, mh)
     assert "\n" not in str(info.value)
     assert re.search(message, str(info.value))
+
+
+def test_names_from_files_are_drawn_as_written(pn: Recording) -> None:
+    """``$...$`` in a checkpoint's name is text, not mathtext (``$\\frac$`` was a parse error)."""
+    import dataclasses
+
+    from neurosym.viz.probes import probes_figure
+
+    hostile = dataclasses.replace(pn, meta={**pn.meta, "checkpoint": "runs/$\\frac$.pt"})
+    for fig in (
+        predinet_figure(hostile, step=0),
+        r_vectors_figure(hostile),
+        ep_mod.episode_figure(hostile, frames=2),
+        relations_figure(hostile),
+    ):
+        assert "$\\frac$.pt" in fig.get_suptitle()
+        assert figure_bytes(fig, "png", 30)[:4] == b"\x89PNG"
+    assert ep_mod.episode_frames(ep_mod.load_trace(hostile, episode=0), steps=(0, 1))
+    table = pd.DataFrame(
+        {"head": [0], "relation": ["all"], "predicate": ["$\\frac$"], "accuracy": [0.9],
+         "control": [0.5], "selectivity": [0.4], "untrained_selectivity": [0.0]}
+    )  # fmt: skip
+    assert figure_bytes(probes_figure(table), "png", 30)[:4] == b"\x89PNG"

@@ -31,7 +31,7 @@ from neurosym.viz.grid import (
 from neurosym.viz.output import save_gif
 from neurosym.viz.panels import widen_for_text
 from neurosym.viz.sources import EnvLike, Source, load_trace
-from neurosym.viz.style import head_colour, legend_text
+from neurosym.viz.style import data_as_text, head_colour, legend_text
 from neurosym.viz.trace import EpisodeTrace
 
 STRIP_PANEL_INCHES = 2.0
@@ -172,6 +172,7 @@ def episode_figure(
     return episode_trace_figure(trace, head=head, steps=steps, frames=frames)
 
 
+@data_as_text
 def episode_trace_figure(
     trace: EpisodeTrace,
     *,
@@ -217,6 +218,7 @@ def episode_trace_figure(
 # animation
 
 
+@data_as_text
 def episode_frames(
     trace: EpisodeTrace,
     *,

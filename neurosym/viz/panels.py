@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.text import Text
 
 from neurosym.viz.grid import draw_heat, label_size, outline_cell
-from neurosym.viz.style import legend_text
+from neurosym.viz.style import data_as_text, legend_text
 
 PANEL_INCHES = 2.4
 """width and height of one grid panel"""
@@ -69,6 +69,7 @@ def figure_size(rows: int, cols: int) -> tuple[float, float]:
     return cols * PANEL_INCHES + MARGIN_INCHES, rows * PANEL_INCHES + MARGIN_INCHES
 
 
+@data_as_text
 def heat_map_figure(
     panels: Sequence[Sequence[Panel]],
     names: np.ndarray,
