@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from neurosym import __version__
+from neurosym.display import plain
 from neurosym.errors import ConfigError, NeurosymError
 
 
@@ -253,8 +254,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if isinstance(exc.__context__, BrokenPipeError):  # a rich console's own way out
             return _reader_gone()
         raise
-    except NeurosymError as exc:
-        print(f"neurosym {args.command}: error: {exc}", file=sys.stderr)
+    except NeurosymError as exc:  # one line, control characters shown (a path may hold any)
+        print(f"neurosym {args.command}: error: {plain(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"neurosym {args.command}: interrupted", file=sys.stderr)

@@ -145,3 +145,9 @@ def test_the_training_bar_never_cuts_a_figure(tmp_path: Path) -> None:
     plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)
     assert "rgw1 predinet" in plain and re.search(r"\d+ frames  ", plain), plain
     assert "…" not in plain, plain
+
+
+def test_an_error_is_one_line_whatever_the_path_holds(run_neurosym) -> None:  # noqa: ANN001
+    proc = run_neurosym("eval", "--checkpoint", "/nowhere/x\x1b[31mred\nline2.pt")
+    assert proc.returncode == 1
+    assert proc.stderr == "neurosym eval: error: checkpoint not found: /nowhere/x\\e[31mred\\nline2.pt\n"
