@@ -58,7 +58,9 @@ def test_bad_values_are_refused_naming_option_value_and_type(
 
 def test_make_refuses_a_value_of_the_wrong_type() -> None:
     """``classic="false"`` is a true value: refused, not played as classic rules."""
-    with pytest.raises(ConfigError, match=r"option classic='false' for rgw2: classic takes true or false"):
+    with pytest.raises(
+        ConfigError, match=r"option classic='false' for rgw2: classic takes true or false"
+    ):
         make("rgw2", classic="false")
     with pytest.raises(ConfigError, match=r"num_mountains takes an integer"):
         make("rgw-random", num_mountains="12")
@@ -68,7 +70,9 @@ def test_make_refuses_a_value_of_the_wrong_type() -> None:
 def test_make_refuses_an_unknown_render_mode_without_gymnasium_warning() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # gymnasium's render-mode warning would fail here
-        with pytest.raises(ConfigError, match=r"render_mode 'human' is not one of rgw2's: rgb_array, ansi"):
+        with pytest.raises(
+            ConfigError, match=r"render_mode 'human' is not one of rgw2's: rgb_array, ansi"
+        ):
             make("rgw2", render_mode="human")
         with pytest.raises(ConfigError, match=r"render_mode 'human' is not one of bw1's"):
             make("bw1", render_mode="human")

@@ -120,7 +120,6 @@ def test_no_progress_when_stderr_is_not_a_terminal(run_neurosym, tmp_path: Path)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
 
 
-
 def test_fields_are_shown_whole_or_left_out() -> None:
     import io
 
@@ -150,4 +149,7 @@ def test_the_training_bar_never_cuts_a_figure(tmp_path: Path) -> None:
 def test_an_error_is_one_line_whatever_the_path_holds(run_neurosym) -> None:  # noqa: ANN001
     proc = run_neurosym("eval", "--checkpoint", "/nowhere/x\x1b[31mred\nline2.pt")
     assert proc.returncode == 1
-    assert proc.stderr == "neurosym eval: error: checkpoint not found: /nowhere/x\\e[31mred\\nline2.pt\n"
+    assert (
+        proc.stderr
+        == "neurosym eval: error: checkpoint not found: /nowhere/x\\e[31mred\\nline2.pt\n"
+    )

@@ -192,9 +192,18 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
             ["episode", "--recording", "{recording}", "--steps", "7:3"],
             "--steps '7:3': expected 0 <= START <= STOP",
         ),
-        (["predinet", "--checkpoint", "{predinet}", "--dpi", "nan"], "--dpi must be a number from 1 to 1200, got nan"),
-        (["predinet", "--checkpoint", "{predinet}", "--dpi", "1e6"], "--dpi must be a number from 1 to 1200"),
-        (["predinet", "--checkpoint", "{predinet}", "--step", "-1"], "--step must be 0 or more, got -1"),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--dpi", "nan"],
+            "--dpi must be a number from 1 to 1200, got nan",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--dpi", "1e6"],
+            "--dpi must be a number from 1 to 1200",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--step", "-1"],
+            "--step must be 0 or more, got -1",
+        ),
         (["mhdpa", "--checkpoint", "{nowhere}"], "checkpoint not found"),
         (["predinet", "--recording", "{tmp}"], "is not a neurosym recording"),
         (["predinet", "--checkpoint", "{predinet}", "--out-as", "gif"], None),

@@ -97,9 +97,7 @@ def _option_type(annotation: Any, default: Any) -> OptionType:
         annotation = type(default)
     origin = typing.get_origin(annotation)
     args = (
-        typing.get_args(annotation)
-        if origin in (typing.Union, types.UnionType)
-        else (annotation,)
+        typing.get_args(annotation) if origin in (typing.Union, types.UnionType) else (annotation,)
     )
     optional = type(None) in args
     rest = [a for a in args if a is not type(None)]

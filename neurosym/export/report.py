@@ -108,7 +108,6 @@ def _print_heads(rec: Any, say: Any, table_type: Any) -> None:
         show_edge=False,
     )
     for col in ("head", "states", "two objects", "next object", "top pairs (share of states)"):
-        top = col.startswith("top")
         table.add_column(col, justify="left" if col.startswith("top") else "right")
     rows = []
     for row in heads.to_dict("records"):
@@ -135,7 +134,6 @@ def _print_heads(rec: Any, say: Any, table_type: Any) -> None:
         show_edge=False,
     )
     for col in ("head", "on or beside two objects", "top pair (share of states)"):
-        top = col.startswith("top")
         beside.add_column(col, justify="left" if col.startswith("top") else "right")
     rows = [
         (
@@ -205,9 +203,7 @@ def print_report(rec: Any, facts: Any, written: dict[str, Path], kb: Path | None
             f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
         )
         r = ep["return"]
-        say(
-            f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {show(outcomes)}"
-        )
+        say(f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {show(outcomes)}")
 
     counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
     say(f"facts: {show(counts)}  ({facts.n_facts} in all)")

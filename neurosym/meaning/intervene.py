@@ -475,13 +475,13 @@ def intervene(
     from neurosym.envs import canonical_name, env_family
     from neurosym.envs.rgw_maps import load_map
     from neurosym.export.recorder import _resolve_env, record
-    from neurosym.progress import Stages
     from neurosym.meaning.features import (
         ablate_heads,
         head_means,
         head_vectors,
         replay_observations,
     )
+    from neurosym.progress import Stages
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
@@ -580,7 +580,9 @@ def intervene(
                             base_obs, _shifted(base_rec, 0), exp.edit, name, env_kwargs
                         )
                     else:
-                        obs = matched_observations(base_obs, base_text, exp.map_text, name, env_kwargs)
+                        obs = matched_observations(
+                            base_obs, base_text, exp.map_text, name, env_kwargs
+                        )
                     vec, p = head_vectors(agent.model, obs)
             finally:
                 torch.set_num_threads(saved)

@@ -35,6 +35,7 @@ def data_as_text(draw: Callable[_P, _R]) -> Callable[_P, _R]:
 
     return run
 
+
 HEAD_COLOURS = (
     "#e6194b",
     "#3cb44b",
