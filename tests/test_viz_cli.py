@@ -177,6 +177,14 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
             "--episode-seed goes with --checkpoint",
         ),
         (
+            ["rvectors", "--recording", "{recording}", "--max-steps", "3"],
+            "--max-steps goes with --checkpoint",
+        ),
+        (
+            ["relations", "--recording", "{recording}", "--episodes", "5"],
+            "--episodes goes with --checkpoint",
+        ),
+        (
             ["predinet", "--checkpoint", "{predinet}", "--episode", "1"],
             "--episode goes with --recording",
         ),

@@ -75,7 +75,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
             cmd.add_argument(
                 "--episodes",
                 type=int,
-                default=1,
+                default=None,
                 help="with --checkpoint: episodes to play, seeds S, S+1, ... (default: 1)",
             )
         if name == "episode":
@@ -183,7 +183,13 @@ def _load_source(args: argparse.Namespace) -> Any:
     from neurosym.errors import ConfigError
 
     if args.recording is not None:
-        for flag, value in (("--env", args.env), ("--episode-seed", args.episode_seed)):
+        played = (
+            ("--env", args.env),
+            ("--episode-seed", args.episode_seed),
+            ("--max-steps", getattr(args, "max_steps", None)),
+            ("--episodes", getattr(args, "episodes", None)),
+        )
+        for flag, value in played:
             if value is not None:
                 raise ConfigError(f"{flag} goes with --checkpoint; a recording already fixes it")
         from neurosym.export.recording import Recording
@@ -222,7 +228,11 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
         )
     elif args.plot == "relations":
         fig = relations.relations_figure(
-            source, args.env, threshold=args.threshold, episodes=args.episodes, seed=where["seed"]
+            source,
+            args.env,
+            threshold=args.threshold,
+            episodes=1 if args.episodes is None else args.episodes,
+            seed=where["seed"],
         )
     elif fmt == "gif":
         path = episode.save_episode_gif(
