@@ -86,6 +86,11 @@ def run(args: argparse.Namespace) -> int:
     env = canonical_name(args.env) if args.env else None
     agent = load_agent(args.checkpoint, env=env)
     env, env_kwargs = play_env(agent, env, args.env_option)
+    if env_kwargs.get("edit") is not None:
+        raise ConfigError(
+            f"--env-option edit={env_kwargs['edit']}: intervene makes the level edits itself "
+            "(remove(sword), remove(enemy), swap(sword, enemy)); play an edited level with eval"
+        )
     report = intervene(
         agent,
         env,
