@@ -112,8 +112,10 @@ def test_intervene_ablates_mhdpa_heads(run_neurosym, tmp_path: Path, swipl: Path
         (["intervene", "--episodes", "0"], "--episodes must be at least 1"),
         (["intervene", "--env-option", "bogus=1"], "unknown option 'bogus' for rgw2; expected"),
         (["probe", "--env-option", "max_steps"], "--env-option wants KEY=VALUE"),
-        (["intervene", "--env", "rgw-random", "--env-option", "edit=remove_sword"],
-         "--env-option edit=remove_sword: intervene makes the level edits itself"),  # fmt: skip
+        (
+            ["intervene", "--env", "rgw-random", "--env-option", "edit=remove_sword"],
+            "--env-option edit=remove_sword: intervene makes the level edits itself",
+        ),  # fmt: skip
         (["probe", "--env-option", "classic=maybe"], "classic takes true or false"),
     ],
 )

@@ -153,7 +153,7 @@ RENDER_ONLY_OPTIONS = ("render_mode", "tile_size")
 def option_types(name_or_id: str) -> dict[str, OptionType]:
     """name -> :class:`~neurosym.envs.options.OptionType` of every option the env takes."""
     e = entry(name_or_id)
-    return _option_types(e.entry_point, e.level_options)
+    return dict(_option_types(e.entry_point, e.level_options))
 
 
 @functools.cache
