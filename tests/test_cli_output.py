@@ -42,8 +42,9 @@ def _into_closed_pipe(*args: object) -> subprocess.CompletedProcess[str]:
         ("envs",),  # a rich table
         ("envs", "--json"),  # print()
         ("eval", "--checkpoint", CHECKPOINTS / "rgw1-predinet.pt", "--episodes", "1"),
+        ("query", "--kb", REPO / "rules" / "tests" / "rgw_facts.pl", "--format", "csv", "true"),
     ],
-    ids=["table", "json", "eval"],
+    ids=["table", "json", "eval", "query"],
 )
 def test_a_closed_pipe_ends_the_command_quietly(args: tuple[object, ...]) -> None:
     proc = _into_closed_pipe(*args)
