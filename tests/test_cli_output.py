@@ -106,7 +106,7 @@ def test_probe_and_intervene_show_progress_on_a_terminal(tmp_path: Path) -> None
         "--no-levels", "--out", tmp_path / "i",
     )  # fmt: skip
     assert code == 0, text
-    assert "experiment" in text and "effects at the baseline's states" in text
+    assert "effects at the baseline's states" in text  # the last stage, drawn when it stops
     code, text = _on_a_terminal(
         "probe", "--checkpoint", CHECKPOINTS / "rgw1-predinet.pt", "--episodes", 2,
         "--no-untrained", "--out", tmp_path / "p",
