@@ -9,19 +9,22 @@ as a module with two functions:
 Only the module of the command being run is imported, so ``neurosym query``
 never pays for importing torch. A :class:`~neurosym.errors.NeurosymError`
 (bad input) is printed as one line and exits with status 1; argparse usage
-errors exit with status 2.
+errors exit with status 2; Ctrl-C exits with 130; a closed stdout (the reader
+of a pipe gone, ``neurosym envs | head -1``) ends the command quietly with 141.
 """
 
 from __future__ import annotations
 
 import argparse
-import ast
+import dataclasses
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 from typing import Any
 
 from neurosym import __version__
+from neurosym.display import plain
 from neurosym.errors import ConfigError, NeurosymError
 
 
@@ -68,34 +71,68 @@ def add_env_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def parse_env_options(items: list[str]) -> dict[str, Any]:
-    """KEY=VALUE strings -> kwargs; values are Python literals when they parse as one, else strings."""
+def parse_env_options(items: list[str], env: str | None = None) -> dict[str, Any]:
+    """KEY=VALUE strings -> env kwargs, each value typed by its option; ConfigError (one line) else.
+
+    The types are the env class's (:func:`neurosym.envs.registration.option_types`):
+    ``classic=false`` is False, ``max_steps=50`` 50, ``max_steps=none`` None.
+    ``env``: the env they are for (an unknown option is refused here, naming
+    the env's); None: typed by name over every env (the env refuses unknowns).
+    Options that only change what ``env.render()`` draws are refused: no command shows it.
+    """
+    from neurosym.envs.options import parse_value
+    from neurosym.envs.registration import ENTRIES, RENDER_ONLY_OPTIONS, entry, option_types
+
+    if env is not None:
+        types = option_types(env)
+    else:
+        types = {}
+        for e in ENTRIES:
+            for key, option in option_types(e.short).items():
+                seen = types.get(key)
+                if seen is not None and seen.kind != option.kind:
+                    option = dataclasses.replace(option, kind="any")  # typed again by the env
+                if seen is not None and seen.optional:
+                    option = dataclasses.replace(option, optional=True)
+                types[key] = option
     out: dict[str, Any] = {}
     for item in items:
         key, sep, text = item.partition("=")
         if not sep or not key.isidentifier():
             raise ConfigError(f"--env-option wants KEY=VALUE with KEY a name, got {item!r}")
+        if key in out:
+            raise ConfigError(f"--env-option {key} is given twice: give each option once")
+        if key in RENDER_ONLY_OPTIONS:
+            raise ConfigError(
+                f"--env-option {key}: not an option here (it only changes what the env draws "
+                "for env.render(), which no command shows)"
+            )
+        option = types.get(key)
+        if option is None:
+            if env is None:  # the env refuses it, naming its own options
+                out[key] = text
+                continue
+            known = ", ".join(k for k in types if k not in RENDER_ONLY_OPTIONS)
+            raise ConfigError(
+                f"--env-option: unknown option {key!r} for {entry(env).short}; "
+                f"expected one of {known}"
+            )
         try:
-            out[key] = ast.literal_eval(text)
-        except (ValueError, SyntaxError):
-            out[key] = text
+            out[key] = parse_value(option, text)
+        except ValueError as exc:
+            raise ConfigError(f"--env-option {key}={text!r}: {key} takes {exc}") from None
     return out
 
 
-def with_env_options(agent: Any, items: list[str]) -> Any:
-    """The agent with ``--env-option`` items on top of its env options (checked by making the env).
-
-    For the commands that play an agent on its own env only (intervene, probe).
+def play_env(agent: Any, env: str | None, items: list[str]) -> tuple[str, dict[str, Any]]:
+    """(env name, options) for intervene and probe: ``--env`` (default: the agent's own)
+    with the ``--env-option`` items on top, typed and checked (family, observation shape).
     """
-    import dataclasses
-
-    extra = parse_env_options(items)
-    if not extra:
-        return agent
     from neurosym.agent.checkpoint import env_for
+    from neurosym.envs import canonical_name
 
-    _, kwargs = env_for(agent, None, extra)
-    return dataclasses.replace(agent, env_kwargs=kwargs)
+    name = canonical_name(env if env is not None else agent.env_name)
+    return env_for(agent, name, parse_env_options(items, name))
 
 
 def play_options(
@@ -103,7 +140,7 @@ def play_options(
 ) -> tuple[str | None, dict[str, Any] | None]:
     """(env name or None, the user's env options or None) from ``--env``, ``--map``, ``--env-option``."""
     env, overrides = map_option(args.env, args.map, trained)
-    extra = parse_env_options(args.env_option)
+    extra = parse_env_options(args.env_option, env or trained)
     if not extra:
         return env, overrides
     if "map" in extra and overrides:
@@ -203,18 +240,42 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
     return parser
 
 
+BROKEN_PIPE_EXIT = 141
+"""exit status when the reader of stdout goes away (``neurosym ... | head``): 128 + SIGPIPE,
+what a shell reports for a command that a closed pipe ends"""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:
-        return int(args._run(args) or 0)
-    except NeurosymError as exc:
-        print(f"neurosym {args.command}: error: {exc}", file=sys.stderr)
+        code = int(args._run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return code
+    except BrokenPipeError:
+        return _reader_gone()
+    except SystemExit as exc:
+        if isinstance(exc.__context__, BrokenPipeError):  # a rich console's own way out
+            return _reader_gone()
+        raise
+    except NeurosymError as exc:  # one line, control characters shown (a path may hold any)
+        print(f"neurosym {args.command}: error: {plain(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"neurosym {args.command}: interrupted", file=sys.stderr)
         return 130
+
+
+def _reader_gone() -> int:
+    """Stop quietly: point stdout at devnull so that Python's flush at exit finds no pipe
+    to complain about (the recipe of the ``signal`` module's documentation)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout without a file descriptor (tests)
+        pass
+    return BROKEN_PIPE_EXIT
 
 
 if __name__ == "__main__":

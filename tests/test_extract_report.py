@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import re
 from pathlib import Path
 
@@ -45,3 +46,40 @@ def test_report_without_a_prolog_kb(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "rule answers: none (they need the Prolog KB: --format pl)" in text
     assert not (tmp_path / "out" / "kb.pl").exists()
     assert (tmp_path / "out" / "facts" / "holds.parquet").is_file()
+
+
+def test_report_shows_data_as_text(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Markup, hyperlinks and escape codes from a recording print as the characters they are."""
+    rec = scripted_recording()
+    link = "[link=https://evil.example]click[/link]"
+    rec.meta["checkpoint"] = link + "\x1b[31m"
+    rec.meta["seed"] = "[bold]7[/bold]"
+    monkeypatch.setenv("COLUMNS", "200")
+    text = report(rec, tmp_path, capsys)
+    assert "\x1b" not in text
+    assert f"of {link}\\e[31m (" in text and "seed [bold]7[/bold])" in text
+
+
+def test_report_columns_of_values_never_wrap(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """In a narrow terminal a value such as "29 %" stays whole; text columns and headers wrap."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from neurosym.export.report import add_rows
+
+    table = Table(show_edge=False)
+    for col in ("head", "two objects", "top pairs (share of states)"):
+        table.add_column(col)
+    add_rows(table, [("0", "100 %", "agent-pit, sword-enemy")], whole=(0, 1))
+    console = Console(width=18, file=io.StringIO(), color_system=None)
+    console.print(table)
+    text = console.file.getvalue()
+    assert "│ 100 % │" in text, text  # rich alone gives "100" over "%" at this width
+    monkeypatch.setenv("COLUMNS", "45")
+    text += report(scripted_recording(), tmp_path, capsys)
+    cells = [c.strip() for line in text.splitlines() for c in re.split(r"[│┃]", line)]
+    assert "%" not in cells, text  # a "%" alone: a percentage split over two lines

@@ -112,6 +112,11 @@ def test_intervene_ablates_mhdpa_heads(run_neurosym, tmp_path: Path, swipl: Path
         (["intervene", "--episodes", "0"], "--episodes must be at least 1"),
         (["intervene", "--env-option", "bogus=1"], "unknown option 'bogus' for rgw2; expected"),
         (["probe", "--env-option", "max_steps"], "--env-option wants KEY=VALUE"),
+        (
+            ["intervene", "--env", "rgw-random", "--env-option", "edit=remove_sword"],
+            "--env-option edit=remove_sword: intervene makes the level edits itself",
+        ),  # fmt: skip
+        (["probe", "--env-option", "classic=maybe"], "classic takes true or false"),
     ],
 )
 def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], message: str) -> None:
@@ -125,19 +130,60 @@ def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], me
 
 
 def test_env_options_reach_the_played_env() -> None:
-    """intervene and probe play the agent on its own env with --env-option on top, checked."""
+    """intervene and probe play --env (default: the agent's own) with --env-option on top, checked."""
     from neurosym.agent.checkpoint import load_agent
-    from neurosym.cli import with_env_options
+    from neurosym.cli import play_env
     from neurosym.errors import ConfigError
     from neurosym.export.recorder import record
 
     agent = load_agent(REPO / "checkpoints" / "rgw2-predinet.pt")
-    assert with_env_options(agent, []) is agent
-    capped = with_env_options(agent, ["max_steps=3"])
-    assert capped.env_kwargs == {**agent.env_kwargs, "max_steps": 3}
+    assert play_env(agent, None, []) == ("rgw2", agent.env_kwargs)
+    name, capped = play_env(agent, None, ["max_steps=3"])
+    assert capped == {**agent.env_kwargs, "max_steps": 3}
     assert agent.env_kwargs.get("max_steps") != 3  # the loaded agent is left as it was
-    rec = record(capped, episodes=2, seed=0, greedy=True)
+    rec = record(agent, name, episodes=2, seed=0, greedy=True, env_kwargs=capped)
     assert rec.meta["env_kwargs"]["max_steps"] == 3
     assert int(rec.episodes["steps"].max()) <= 3  # its episodes end at 3 steps
     with pytest.raises(ConfigError, match="num_mountains"):
-        with_env_options(agent, ["num_mountains=12"])  # rgw2 takes no level parameters
+        play_env(agent, None, ["num_mountains=12"])  # rgw2 takes no level parameters
+    cellkeys = load_agent(REPO / "checkpoints" / "rgw-random-predinet-cellkeys.pt")
+    # another env of the family: its options, not the agent's own (num_mountains=12) nor lost
+    assert play_env(cellkeys, "rgw2", ["max_steps=3"]) == ("rgw2", {"max_steps": 3})
+    with pytest.raises(ConfigError, match="unknown option 'num_mountains' for rgw2"):
+        play_env(cellkeys, "rgw2", ["num_mountains=12"])
+
+
+@pytest.mark.parametrize(
+    ("checkpoint", "env"),
+    [("rgw-random-predinet-cellkeys.pt", "rgw2"), ("rgw2-predinet.pt", "rgw1")],
+)
+def test_intervene_changes_the_level_of_the_env_asked_for(checkpoint: str, env: str) -> None:
+    """On another env than the agent's, every level change is played (the sword removed is
+    never picked up), not the unchanged level under the change's name."""
+    from neurosym.agent.checkpoint import load_agent
+    from neurosym.meaning.intervene import intervene
+
+    agent = load_agent(REPO / "checkpoints" / checkpoint)
+    report = intervene(agent, env, episodes=3, ablations=False)
+    m = report.measures.pivot(index="experiment", columns="measure", values="value")
+    assert report.meta["env"] == env
+    assert m.loc["baseline", "sword_picked"] == 1.0
+    assert m.loc["remove_sword", "sword_picked"] == 0.0
+    assert m.loc["remove_enemy", "enemy_met"] == 0.0
+    for rec in report.recordings.values():
+        assert rec.meta["env"] == env
+
+
+def test_probe_plays_env_options_on_another_env(run_neurosym, tmp_path: Path) -> None:
+    """probe --env rgw2 --env-option max_steps=3 of an rgw-random agent: 3-step episodes on
+    rgw2; paths print as text."""
+    out = tmp_path / "p\x1b[31m"
+    proc = run_neurosym(
+        "probe", "--checkpoint", REPO / "checkpoints" / "rgw-random-predinet-cellkeys.pt",
+        "--env", "rgw2", "--env-option", "max_steps=3", "--episodes", 4, "--no-untrained",
+        "--out", out,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    first = proc.stdout.splitlines()[0]
+    assert first.startswith("rgw2 predinet: 4 episodes") and "12 states" in first, first
+    assert "\x1b" not in proc.stdout and "p\\e[31m" in proc.stdout

@@ -8,6 +8,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.figure import Figure
 from PIL import Image
 
 from neurosym.errors import ConfigError
@@ -229,8 +230,39 @@ def test_mhdpa_figure_size_is_fixed_by_the_heads(mh: Recording) -> None:
     )  # (2 heads * 2.4 + 1.0) inches at 50 dpi
     assert "sword (0,6)" in fig.get_suptitle() and "rgw2-mhdpa.pt" in fig.get_suptitle()
     one = mhdpa_figure(mh, step=1, cell=(3, 9), head=1)
-    assert png_size(figure_bytes(one, "png", 50)) == (170, 290)
+    width, height = png_size(figure_bytes(one, "png", 50))
+    assert height == 290 and width >= 170  # one head: as wide as its title needs
+    assert_texts_inside(one)
     assert "teleport (3,9)" in one.get_suptitle()
+
+
+def assert_texts_inside(fig: Figure) -> None:
+    """The title and the note under the panels are inside the figure, not cut at its sides."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    width = fig.get_figwidth() * fig.dpi
+    for text in (fig._suptitle, fig._supxlabel):
+        if text is None:
+            continue
+        box = text.get_window_extent(renderer)
+        assert box.x0 >= 0 and box.x1 <= width, (text.get_text(), box, width)
+
+
+def test_one_head_figures_are_wide_enough_for_their_text(pn: Recording, mh: Recording) -> None:
+    assert_texts_inside(predinet_figure(pn, step=0, head=0))
+    assert_texts_inside(mhdpa_figure(mh, step=1, object="sword", head=0))
+    assert_texts_inside(ep_mod.episode_figure(pn, head=0, frames=1))
+
+
+def test_recorded_attention_is_on_the_weights_scale(pn: Recording) -> None:
+    """A recording keeps only the strongest cells: the colour scale is 0..1, not min..max of them."""
+    fig = predinet_figure(pn, step=0)
+    bars = [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    assert len(bars) == 2
+    for bar in bars:
+        assert bar.get_ylim() == (0.0, 1.0)
 
 
 def test_predinet_figure_names_the_attended_objects(pn: Recording) -> None:
@@ -364,3 +396,26 @@ def test_bad_requests_are_one_line_errors(pn: Recording, mh: Recording, call, me
         call(pn, mh)
     assert "\n" not in str(info.value)
     assert re.search(message, str(info.value))
+
+
+def test_names_from_files_are_drawn_as_written(pn: Recording) -> None:
+    """``$...$`` in a checkpoint's name is text, not mathtext (``$\\frac$`` was a parse error)."""
+    import dataclasses
+
+    from neurosym.viz.probes import probes_figure
+
+    hostile = dataclasses.replace(pn, meta={**pn.meta, "checkpoint": "runs/$\\frac$.pt"})
+    for fig in (
+        predinet_figure(hostile, step=0),
+        r_vectors_figure(hostile),
+        ep_mod.episode_figure(hostile, frames=2),
+        relations_figure(hostile),
+    ):
+        assert "$\\frac$.pt" in fig.get_suptitle()
+        assert figure_bytes(fig, "png", 30)[:4] == b"\x89PNG"
+    assert ep_mod.episode_frames(ep_mod.load_trace(hostile, episode=0), steps=(0, 1))
+    table = pd.DataFrame(
+        {"head": [0], "relation": ["all"], "predicate": ["$\\frac$"], "accuracy": [0.9],
+         "control": [0.5], "selectivity": [0.4], "untrained_selectivity": [0.0]}
+    )  # fmt: skip
+    assert figure_bytes(probes_figure(table), "png", 30)[:4] == b"\x89PNG"

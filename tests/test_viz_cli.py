@@ -136,7 +136,9 @@ def test_svg_is_reproducible_with_the_figure_size_in_points(files: dict[str, Pat
         )
     text = outs[0].read_text()
     assert outs[0].read_bytes() == outs[1].read_bytes()
-    assert 'width="244.8pt" height="417.6pt"' in text  # (2.4 + 1.0) x (2 * 2.4 + 1.0) inches
+    # (2.4 + 1.0) x (2 * 2.4 + 1.0) inches, or wider for the title and the D line of one head
+    size = re.search(r'<svg [^>]*width="([0-9.]+)pt" height="([0-9.]+)pt"', text)
+    assert size is not None and float(size[1]) >= 244.8 and size[2] == "417.6"
 
 
 def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> None:
@@ -175,6 +177,14 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
             "--episode-seed goes with --checkpoint",
         ),
         (
+            ["rvectors", "--recording", "{recording}", "--max-steps", "3"],
+            "--max-steps goes with --checkpoint",
+        ),
+        (
+            ["relations", "--recording", "{recording}", "--episodes", "5"],
+            "--episodes goes with --checkpoint",
+        ),
+        (
             ["predinet", "--checkpoint", "{predinet}", "--episode", "1"],
             "--episode goes with --recording",
         ),
@@ -189,6 +199,18 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
         (
             ["episode", "--recording", "{recording}", "--steps", "7:3"],
             "--steps '7:3': expected 0 <= START <= STOP",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--dpi", "nan"],
+            "--dpi must be a number from 1 to 1200, got nan",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--dpi", "1e6"],
+            "--dpi must be a number from 1 to 1200",
+        ),
+        (
+            ["predinet", "--checkpoint", "{predinet}", "--step", "-1"],
+            "--step must be 0 or more, got -1",
         ),
         (["mhdpa", "--checkpoint", "{nowhere}"], "checkpoint not found"),
         (["predinet", "--recording", "{tmp}"], "is not a neurosym recording"),
@@ -261,3 +283,14 @@ def test_the_default_threshold_is_extracts() -> None:
     configure(parser)
     args = parser.parse_args(["relations", "--recording", "r", "--out", "x.png"])
     assert args.threshold == DEFAULT_THRESHOLD
+
+
+@pytest.mark.parametrize("fps", [float("nan"), float("inf"), 0.0])
+def test_a_gif_needs_a_finite_positive_frame_rate(fps: float) -> None:
+    import numpy as np
+
+    from neurosym.errors import ConfigError
+    from neurosym.viz.output import gif_bytes
+
+    with pytest.raises(ConfigError, match="--fps must be a positive number"):
+        gif_bytes([np.zeros((4, 4, 3), dtype=np.uint8)], fps)

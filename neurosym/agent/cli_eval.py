@@ -130,9 +130,13 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(report))
         return 0
-    outcomes = ", ".join(f"{k} {v}" for k, v in report["outcomes"].items())
+    from neurosym.display import plain
+
+    outcomes = plain(", ".join(f"{k} {v}" for k, v in report["outcomes"].items()))
+    frames = report["trained_frames"]
     print(
-        f"checkpoint   {report['checkpoint']} ({report['env']}, {report['module']}, {report['trained_frames']:,} frames)"
+        f"checkpoint   {plain(report['checkpoint'])} ({plain(report['env'])}, "
+        f"{plain(report['module'])}, {f'{frames:,}' if isinstance(frames, int) else plain(frames)} frames)"
     )
     print(
         f"episodes     {report['episodes']} ({'greedy' if report['greedy'] else 'sampled'}, seed {report['seed']})"

@@ -684,6 +684,9 @@ def train(
 
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.table import Column
+
+    from neurosym.progress import FieldsColumn
 
     total = (
         options.frames - frames0
@@ -691,9 +694,9 @@ def train(
         else (options.minutes * 60 if options.minutes else None)
     )
     progress = Progress(
-        TextColumn("[bold]{task.description}"),
+        TextColumn("[bold]{task.description}", table_column=Column(no_wrap=True)),
         BarColumn(),
-        TextColumn("{task.fields[stats]}"),
+        FieldsColumn("stats"),  # whole figures only, those that fit
         TimeElapsedColumn(),
         console=Console(stderr=True),
         disable=not options.progress,

@@ -33,11 +33,14 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.table import Table
 
+    from neurosym.display import show
+
     table = Table(title="neurosym environments", title_justify="left")
-    for column in ("name", "id", "family", "description"):
-        table.add_column(column, overflow="fold")
+    for column in ("name", "id", "family"):  # names never wrap; the description does, at spaces
+        table.add_column(column, no_wrap=True)
+    table.add_column("description")
     for e in ENTRIES:
-        table.add_row(e.short, e.id, e.family, e.description)
+        table.add_row(show(e.short), show(e.id), show(e.family), show(e.description))
     console = Console()
     if not console.is_terminal:  # piped: never wrap, whatever width rich guesses
         rows = [(e.short, e.id, e.family, e.description) for e in ENTRIES]

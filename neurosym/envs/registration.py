@@ -9,9 +9,12 @@ also carries a ``vector_entry_point``: the batched class that
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
+from neurosym.envs.options import OptionType, check_value, load
+from neurosym.envs.options import option_types as option_types_of
 from neurosym.errors import ConfigError
 
 
@@ -26,6 +29,8 @@ class EnvEntry:
     vector_entry_point: str
     description: str
     kwargs: dict[str, Any] = field(default_factory=dict)
+    level_options: str = ""
+    """``"module:Dataclass"`` whose fields the class takes through ``**kwargs`` (typed options)"""
 
 
 _RGW = "neurosym.envs.rgw:RGWEnv"
@@ -60,6 +65,7 @@ ENTRIES: tuple[EnvEntry, ...] = (
         "neurosym.envs.rgw_vector:RGWRandomVectorEnv",
         "RGW on procedural levels, a new one every episode: blocking enemy; guarded, decoy, "
         "teleport-only and hazard levels, each with its optimal return",
+        level_options="neurosym.envs.rgw_random:RandomLevelConfig",
     ),
     EnvEntry(
         "bw1",
@@ -140,25 +146,53 @@ def env_family(name_or_id: str) -> str:
     return entry(name_or_id).family
 
 
-def check_options(name_or_id: str, kwargs: dict[str, Any]) -> None:
-    """Refuse, in one line naming the ones it takes, an option the env's class does not take.
+RENDER_ONLY_OPTIONS = ("render_mode", "tile_size")
+"""options that change only what ``env.render()`` draws: no command shows it"""
 
-    gymnasium would raise a TypeError deep in its factory instead; options the
-    class gathers in ``**kwargs`` (rgw-random's level parameters) it checks itself.
+
+def option_types(name_or_id: str) -> dict[str, OptionType]:
+    """name -> :class:`~neurosym.envs.options.OptionType` of every option the env takes."""
+    e = entry(name_or_id)
+    return dict(_option_types(e.entry_point, e.level_options))
+
+
+@functools.cache
+def _option_types(entry_point: str, level_options: str) -> dict[str, OptionType]:
+    return option_types_of(entry_point, level_options)
+
+
+def check_options(name_or_id: str, kwargs: dict[str, Any]) -> None:
+    """Refuse, in one line, an option the env's class does not take or a value of the wrong type.
+
+    gymnasium would raise a TypeError deep in its factory instead (or, for a
+    render mode the env lacks, warn first); options the class gathers in
+    ``**kwargs`` it checks itself (rgw-random names its level parameters). Values
+    are checked against the option's annotation: ``classic="false"`` is refused,
+    not played as a true value.
     """
-    import importlib
     import inspect
 
     e = entry(name_or_id)
-    module, _, cls = e.entry_point.partition(":")
-    params = inspect.signature(getattr(importlib.import_module(module), cls).__init__).parameters
-    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
-        return
-    known = [n for n, p in params.items() if n != "self" and p.kind is not p.VAR_POSITIONAL]
-    unknown = sorted(set(kwargs) - set(known))
-    if unknown:
+    cls = load(e.entry_point)
+    params = inspect.signature(cls.__init__).parameters
+    types = option_types(name_or_id)
+    if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+        unknown = sorted(set(kwargs) - set(types))
+        if unknown:
+            raise ConfigError(
+                f"unknown option {unknown[0]!r} for {e.short}; expected one of {', '.join(types)}"
+            )
+    for key, value in kwargs.items():
+        option = types.get(key)
+        if option is not None and not check_value(option, value):
+            raise ConfigError(
+                f"option {key}={value!r} for {e.short}: {key} takes {option.expected()}"
+            )
+    modes = (getattr(cls, "metadata", None) or {}).get("render_modes")
+    mode = kwargs.get("render_mode")
+    if mode is not None and modes is not None and mode not in modes:
         raise ConfigError(
-            f"unknown option {unknown[0]!r} for {e.short}; expected one of {', '.join(known)}"
+            f"render_mode {mode!r} is not one of {e.short}'s: {', '.join(map(str, modes))} or None"
         )
 
 

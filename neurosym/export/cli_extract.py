@@ -77,9 +77,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--top-keys",
         type=int,
-        default=1,
+        default=None,
         metavar="N",
-        help="MHDPA: keep each query cell's N strongest keys as attention/6 facts (default: 1)",
+        help="MHDPA only: keep each query cell's N strongest keys as attention/6 facts (default: 1)",
     )
     parser.add_argument(
         "--verbose",
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     check_seed(args.seed, args.episodes)
     if args.batch is not None and args.batch < 1:
         raise ConfigError(f"--batch must be at least 1, got {args.batch}")
-    if args.top_keys < 1:
+    if args.top_keys is not None and args.top_keys < 1:
         raise ConfigError(f"--top-keys must be at least 1, got {args.top_keys}")
 
     from neurosym.agent.checkpoint import env_for, load_agent
@@ -121,6 +121,11 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.publish import check_out
 
     agent = load_agent(args.checkpoint)
+    if args.top_keys is not None and agent.config.module != "mhdpa":
+        raise ConfigError(
+            f"--top-keys is for MHDPA checkpoints (attention/6 facts); {args.checkpoint} is a "
+            f"{agent.config.module} (its facts are attends/8, relation/7 and holds/5)"
+        )
     env, overrides = play_options(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once: the default folder needs the checkpoint's env
@@ -134,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
         greedy=args.greedy,
         batch=args.batch,
         progress=show and _tty(),
-        top_keys=args.top_keys,
+        top_keys=args.top_keys or 1,
         env_kwargs=env_kwargs,
     )
     facts = extract_facts(rec, threshold=threshold)

@@ -12,6 +12,8 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from neurosym.display import show
+
 # (title, goal, variable): goals answered for every KB of a family. Each
 # variable's value is printed as Prolog text; a goal with no answer prints "none".
 QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
@@ -100,21 +102,38 @@ def _brief(values: list[str], of: int | None) -> str:
     return _short(values, limit=3)
 
 
-def _print_episodes(ep: Any, say: Any, escape: Any, table_type: Any) -> None:
+def add_rows(table: Any, rows: list[tuple[str, ...]], whole: tuple[int, ...]) -> None:
+    """Add ``rows`` (rich markup) to a rich table; the columns ``whole`` are never made
+    narrower than their widest cell, so that a narrow terminal wraps the text columns
+    and the headers, never a value such as ``29 %`` over two lines."""
+    from rich.text import Text
+
+    for row in rows:
+        table.add_row(*row)
+    for i in whole:
+        column = table.columns[i]
+        widest = max((Text.from_markup(row[i]).cell_len for row in rows), default=0)
+        column.min_width = max(column.min_width or 0, widest)
+
+
+def _print_episodes(ep: Any, say: Any, table_type: Any) -> None:
     """The first 20 episodes, a row each (the verbose report)."""
     table = table_type(title="episodes", show_edge=False)
     for col in ("episode", "steps", "return", "outcome"):
         table.add_column(col, justify="left" if col == "outcome" else "right")
     shown = ep.head(20)[["episode", "steps", "return", "outcome"]]
-    for e, steps, ret, outcome in shown.itertuples(index=False, name=None):
-        table.add_row(str(e), str(steps), f"{ret:.2f}", escape(str(outcome)))
+    rows = [
+        (show(e), show(steps), f"{ret:.2f}", show(outcome))
+        for e, steps, ret, outcome in shown.itertuples(index=False, name=None)
+    ]
+    add_rows(table, rows, whole=(0, 1, 2, 3))
     say(table)
     say("  (steps, return and how each episode ended)")
     if len(ep) > 20:
         say(f"... {len(ep) - 20} more episodes")
 
 
-def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any, verbose: bool = True) -> None:
+def _print_heads(rec: Any, say: Any, table_type: Any, verbose: bool = True) -> None:
     """The per-head table of :func:`neurosym.export.heads.head_summary` (PrediNet only);
     ``verbose`` adds the table that counts arguments beside objects."""
     from neurosym.export.heads import head_summary
@@ -122,111 +141,91 @@ def _print_heads(rec: Any, say: Any, escape: Any, table_type: Any, verbose: bool
     heads = head_summary(rec)
     if heads.empty:
         return
-    table = table_type(
-        title="heads: two arguments on two different objects",
-        show_edge=False,
-    )
+    table = table_type(title="heads: two arguments on two different objects", show_edge=False)
     for col in ("head", "states", "two objects", "next object", "top pairs (share of states)"):
         table.add_column(col, justify="left" if col.startswith("top") else "right")
+    rows = []
     for row in heads.to_dict("records"):
         pairs = [
             f"{row[f'pair_{k}']} {100 * row[f'share_{k}']:.0f} %"
             for k in ((1, 2, 3) if verbose else (1, 2))
             if row.get(f"pair_{k}") is not None
         ]
-        table.add_row(
-            str(row["head"]),
-            str(row["states"]),
-            f"{100 * row['two_objects']:.0f} %",
-            "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
-            escape(", ".join(pairs) or "none"),
+        rows.append(
+            (
+                show(row["head"]),
+                show(row["states"]),
+                f"{100 * row['two_objects']:.0f} %",
+                "-" if row["next_object"] is None else f"{100 * row['next_object']:.0f} %",
+                show(", ".join(pairs) or "none"),
+            )
         )
+    add_rows(table, rows, whole=(0, 1, 2, 3))
     say(table)
     say("  (share of states with the head's two arguments on two objects; top pairs)")
     if not verbose or heads["beside_objects"].isna().all():
         return
-    beside = table_type(
-        title="heads: arguments on or beside two different objects",
-        show_edge=False,
-    )
+    beside = table_type(title="heads: arguments on or beside two different objects", show_edge=False)
     for col in ("head", "on or beside two objects", "top pair (share of states)"):
         beside.add_column(col, justify="left" if col.startswith("top") else "right")
-    for row in heads.to_dict("records"):
-        share = row["beside_objects"]
-        pair = row["beside_pair"]
-        beside.add_row(
-            str(row["head"]),
-            "-" if share is None else f"{100 * share:.0f} %",
-            "none" if pair is None else escape(f"{pair} {100 * row['beside_share']:.0f} %"),
+    rows = [
+        (
+            show(row["head"]),
+            "-" if row["beside_objects"] is None else f"{100 * row['beside_objects']:.0f} %",
+            "none"
+            if row["beside_pair"] is None
+            else show(f"{row['beside_pair']} {100 * row['beside_share']:.0f} %"),
         )
+        for row in heads.to_dict("records")
+    ]
+    add_rows(beside, rows, whole=(0, 1))
     say(beside)
     say("  (the same, with an argument beside an object counted as on it)")
 
 
-def print_report(
-    rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None, verbose: bool = True
-) -> None:
-    """Print the summary of an extract run with rich (plain text when not a terminal).
-
-    Every value printed is escaped: Prolog lists such as ``[sword,enemy]`` would
-    otherwise be read as rich markup and vanish. Without ``verbose`` it is the
-    short report: the episodes in one line, the heads and the rule answers
-    (episode lists as counts); ``verbose`` adds the episodes, fact counts,
-    thresholds and relation tables and every answer.
-    """
-    from rich.console import Console
-    from rich.markup import escape
-    from rich.table import Table
-
-    from neurosym.envs import env_family
-
-    console = Console(highlight=False)
-    say = console.print
+def _print_summary(rec: Any, facts: Any, say: Any, table_type: Any, verbose: bool) -> None:
+    """The run in a line, its episodes (verbose), returns, fact counts and thresholds."""
     meta = rec.meta
     ep = rec.episodes
     mode = "greedy" if meta.get("greedy", True) else "sampled"
     say(
-        f"[bold]{escape(str(meta.get('env')))}[/]: {len(ep)} episodes ({mode}, seed {meta.get('seed')}) "
-        f"of {escape(str(meta.get('checkpoint')))} ({meta.get('module')}, {meta.get('heads')} heads, "
-        f"{meta.get('relations')} relations)"
+        f"[bold]{show(meta.get('env'))}[/]: {len(ep)} episodes ({mode}, seed {show(meta.get('seed'))}) "
+        f"of {show(meta.get('checkpoint'))} ({show(meta.get('module'))}, "
+        f"{show(meta.get('heads'))} heads, {show(meta.get('relations'))} relations)"
     )
     if verbose:
-        _print_episodes(ep, say, escape, Table)
+        _print_episodes(ep, say, table_type)
     if len(ep):
         outcomes = ", ".join(
             f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
         )
         r = ep["return"]
-        say(
-            f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {escape(outcomes)}"
-        )
-
+        say(f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {show(outcomes)}")
     if not verbose:
         say(f"facts: {facts.n_facts} (--verbose: by predicate, and the relation tables)")
-    else:
-        counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
-        say(f"facts: {counts}  ({facts.n_facts} in all)")
+        return
+    counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
+    say(f"facts: {show(counts)}  ({facts.n_facts} in all)")
     thr = facts.thresholds()
-    if verbose and len(thr):
+    if len(thr):
         say(
-            f"thresholds ({facts.threshold}): "
-            + ", ".join(f"r({j}) {v:.4g}" for j, v in thr.items())
+            f"thresholds ({show(facts.threshold)}): "
+            + show(", ".join(f"r({j}) {v:.4g}" for j, v in thr.items()))
         )
 
-    _print_heads(rec, say, escape, Table, verbose)
 
+def _print_relations(facts: Any, say: Any, table_type: Any, verbose: bool) -> None:
+    """The strongest relations between object types (verbose), or what stands in for them."""
     strongest = facts.strongest_relations(5) if verbose else []
     if len(strongest):
-        st = Table(
-            title="strongest relations between object types (holds/5)",
-            show_edge=False,
-        )
+        st = table_type(title="strongest relations between object types (holds/5)", show_edge=False)
         for col in ("relation", "from", "to", "states", "mean value"):
             st.add_column(col)
-        for r in strongest.itertuples(index=False):
-            st.add_row(
-                f"r({r.j})", escape(str(r.a)), escape(str(r.b)), str(r.held), f"{r.mean_value:.4g}"
-            )
+        rows = [
+            (show(f"r({r.j})"), show(r.a), show(r.b), show(r.held), f"{r.mean_value:.4g}")
+            for r in strongest.itertuples(index=False)
+        ]
+        add_rows(st, rows, whole=(0, 3, 4))
         say(st)
         say("  (r(j) above threshold from one object type to another: states, mean value)")
     elif not facts["attention"].empty:
@@ -234,25 +233,50 @@ def print_report(
     elif verbose and not facts["relation"].empty:
         say("strongest relations between object types: none held above threshold")
 
+
+def _print_answers(rec: Any, kb: Path | None, say: Any, table_type: Any, verbose: bool) -> None:
+    """The rule files' answers from the written KB (episode lists as counts unless verbose)."""
+    from neurosym.envs import env_family
+
     if kb is None:
         say("rule answers: none (they need the Prolog KB: --format pl)")
-    else:
-        family = env_family(str(meta.get("env")))
-        answers = rule_answers(kb, family)
-        if answers:
-            qt = Table(
-                title=f"rules/{RULE_FILES[family][0]}",
-                show_edge=False,
-            )
-            qt.add_column("question")
-            qt.add_column("answers")
-            for title, goal, values in answers:
-                of = len(ep) if goal.endswith("(E)") else None
-                text = _short(values, of=of) if verbose else _brief(values, of)
-                qt.add_row(title, escape(text))
-            say(qt)
-            say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
-        else:
-            say("rule answers: none (neurosym's rule files are missing: no rules/ folder found)")
+        return
+    family = env_family(str(rec.meta.get("env")))
+    answers = rule_answers(kb, family)
+    if not answers:
+        say("rule answers: none (neurosym's rule files are missing: no rules/ folder found)")
+        return
+    qt = table_type(title=f"rules/{RULE_FILES[family][0]}", show_edge=False)
+    qt.add_column("question")
+    qt.add_column("answers")
+    for title, goal, values in answers:
+        of = len(rec.episodes) if goal.endswith("(E)") else None
+        text = _short(values, of=of) if verbose else _brief(values, of)
+        qt.add_row(show(title), show(text))
+    say(qt)
+    say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
+
+
+def print_report(
+    rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None, verbose: bool = True
+) -> None:
+    """Print the summary of an extract run with rich (plain text when not a terminal).
+
+    Every value printed from the recording, the facts or the KB goes through
+    :func:`neurosym.display.show`: Prolog lists such as ``[sword,enemy]`` would
+    otherwise be read as rich markup and vanish, and an atom holding escape
+    codes would style the terminal. Values never wrap (:func:`add_rows`).
+    Without ``verbose`` it is the short report: the episodes in one line, the
+    heads and the rule answers (episode lists as counts); ``verbose`` adds the
+    episodes, fact counts, thresholds and relation tables and every answer.
+    """
+    from rich.console import Console
+    from rich.table import Table
+
+    say = Console(highlight=False).print
+    _print_summary(rec, facts, say, Table, verbose)
+    _print_heads(rec, say, Table, verbose)
+    _print_relations(facts, say, Table, verbose)
+    _print_answers(rec, kb, say, Table, verbose)
     for path in written.values():
-        say(f"wrote {escape(str(path))}")
+        say(f"wrote {show(path)}")

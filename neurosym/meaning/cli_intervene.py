@@ -21,9 +21,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
-from neurosym.cli import add_env_option, with_env_options
+from neurosym.cli import add_env_option, play_env
 from neurosym.errors import ConfigError
 
 
@@ -31,7 +32,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     """Add the intervene options."""
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
     parser.add_argument(
-        "--env", metavar="NAME", help="environment; must be the checkpoint's (default: it)"
+        "--env",
+        metavar="NAME",
+        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
+        "shape (default: the checkpoint's own)",
     )
     add_env_option(parser)
     parser.add_argument(
@@ -81,13 +85,21 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.meaning.intervene import intervene
 
     env = canonical_name(args.env) if args.env else None
-    agent = with_env_options(load_agent(args.checkpoint, env=env), args.env_option)
+    agent = load_agent(args.checkpoint, env=env)
+    env, env_kwargs = play_env(agent, env, args.env_option)
+    if env_kwargs.get("edit") is not None:
+        raise ConfigError(
+            f"--env-option edit={env_kwargs['edit']}: intervene makes the level edits itself "
+            "(remove(sword), remove(enemy), swap(sword, enemy)); play an edited level with eval"
+        )
     report = intervene(
         agent,
         env,
+        env_kwargs=env_kwargs,
         episodes=args.episodes,
         seed=args.seed,
         greedy=args.greedy,
+        progress=sys.stderr.isatty(),
         levels=args.levels,
         ablations=args.ablations,
     )
@@ -130,10 +142,12 @@ def cause_answer(kb_path: Path) -> str | None:
 
 def print_summary(report, written: dict[str, Path]) -> None:  # noqa: ANN001 (an InterventionReport)
     """The measures per experiment, the skipped ones, and the causal answer (RGW)."""
+    from neurosym.display import plain
+
     m = report.meta
     mode = "greedy" if m["greedy"] else "sampled"
     print(
-        f"{m['env']} {m['module']}: {len(report.experiments)} experiments x {m['episodes']} "
+        f"{plain(m['env'])} {plain(m['module'])}: {len(report.experiments)} experiments x {m['episodes']} "
         f"episodes ({mode}, seed {m['seed']})"
     )
     table = report.measures.pivot(index="experiment", columns="measure", values="value")
@@ -147,17 +161,17 @@ def print_summary(report, written: dict[str, Path]) -> None:  # noqa: ANN001 (an
         row = table.loc[exp.id]
         kl_text = f"{kl[exp.id]:9.4f}" if exp.id in kl.index else " " * 9
         print(
-            f"{exp.id:<18} {str(exp.kind):<24} "
+            f"{plain(exp.id):<18} {plain(exp.kind):<24} "
             + " ".join(f"{row[c]:18.3f}" for c in cols)
             + f" {kl_text}"
         )
     for kind, reason in report.skipped:
-        print(f"skipped {kind}: {reason}")
+        print(f"skipped {plain(kind)}: {plain(reason)}")
     if "kb.pl" in written and m["env"].startswith("rgw"):
         answer = cause_answer(written["kb.pl"])
         if answer is not None:
-            print(f"sword_enemy_cause: {answer}")
+            print(f"sword_enemy_cause: {plain(answer)}")
         elif _causal_rules() is None:
             print("sword_enemy_cause: not asked (the shipped rule file causal.pl is missing)")
-    for name, path in written.items():
-        print(f"wrote {path}" if name == "kb.pl" else f"      {path}")
+    for name, path in sorted(written.items(), key=lambda item: item[0] != "kb.pl"):
+        print(f"wrote {plain(path)}" if name == "kb.pl" else f"      {plain(path)}")

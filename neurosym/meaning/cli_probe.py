@@ -24,7 +24,7 @@ import json
 import sys
 from pathlib import Path
 
-from neurosym.cli import add_env_option, with_env_options
+from neurosym.cli import add_env_option, play_env
 from neurosym.errors import ConfigError
 
 
@@ -32,7 +32,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     """Add the probe options."""
     parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
     parser.add_argument(
-        "--env", metavar="NAME", help="environment; must be the checkpoint's (default: it)"
+        "--env",
+        metavar="NAME",
+        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
+        "shape (default: the checkpoint's own)",
     )
     add_env_option(parser)
     parser.add_argument(
@@ -84,13 +87,16 @@ def run(args: argparse.Namespace) -> int:
     from neurosym.meaning.probe import probe
 
     env = canonical_name(args.env) if args.env else None
-    agent = with_env_options(load_agent(args.checkpoint, env=env), args.env_option)
+    agent = load_agent(args.checkpoint, env=env)
+    env, env_kwargs = play_env(agent, env, args.env_option)
     report = probe(
         agent,
         env,
+        env_kwargs=env_kwargs,
         episodes=args.episodes,
         seed=args.seed,
         greedy=args.greedy,
+        progress=sys.stderr.isatty(),
         untrained=args.untrained,
         solver=args.solver,
     )
@@ -120,10 +126,12 @@ def _plain(value: object) -> object:
 
 def print_summary(report, written: dict[str, Path]) -> None:  # noqa: ANN001 (a ProbeReport)
     """Per head: the most selective predicates of the whole vector and of single relations."""
+    from neurosym.display import plain
+
     m = report.meta
     mode = "greedy" if m.get("greedy") else "sampled"
     print(
-        f"{m['env']} {m['module']}: {m['episodes']} episodes ({mode}, seed {m['seed']}), "
+        f"{plain(m['env'])} {plain(m['module'])}: {m['episodes']} episodes ({mode}, seed {m['seed']}), "
         f"{m['states']} states; {m['probed']} of {m['predicates']} predicates probed "
         f"({len(report.skipped)} skipped, see probe_skipped/2)"
     )
@@ -134,12 +142,12 @@ def print_summary(report, written: dict[str, Path]) -> None:  # noqa: ANN001 (a 
         rows = t[t["head"] == h].sort_values(["selectivity", "accuracy"], ascending=False)
         best = rows.head(3)
         parts = [
-            f"{r.predicate} r({r.relation}) acc {r.accuracy:.2f} ctl {r.control:.2f} "
+            f"{plain(r.predicate)} r({plain(r.relation)}) acc {r.accuracy:.2f} ctl {r.control:.2f} "
             f"sel {r.selectivity:+.2f}"
             + ("" if r.untrained_selectivity != r.untrained_selectivity
                else f" (untrained sel {r.untrained_selectivity:+.2f})")
             for r in best.itertuples()
         ]  # fmt: skip
         print(f"head {h}: " + "; ".join(parts))
-    for name, path in written.items():
-        print(f"wrote {path}" if name == "kb.pl" else f"      {path}")
+    for name, path in sorted(written.items(), key=lambda item: item[0] != "kb.pl"):
+        print(f"wrote {plain(path)}" if name == "kb.pl" else f"      {plain(path)}")

@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import functools
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -461,8 +462,14 @@ def intervene(
     ablations: bool = True,
     batch: int | None = None,
     progress: bool = False,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> InterventionReport:
-    """Play the baseline and every experiment on the batched env; measure what changed."""
+    """Play the baseline and every experiment on the batched env; measure what changed.
+
+    ``env``: any env of the agent's family with its observation shape (default:
+    its own); ``env_kwargs``: options on top of the agent's (every experiment
+    plays them, with its own change on top). ``progress``: bars on stderr.
+    """
     import torch
 
     from neurosym.envs import canonical_name, env_family
@@ -474,10 +481,11 @@ def intervene(
         head_vectors,
         replay_observations,
     )
+    from neurosym.progress import Stages
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
-    name, env_kwargs = _resolve_env(agent, env)
+    name, env_kwargs = _resolve_env(agent, env, env_kwargs)
     env_kwargs = dict(env_kwargs)
     family = env_family(name)
     module = agent.config.module
@@ -487,95 +495,110 @@ def intervene(
     batch = batch or min(episodes, 256)
 
     def play(exp: Experiment, index: int, base_means: dict | None) -> Any:
-        who = agent
+        # the change goes in as an env option of the env played (not as the agent's own
+        # options, which another env than the agent's would not carry over)
+        kwargs = env_kwargs
         if exp.map_text is not None:
-            who = dataclasses.replace(agent, env_kwargs={**env_kwargs, "map": exp.map_text})
+            kwargs = {**env_kwargs, "map": exp.map_text}
         elif exp.edit is not None:
-            who = dataclasses.replace(agent, env_kwargs={**env_kwargs, "edit": exp.edit})
+            kwargs = {**env_kwargs, "edit": exp.edit}
+        play_one = functools.partial(
+            record, agent, name, episodes, seed, greedy, batch, env_kwargs=kwargs
+        )
         if exp.ablate:
             with ablate_heads(agent.model, {h: base_means[h] for h in exp.ablate}):
-                rec = record(who, name, episodes=episodes, seed=seed, greedy=greedy, batch=batch)
+                rec = play_one()
         else:
-            rec = record(who, name, episodes=episodes, seed=seed, greedy=greedy, batch=batch)
+            rec = play_one()
         offset = index * stride
         for table in TRACE_TABLES:
             df = getattr(rec, table)
             df["episode"] = df["episode"] + offset
         return rec
 
-    baseline = Experiment("baseline", "baseline", "unchanged")
-    experiments = [baseline]
-    recs = {"baseline": play(baseline, 0, None)}
-    base_rec = recs["baseline"]
-    saved = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        base_obs = replay_observations(_shifted(base_rec, 0), name, env_kwargs)
-        base_vec, base_p = head_vectors(agent.model, base_obs)
-        means = head_means(agent.model, base_obs)
-    finally:
-        torch.set_num_threads(saved)
-    skipped: list[tuple[str, str]] = []
-    fixed_map = family == "rgw" and name != "rgw-random"
-    base_text = None
-    if levels and fixed_map:
-        grid_map = load_map(env_kwargs.get("map", name))
-        base_text = grid_map.text()
-        route = np.zeros(grid_map.height * grid_map.width, dtype=bool)
-        agent_pos = base_rec.positions[base_rec.positions["object"] == "agent"]
-        route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
-        found, skipped = level_experiments(grid_map, route)
-        experiments += found
-    elif levels and family == "rgw":  # rgw-random: each episode's own level, changed
-        found, skipped = procedural_experiments(env_kwargs)
-        experiments += found
-    elif levels:
-        skipped.append(
-            ("level_changes", "level changes are RGW-only; Box-World levels are generated")
-        )
-    if ablations:
-        experiments += ablation_experiments(int(agent.config.heads), module)
-    for index, exp in enumerate(experiments[1:], start=1):
-        recs[exp.id] = play(exp, index, means)
-
-    # measures and effects
-    m_rows, e_rows = [], []
-    base_m = behaviour(base_rec, family)
-    for exp in experiments:
-        m = behaviour(recs[exp.id], family)
-        for key, value in m.items():
-            m_rows.append((exp.id, key, value))
-            if exp.id != "baseline":
-                e_rows.append((exp.id, key, value - base_m[key]))
-        if exp.id == "baseline":
-            continue
+    with Stages(progress) as stages:
+        baseline = Experiment("baseline", "baseline", "unchanged")
+        experiments = [baseline]
+        stages.stage("experiment baseline", 1)
+        recs = {"baseline": play(baseline, 0, None)}
+        base_rec = recs["baseline"]
+        saved = torch.get_num_threads()
         torch.set_num_threads(1)
         try:
-            if exp.ablate:
-                with ablate_heads(agent.model, {h: means[h] for h in exp.ablate}):
-                    vec, p = head_vectors(agent.model, base_obs)
-            else:
-                if exp.edit is not None:
-                    obs = matched_procedural_observations(
-                        base_obs, _shifted(base_rec, 0), exp.edit, name, env_kwargs
-                    )
-                else:
-                    obs = matched_observations(base_obs, base_text, exp.map_text, name, env_kwargs)
-                vec, p = head_vectors(agent.model, obs)
+            base_obs = replay_observations(_shifted(base_rec, 0), name, env_kwargs)
+            base_vec, base_p = head_vectors(agent.model, base_obs)
+            means = head_means(agent.model, base_obs)
         finally:
             torch.set_num_threads(saved)
-        e_rows.append((exp.id, "kl", _kl(base_p, p)))
-        diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
-        if module == "predinet":
-            J = int(agent.config.relations)
-            shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
-            for h in range(shift.shape[0]):
-                for j in range(J):
-                    e_rows.append((exp.id, f"relation_shift({h},{j})", float(shift[h, j])))
-        else:
-            shift = np.linalg.norm(diff, axis=2).mean(axis=0)  # (H,)
-            for h in range(len(shift)):
-                e_rows.append((exp.id, f"head_shift({h})", float(shift[h])))
+        skipped: list[tuple[str, str]] = []
+        fixed_map = family == "rgw" and name != "rgw-random"
+        base_text = None
+        if levels and fixed_map:
+            grid_map = load_map(env_kwargs.get("map", name))
+            base_text = grid_map.text()
+            route = np.zeros(grid_map.height * grid_map.width, dtype=bool)
+            agent_pos = base_rec.positions[base_rec.positions["object"] == "agent"]
+            route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
+            found, skipped = level_experiments(grid_map, route)
+            experiments += found
+        elif levels and family == "rgw":  # rgw-random: each episode's own level, changed
+            found, skipped = procedural_experiments(env_kwargs)
+            experiments += found
+        elif levels:
+            skipped.append(
+                ("level_changes", "level changes are RGW-only; Box-World levels are generated")
+            )
+        if ablations:
+            experiments += ablation_experiments(int(agent.config.heads), module)
+        advance = stages.stage("experiments", len(experiments))
+        advance(1)  # the baseline
+        for index, exp in enumerate(experiments[1:], start=1):
+            stages.describe(f"experiment {exp.id}")
+            recs[exp.id] = play(exp, index, means)
+            advance(1)
+        advance = stages.stage("effects at the baseline's states", len(experiments) - 1)
+
+        # measures and effects
+        m_rows, e_rows = [], []
+        base_m = behaviour(base_rec, family)
+        for exp in experiments:
+            m = behaviour(recs[exp.id], family)
+            for key, value in m.items():
+                m_rows.append((exp.id, key, value))
+                if exp.id != "baseline":
+                    e_rows.append((exp.id, key, value - base_m[key]))
+            if exp.id == "baseline":
+                continue
+            torch.set_num_threads(1)
+            try:
+                if exp.ablate:
+                    with ablate_heads(agent.model, {h: means[h] for h in exp.ablate}):
+                        vec, p = head_vectors(agent.model, base_obs)
+                else:
+                    if exp.edit is not None:
+                        obs = matched_procedural_observations(
+                            base_obs, _shifted(base_rec, 0), exp.edit, name, env_kwargs
+                        )
+                    else:
+                        obs = matched_observations(
+                            base_obs, base_text, exp.map_text, name, env_kwargs
+                        )
+                    vec, p = head_vectors(agent.model, obs)
+            finally:
+                torch.set_num_threads(saved)
+            advance(1)
+            e_rows.append((exp.id, "kl", _kl(base_p, p)))
+            diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
+            if module == "predinet":
+                J = int(agent.config.relations)
+                shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
+                for h in range(shift.shape[0]):
+                    for j in range(J):
+                        e_rows.append((exp.id, f"relation_shift({h},{j})", float(shift[h, j])))
+            else:
+                shift = np.linalg.norm(diff, axis=2).mean(axis=0)  # (H,)
+                for h in range(len(shift)):
+                    e_rows.append((exp.id, f"head_shift({h})", float(shift[h])))
     from neurosym import __version__
 
     meta = {

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,7 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 from neurosym.meaning.predicates import StateLabels
+from neurosym.progress import Stages
 
 DEFAULT_EPISODES = 200
 """probe episodes by default: sampled, seeds S..S+199 (about 4k states on rgw2)"""
@@ -254,13 +256,15 @@ def fit_probes(
     max_train: int = MAX_TRAIN,
     max_test: int = MAX_TEST,
     solver: str = "batched",
+    advance: Callable[[int], None] | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Fit every (head, relation, predicate) probe; (table, skipped) as in :class:`ProbeReport`.
 
     ``features`` (S, H, D) per-head vectors; relation j is column j (j <
     ``relations``; None: only ``all``), ``all`` the whole vector. ``types``
     (S,) state types for the control task. ``untrained`` (S, H, D) the same
-    from an untrained network, or None.
+    from an untrained network, or None. ``advance(1)`` is called after each
+    (network, head, relation) fit, for a progress display.
     """
     S, H, D = features.shape
     if len(labels.states) != S or len(types) != S:
@@ -290,7 +294,7 @@ def fit_probes(
     if solver not in ("batched", "sklearn"):
         raise ConfigError(f"solver must be batched or sklearn, got {solver!r}")
     rows, skipped = _fit_all(
-        labels, nets, scaled, columns, types, train_idx, test_idx, H, rng, solver
+        labels, nets, scaled, columns, types, train_idx, test_idx, H, rng, solver, advance
     )
     table = pd.DataFrame(rows, columns=[c for c in TABLE_COLUMNS if c not in ("selectivity",)])
 
@@ -321,6 +325,7 @@ def _fit_all(
     H: int,
     rng: np.random.Generator,
     solver: str,
+    advance: Callable[[int], None] | None = None,
 ) -> tuple[list[dict[str, Any]], list[tuple[str, str]]]:
     """The fits of :func:`fit_probes`: predicates are screened, then probed all at once."""
     S = len(types)
@@ -358,6 +363,8 @@ def _fit_all(
                 else:
                     acc = logistic_accuracy(X[train_idx], Y_tr, X[test_idx], Y_te)
                 scores[prefix, h, c] = acc  # (2P,)
+                if advance is not None:
+                    advance(1)
     # What always answering the training majority scores on the held-out states: a
     # control task on a rare predicate can score below it by bad luck in the types
     # drawn, and a control below what a constant answer gets would flatter the probe.
@@ -401,8 +408,36 @@ def probe_recording(
     test_fraction: float = TEST_FRACTION,
     max_train: int = MAX_TRAIN,
     solver: str = "batched",
+    progress: bool = False,
 ) -> ProbeReport:
-    """Probe ``agent``'s heads on the states of an existing recording of it."""
+    """Probe ``agent``'s heads on the states of an existing recording of it.
+
+    ``progress``: bars on stderr (replaying the states, fitting the probes).
+    """
+    with Stages(progress) as stages:
+        return _probe_recording(
+            agent,
+            recording,
+            stages,
+            seed=seed,
+            untrained=untrained,
+            test_fraction=test_fraction,
+            max_train=max_train,
+            solver=solver,
+        )
+
+
+def _probe_recording(
+    agent: Any,
+    recording: Any,
+    stages: Stages,
+    *,
+    seed: int,
+    untrained: bool,
+    test_fraction: float,
+    max_train: int,
+    solver: str,
+) -> ProbeReport:
     import torch
 
     from neurosym.envs import canonical_name, env_family
@@ -419,6 +454,7 @@ def probe_recording(
     torch.set_num_threads(1)
     try:
         kwargs = recording.meta.get("env_kwargs", agent.env_kwargs)  # what it was played with
+        stages.stage("replaying the recorded states", 1)
         obs = replay_observations(recording, env, kwargs)
         labels = state_labels(recording, family)
         feats, _ = head_vectors(agent.model, obs)
@@ -428,6 +464,8 @@ def probe_recording(
     finally:
         torch.set_num_threads(saved)
     module = agent.config.module
+    relations = int(agent.config.relations) if module == "predinet" else 0
+    fits = (2 if base is not None else 1) * feats.shape[1] * (relations + 1)
     table, skipped = fit_probes(
         feats,
         labels,
@@ -438,6 +476,7 @@ def probe_recording(
         test_fraction=test_fraction,
         max_train=max_train,
         solver=solver,
+        advance=stages.stage("fitting probes", fits),
     )
     from neurosym import __version__
 
@@ -473,10 +512,13 @@ def probe(
     max_train: int = MAX_TRAIN,
     solver: str = "batched",
     progress: bool = False,
+    env_kwargs: dict[str, Any] | None = None,
 ) -> ProbeReport:
     """Record ``episodes`` episodes of ``agent`` (sampled by default) and probe its heads.
 
     Episode k is played from seed ``seed + k`` (as ``neurosym extract`` does).
+    ``env``: any env of the agent's family with its observation shape (default:
+    its own); ``env_kwargs``: options on top of the agent's.
     """
     from neurosym.export.recorder import record
 
@@ -484,7 +526,15 @@ def probe(
         raise ConfigError(f"probes need at least 2 episodes, got {episodes!r}")
     if not 0.0 < test_fraction < 1.0:
         raise ConfigError(f"test_fraction must be between 0 and 1, got {test_fraction!r}")
-    rec = record(agent, env, episodes=episodes, seed=seed, greedy=greedy, progress=progress)
+    rec = record(
+        agent,
+        env,
+        episodes=episodes,
+        seed=seed,
+        greedy=greedy,
+        progress=progress,
+        env_kwargs=env_kwargs,
+    )
     return probe_recording(
         agent,
         rec,
@@ -493,4 +543,5 @@ def probe(
         test_fraction=test_fraction,
         max_train=max_train,
         solver=solver,
+        progress=progress,
     )

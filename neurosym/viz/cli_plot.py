@@ -27,6 +27,10 @@ _SUBCOMMANDS = {
 }
 
 
+MIN_DPI, MAX_DPI = 1, 1200
+"""--dpi range: a 4-head figure at 1200 dpi is about 12,700 pixels wide (matplotlib's limit: 65,536)"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the plot subcommands and their options."""
     sub = parser.add_subparsers(dest="plot", metavar="PLOT", required=True)
@@ -71,7 +75,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
             cmd.add_argument(
                 "--episodes",
                 type=int,
-                default=1,
+                default=None,
                 help="with --checkpoint: episodes to play, seeds S, S+1, ... (default: 1)",
             )
         if name == "episode":
@@ -149,13 +153,16 @@ def _cell(text: str) -> tuple[int, int]:
 
 def run(args: argparse.Namespace) -> int:
     """Load the source, draw the requested picture and write it."""
+    from neurosym.display import plain
     from neurosym.errors import ConfigError
     from neurosym.viz.output import ANIMATION_FORMATS, IMAGE_FORMATS, image_format
 
     allowed = IMAGE_FORMATS + (ANIMATION_FORMATS if args.plot == "episode" else ())
     fmt = image_format(args.out, allowed)
-    if args.dpi <= 0:
-        raise ConfigError(f"--dpi must be positive, got {args.dpi:g}")
+    if not MIN_DPI <= args.dpi <= MAX_DPI:  # NaN fails too
+        raise ConfigError(f"--dpi must be a number from {MIN_DPI} to {MAX_DPI}, got {args.dpi:g}")
+    if getattr(args, "step", 0) < 0:
+        raise ConfigError(f"--step must be 0 or more, got {args.step}")
     if args.plot == "probes":
         from neurosym.viz.output import save_figure
         from neurosym.viz.probes import load_probe_table, probes_figure
@@ -164,11 +171,11 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(f"--top must be at least 1, got {args.top}")
         fig = probes_figure(load_probe_table(args.probes), args.relation, args.top)
         path = save_figure(fig, args.out, dpi=args.dpi)
-        print(f"wrote {args.out} ({_pixels(path) if fmt == 'png' else 'svg'})")
+        print(f"wrote {plain(args.out)} ({_pixels(path) if fmt == 'png' else 'svg'})")
         return 0
     source = _load_source(args)
     written = _draw(args, source, fmt)
-    print(f"wrote {args.out} ({written})")
+    print(f"wrote {plain(args.out)} ({written})")
     return 0
 
 
@@ -176,7 +183,13 @@ def _load_source(args: argparse.Namespace) -> Any:
     from neurosym.errors import ConfigError
 
     if args.recording is not None:
-        for flag, value in (("--env", args.env), ("--episode-seed", args.episode_seed)):
+        played = (
+            ("--env", args.env),
+            ("--episode-seed", args.episode_seed),
+            ("--max-steps", getattr(args, "max_steps", None)),
+            ("--episodes", getattr(args, "episodes", None)),
+        )
+        for flag, value in played:
             if value is not None:
                 raise ConfigError(f"{flag} goes with --checkpoint; a recording already fixes it")
         from neurosym.export.recording import Recording
@@ -215,7 +228,11 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
         )
     elif args.plot == "relations":
         fig = relations.relations_figure(
-            source, args.env, threshold=args.threshold, episodes=args.episodes, seed=where["seed"]
+            source,
+            args.env,
+            threshold=args.threshold,
+            episodes=1 if args.episodes is None else args.episodes,
+            seed=where["seed"],
         )
     elif fmt == "gif":
         path = episode.save_episode_gif(

@@ -29,8 +29,9 @@ from neurosym.viz.grid import (
     mark_agent,
 )
 from neurosym.viz.output import save_gif
+from neurosym.viz.panels import widen_for_text
 from neurosym.viz.sources import EnvLike, Source, load_trace
-from neurosym.viz.style import head_colour, legend_text
+from neurosym.viz.style import data_as_text, head_colour, legend_text
 from neurosym.viz.trace import EpisodeTrace
 
 STRIP_PANEL_INCHES = 2.0
@@ -171,6 +172,7 @@ def episode_figure(
     return episode_trace_figure(trace, head=head, steps=steps, frames=frames)
 
 
+@data_as_text
 def episode_trace_figure(
     trace: EpisodeTrace,
     *,
@@ -198,16 +200,17 @@ def episode_trace_figure(
             ax.set_axis_off()
     outcome = f", outcome {trace.outcome}" if trace.outcome else ""
     total = float(np.sum(trace.rewards))
-    fig.suptitle(
+    title = fig.suptitle(
         f"Episode of {trace.steps} steps, return {total:+.1f}{outcome}\n{trace.title_name}",
         fontsize=10,
     )
-    fig.supxlabel(
+    note = fig.supxlabel(
         legend_text(np.concatenate([trace.grids[t].ravel() for t in states]))
         + "\n"
         + _arrow_note(trace, heads),
         fontsize=7,
     )
+    widen_for_text(fig, [title, note])
     return fig
 
 
@@ -215,6 +218,7 @@ def episode_trace_figure(
 # animation
 
 
+@data_as_text
 def episode_frames(
     trace: EpisodeTrace,
     *,

@@ -10,6 +10,7 @@ the target and moved into place, so a crash never leaves half an image.
 from __future__ import annotations
 
 import io
+import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -85,8 +86,8 @@ def gif_bytes(frames: Sequence[np.ndarray], fps: float) -> bytes:
 
     if not frames:
         raise ConfigError("an animation needs at least one frame")
-    if fps <= 0:
-        raise ConfigError(f"--fps must be positive, got {fps}")
+    if not math.isfinite(fps) or fps <= 0:
+        raise ConfigError(f"--fps must be a positive number, got {fps}")
     # One adaptive palette for the whole film, from all frames side by side.
     sheet = Image.fromarray(np.concatenate(list(frames), axis=1))
     palette = sheet.quantize(

@@ -6,7 +6,8 @@ argument 2) have this shape, so they share the layout, the colour scaling
 
 Size: ``PANEL_INCHES`` per panel plus fixed margins, so a figure of ``heads``
 columns and ``rows`` rows is ``(heads * 2.4 + 1.0) x (rows * 2.4 + 1.0)``
-inches, i.e. ``(240 * heads + 100) x (240 * rows + 100)`` pixels at 100 dpi.
+inches, i.e. ``(240 * heads + 100) x (240 * rows + 100)`` pixels at 100 dpi,
+or wider when the title or the note under the panels needs it (one head).
 """
 
 from __future__ import annotations
@@ -17,9 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from neurosym.viz.grid import draw_heat, label_size, outline_cell
-from neurosym.viz.style import legend_text
+from neurosym.viz.style import data_as_text, legend_text
 
 PANEL_INCHES = 2.4
 """width and height of one grid panel"""
@@ -47,12 +49,15 @@ def row_norm(row: Sequence[Panel]) -> Normalize:
 
     Attention of an untrained or uncertain head is close to uniform (1/N
     everywhere); a scale from 0 would paint it one flat colour, min..max shows
-    where it leans, and the colour bar gives the true range.
+    where it leans, and the colour bar gives the true range. A row with cells
+    not recorded (a saved recording keeps only the strongest cell of a map)
+    is on the weights' own scale, 0..1: min..max of a few strongest cells
+    would be a range of nothing (all 1.00 gave a 0.5..1.5 bar).
     """
     finite = [p.values[np.isfinite(p.values)] for p in row]
     values = np.concatenate(finite) if finite else np.zeros(0)
-    if values.size == 0:
-        return Normalize(0.0, 1.0)
+    if values.size == 0 or any(not np.isfinite(p.values).all() for p in row):
+        return Normalize(0.0, max(1.0, float(values.max()) if values.size else 1.0))
     lo, hi = float(values.min()), float(values.max())
     if hi - lo < 1e-12:
         lo, hi = max(0.0, lo - 0.5 * max(abs(lo), 1e-3)), hi + 0.5 * max(abs(hi), 1e-3)
@@ -64,6 +69,7 @@ def figure_size(rows: int, cols: int) -> tuple[float, float]:
     return cols * PANEL_INCHES + MARGIN_INCHES, rows * PANEL_INCHES + MARGIN_INCHES
 
 
+@data_as_text
 def heat_map_figure(
     panels: Sequence[Sequence[Panel]],
     names: np.ndarray,
@@ -87,10 +93,27 @@ def heat_map_figure(
             for row_i, col_i, colour in panel.outlines:
                 outline_cell(ax, row_i, col_i, colour=colour)
             ax.set_title(panel.title, fontsize=8)
-        bar = fig.colorbar(image, ax=list(axes[r]), shrink=0.9, pad=0.01, fraction=0.04)
+        bar = fig.colorbar(
+            image, ax=list(axes[r]), shrink=0.9, pad=0.01, fraction=0.04, panchor=False
+        )
         bar.set_label(colourbar_labels[r], fontsize=8)
         bar.ax.tick_params(labelsize=7)
-    fig.suptitle(title, fontsize=10)
+    texts = [fig.suptitle(title, fontsize=10)]
     legend = legend_text(names.ravel())
-    fig.supxlabel("\n".join(s for s in (legend, note) if s), fontsize=7.5)
+    texts.append(fig.supxlabel("\n".join(s for s in (legend, note) if s), fontsize=7.5))
+    widen_for_text(fig, texts)
     return fig
+
+
+def widen_for_text(fig: Figure, texts: Sequence[Text], margin_inches: float = 0.3) -> None:
+    """Make ``fig`` wide enough for the longest of ``texts`` (titles, legend, notes).
+
+    Panels set a figure's width; one head's panel is narrower than the title
+    and the D line under it, which would be cut at both sides.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    widest = max(t.get_window_extent(renderer).width for t in texts) / fig.dpi
+    if widest + margin_inches > fig.get_figwidth():
+        fig.set_figwidth(widest + margin_inches)

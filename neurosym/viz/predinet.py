@@ -20,7 +20,7 @@ from matplotlib.ticker import MaxNLocator
 from neurosym.errors import ConfigError
 from neurosym.viz.panels import Panel, heat_map_figure
 from neurosym.viz.sources import EnvLike, Source, load_trace, require_source_module
-from neurosym.viz.style import head_colour
+from neurosym.viz.style import data_as_text, head_colour
 from neurosym.viz.trace import EpisodeTrace
 
 NOT_RECORDED = (
@@ -127,6 +127,7 @@ def r_vectors_figure(
     return r_vectors_trace_figure(trace, head=head)
 
 
+@data_as_text
 def r_vectors_trace_figure(trace: EpisodeTrace, *, head: int | None = None) -> Figure:
     """:func:`r_vectors_figure` for a trace already built.
 
@@ -179,7 +180,7 @@ def r_vectors_trace_figure(trace: EpisodeTrace, *, head: int | None = None) -> F
     axes[-1].xaxis.set_major_locator(MaxNLocator(integer=True))
     # both bars beside all panels (side by side): bars over interleaved panels would overlap
     d_bar = fig.colorbar(d_image, ax=list(axes), shrink=0.7, pad=0.01, fraction=0.03)
-    d_bar.set_label(r"relations r(j): $D^h_j = (E_1 - E_2)\,W_S$", fontsize=8)
+    d_bar.set_label(r"relations r(j): $D^h_j = (E_1 - E_2)\,W_S$", fontsize=8, parse_math=True)
     p_bar = fig.colorbar(p_image, ax=list(axes), shrink=0.7, pad=0.01, fraction=0.03)
     p_bar.set_label("position in [0, 1]", fontsize=8)
     for bar in (d_bar, p_bar):

@@ -17,6 +17,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from neurosym.errors import ConfigError
+from neurosym.viz.style import data_as_text
 
 
 def load_probe_table(path: str | os.PathLike[str]) -> pd.DataFrame:
@@ -30,6 +31,7 @@ def load_probe_table(path: str | os.PathLike[str]) -> pd.DataFrame:
         raise ConfigError(f"cannot read the probe table {p}: {exc}") from None
 
 
+@data_as_text
 def probes_figure(table: pd.DataFrame, relation: str = "all", top: int = 25) -> Figure:
     """Heads x predicates selectivity of relation ``relation`` (``all``, ``0``, ... or ``best``).
 

@@ -22,8 +22,9 @@ from neurosym.errors import ConfigError
 from neurosym.export.facts import DEFAULT_THRESHOLD
 from neurosym.export.recording import Recording
 from neurosym.viz.live import trace_from_agent
+from neurosym.viz.panels import widen_for_text
 from neurosym.viz.sources import EnvLike, Source, require_source_module
-from neurosym.viz.style import head_colour
+from neurosym.viz.style import data_as_text, head_colour
 from neurosym.viz.trace import EpisodeTrace
 
 HIST_PANEL_INCHES = (2.6, 2.2)
@@ -94,6 +95,7 @@ def _trace_relations(traces: Sequence[EpisodeTrace]) -> pd.DataFrame:
     return table.loc[np.isfinite(table["value"].to_numpy())]
 
 
+@data_as_text
 def relations_figure(
     source: Source,
     env: EnvLike = None,
@@ -150,11 +152,12 @@ def relations_figure(
                 ax.axvline(x, color="black", linestyle="--", linewidth=1.0)
         ax.set_title(f"r({j}): threshold ±{thr:.3g}, {kept} of {len(v)} kept", fontsize=8)
         ax.tick_params(labelsize=7)
-        ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7)
+        ax.set_xlabel(rf"$D_{{{j}}}$ (all heads)", fontsize=7, parse_math=True)
     axes[0, 0].set_ylabel("steps x heads", fontsize=7)
     axes[0, 0].legend(fontsize=6, frameon=False, loc="upper left")
-    fig.suptitle(
+    title = fig.suptitle(
         f"PrediNet relation values with threshold {rule} (dashed: ± threshold)\n{where}",
         fontsize=10,
     )
+    widen_for_text(fig, [title])
     return fig

@@ -9,11 +9,32 @@ chosen from a digest of its name, so the same name always looks the same.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import ParamSpec, TypeVar
 
+import matplotlib
 from matplotlib import colors as mcolors
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def data_as_text(draw: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Run a figure builder with matplotlib's mathtext off, so that names from files (a
+    checkpoint, an entity, a predicate) are drawn as written: ``$\\alpha$`` in a file name
+    would be a Greek letter and ``$\\frac$`` a parse error. Labels of our own that are
+    mathtext ask for it (``parse_math=True``)."""
+
+    @functools.wraps(draw)
+    def run(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        with matplotlib.rc_context({"text.parse_math": False}):
+            return draw(*args, **kwargs)
+
+    return run
+
 
 HEAD_COLOURS = (
     "#e6194b",
