@@ -21,6 +21,8 @@ from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.prolog.signature import signature_path
 from neurosym.terms import atom_text
 
+REPO = Path(__file__).resolve().parents[1]
+
 
 def _touch(marker: Path) -> str:
     """Prolog goal text that creates ``marker``."""
@@ -54,6 +56,13 @@ PLANTED = [
     ("library-fact", "member(x, [x]).", "library predicate member/2"),
     ("variable", "_.", "a variable"),
     ("number", "42.", "a term that is not a fact"),
+    ("ssu-rule", "ok(_) => {touch}.", "a rule (Head => Body)"),
+    ("ssu-guard", "ok(X), X > 0 => {touch}.", "a rule (Head => Body)"),
+    ("ssu-quoted", "'=>'(ok(_), {touch}).", "a rule (Head => Body)"),
+    ("operator-fact", "'?=>'(ok(1), true).", "not a plain predicate name"),
+    ("symbol-fact", "'$hidden'(1).", "not a plain predicate name"),
+    ("dynamic-operator", ":- dynamic (=>)/2.", "not a plain predicate name"),
+    ("non-ground", "ok(_).", "a fact with a variable"),
 ]  # fmt: skip
 
 
@@ -97,6 +106,42 @@ def test_the_cli_refuses_planted_code_in_one_line(run_neurosym, tmp_path: Path, 
     assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}:3: found a directive")
     assert not marker.exists()
     assert not path.with_suffix(".qlf").exists()  # nothing of an unchecked source is compiled
+
+
+def _rgw_kb(tmp_path: Path) -> Path:
+    """A small KB as ``neurosym extract`` writes it (the writer's headers and shapes)."""
+    tables = {
+        "object": pd.DataFrame({"id": ["s1", "e1"], "type": ["sword", "enemy"]}),
+        "holds": pd.DataFrame(
+            {"e": [0, 0], "t": [1, 1], "r": ["r(1)", "r(1)"], "a": ["sword", "agent"], "b": ["agent", "enemy"]}
+        ),
+    }
+    return write_prolog(
+        tmp_path / "K.pl", tables, dynamic=["attention/6"], term_columns={"holds": ["r"]}
+    )
+
+
+@pytest.mark.parametrize("qlf", [False, True])
+def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
+    run_neurosym, tmp_path: Path, marker: Path, qlf: bool
+) -> None:
+    path = _rgw_kb(tmp_path)
+    with KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"]) as kb:  # the KB as written works
+        assert str(kb.once("sword_enemy_link(L)")["L"]) == "indirect([agent])"
+    line = path.read_text().count("\n") + 1
+    with path.open("a") as fh:
+        fh.write(f"attention(_,_,_,_,_,_) => {_touch(marker)}, fail.\n")
+    args = ["query", "--kb", path, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(L)"]
+    proc = run_neurosym(*args, *(["--qlf"] if qlf else []))
+    assert proc.returncode == 1, proc.stdout
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(
+        f"neurosym query: error: cannot load {path}:{line}: found a rule (Head => Body)"
+    )
+    with pytest.raises(PrologError, match=rf"^cannot load {path}:{line}: found a rule"):
+        KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"], qlf=qlf)
+    assert not marker.exists()
+    assert not path.with_suffix(".qlf").exists()
 
 
 def test_trust_and_rules_load_the_same_file_as_code(run_neurosym, tmp_path, marker) -> None:

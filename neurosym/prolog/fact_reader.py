@@ -172,7 +172,7 @@ chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
     (   T == end_of_file
     ->  Terms = [], LName = PName, LArity = PArity, End = eof
     ;   QQ == [],
-        (   nonvar(T), functor(T, PName, PArity)
+        (   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   T \= (:- _),
             check_(T, S, M, check, 0, Name, Arity)
@@ -231,7 +231,7 @@ take_batches_(Q, S, M, Mode, Pos, PName, PArity, N0, N, Name, Arity, End) :-
 add_terms_([], _, _, _, PName, PArity, N, N, PName, PArity).
 add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
     N1 is N0 + 1,
-    (   functor(T, PName, PArity)
+    (   same_(T, PName, PArity)
     ->  Name1 = PName, Arity1 = PArity
     ;   check_(T, S, M, Mode, N1, Name1, Arity1)
     ),
@@ -247,7 +247,7 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
     ;   N1 is N0 + 1,
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
-        ;   nonvar(T), functor(T, PName, PArity)
+        ;   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   check_(T, S, M, Mode, N1, Name, Arity),
             (   T = (:- encoding(Enc)), Enc \== utf8
@@ -268,7 +268,7 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
     ).
 
 % The tight loop: a fact of the same predicate as the previous one needs no
-% check beyond its functor; a new functor goes through check_/7 once.
+% check beyond its functor and groundness; a new functor goes through check_/7 once.
 read_loop_(S, M, Mode, PName, PArity, N0, N) :-
     read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
     (   T == end_of_file
@@ -276,7 +276,7 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
     ;   N1 is N0 + 1,
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
-        ;   nonvar(T), functor(T, PName, PArity)
+        ;   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   check_(T, S, M, Mode, N1, Name, Arity)
         ),
@@ -287,27 +287,68 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
         )
     ).
 
+%   same_(+T, +Name, +Arity): T is a ground fact of the predicate just checked.
+same_(T, Name, Arity) :- nonvar(T), functor(T, Name, Arity), ground(T).
+
 %   check_(+Term, +Stream, +M, +Mode, +N, -Name, -Arity): the predicate of a
 %   fact, or (:-)/1 for an accepted header; throws neurosym_refused/3.
-check_(T, _, _, _, N, _, _) :- var(T), !, refuse_(N, 'a variable where a fact should be', T).
-check_((:- D), S, M, Mode, N, (:-), 1) :- !, header_(D, S, M, Mode, N).
-check_(T, _, _, _, N, _, _) :- T = (?- _), !, refuse_(N, 'a directive', T).
-check_(T, _, _, _, N, _, _) :- T = (_ :- _), !, refuse_(N, 'a clause with a body (a rule)', T).
-check_(T, _, _, _, N, _, _) :- T = (_ --> _), !, refuse_(N, 'a grammar rule', T).
-check_(T, _, _, _, N, _, _) :- T = (_ : _), !, refuse_(N, 'a module-qualified clause', T).
-check_(T, _, _, _, N, _, _) :- \+ callable(T), !, refuse_(N, 'a term that is not a fact', T).
+%   A term is admitted when it has the shape of a fact (fact_shape_/1), not
+%   when it misses a list of known bad forms: a clause-like form SWI-Prolog
+%   adds one day has an operator for a name, and is refused as it is today.
+check_((:- D), S, M, Mode, N, (:-), 1) :- nonvar(D), !, header_(D, S, M, Mode, N).
 check_(T, _, M, _, N, Name, Arity) :-
+    (   fact_shape_(T)
+    ->  functor(T, Name, Arity),
+        predicate_check_(M, Name, Arity, N, T),
+        ( ground(T) -> true ; refuse_(N, 'a fact with a variable (facts are ground)', T) ),
+        note_touched_(M, Name, Arity)
+    ;   not_a_fact_(T, What),
+        refuse_(N, What, T)
+    ).
+
+%   fact_shape_(+T): T is an atom or compound whose name is a plain
+%   predicate name (plain_name_/1); check_/7 then asks for it to be ground.
+fact_shape_(T) :-
+    callable(T),
+    functor(T, Name, _),
+    plain_name_(Name).
+
+%   plain_name_(+Name): a name written without quotes that is no operator:
+%   a lowercase letter, then letters, digits and underscores (p, kb_meta,
+%   ключ). Operators (:-, =>, -->, ?-, :) and quoted names are not.
+plain_name_(Name) :-
+    atom(Name),
+    atom_codes(Name, [C|Cs]),
+    code_type(C, csymf), C \== 0'_, \+ code_type(C, upper),
+    forall(member(X, Cs), code_type(X, csym)).
+
+%   not_a_fact_(+T, -What): what T is, for the message.
+not_a_fact_(T, 'a variable where a fact should be') :- var(T), !.
+not_a_fact_((?- _), 'a directive') :- !.
+not_a_fact_((:- _), 'a directive') :- !.
+not_a_fact_((_ :- _), 'a clause with a body (a rule)') :- !.
+not_a_fact_((_ => _), 'a rule (Head => Body)') :- !.
+not_a_fact_((_ --> _), 'a grammar rule') :- !.
+not_a_fact_((_ : _), 'a module-qualified clause') :- !.
+not_a_fact_(T, 'a term that is not a fact') :- \+ callable(T), !.
+not_a_fact_(T, What) :-
     functor(T, Name, Arity),
-    predicate_check_(M, Name, Arity, N, T),
-    note_touched_(M, Name, Arity).
+    \+ plain_name_(Name), !,
+    format(atom(What), 'a term whose name ~q (~q/~w) is not a plain predicate name', [Name, Name, Arity]).
 
 header_(D, S, M, Mode, N) :-
-    (   nonvar(D), D = encoding(Enc), atom(Enc),
+    (   D = encoding(Enc), atom(Enc),
         catch(set_stream(S, encoding(Enc)), _, fail)
     ->  true
-    ;   nonvar(D), D = dynamic(Spec), specs_(Spec, PIs)
+    ;   D = dynamic(Spec), specs_(Spec, PIs)
     ->  forall(member(Name/Arity, PIs),
-               (   predicate_check_(M, Name, Arity, N, (:- D)),
+               (   (   plain_name_(Name)
+                   ->  true
+                   ;   format(atom(What), 'a declaration of ~q/~w, which is not a plain predicate name',
+                              [Name, Arity]),
+                       refuse_(N, What, (:- D))
+                   ),
+                   predicate_check_(M, Name, Arity, N, (:- D)),
                    note_touched_(M, Name, Arity),
                    ( Mode == assert -> dynamic(M:Name/Arity) ; true )
                ))
@@ -418,7 +459,7 @@ message_(neurosym_refused(N, What, Term), File, Text) :- !,
                            write_term(Term, [quoted(true), max_depth(8), portray(false),
                                              numbervars(true), spacing(next_argument)]) )),
     format(string(Text),
-           "~w:~w: found ~w: ~w; a fact file holds only facts such as p(a, 1). and the \c
+           "~w:~w: found ~w: ~w; a fact file holds only ground facts such as p(a, 1). and the \c
             writer's :- encoding/dynamic headers (load code as rules, or trust the file)",
            [File, Line, What, Shown]).
 message_(error(syntax_error(What), Context), File, Text) :- !,
