@@ -22,9 +22,11 @@ package without any package-data settings. What it does, and why in Prolog:
 
 from __future__ import annotations
 
+from neurosym.terms import MAX_DEPTH
+
 MODULE = "neurosym_bridge"
 
-SOURCE = r"""
+_SOURCE = r"""
 :- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/8, count/7]).
 :- use_module(library(time), [call_with_time_limit/2]).
 :- use_module(library(solution_sequences), [limit/2]).
@@ -185,9 +187,24 @@ bounded_([stack-Bytes|Bs], Goal) :- !,
 failure_(E, Bounds, Status) :-
     (   limit_text_(E, Bounds, Msg)
     ->  Status = limit-Msg
+    ;   neurosym_text_(E, Msg)
+    ->  Status = error-Msg
     ;   error_text_(E, Msg),
         Status = error-Msg
     ).
+
+neurosym_text_(neurosym_goal(variable), "the goal is a variable; give a goal such as object(Id, Type)").
+neurosym_text_(neurosym_goal(not_callable(G)), Msg) :-
+    format(string(Msg), "the goal ~q is not something to run; give a goal such as object(Id, Type)", [G]).
+neurosym_text_(neurosym_goal(trailing(Rest)), Msg) :-
+    format(string(Msg), "the goal has text after its full stop (~w); give one goal, \c
+                         joining goals with ',' rather than '.'", [Rest]).
+neurosym_text_(neurosym_answer(deep), Msg) :-
+    max_depth_(D),
+    format(string(Msg), "an answer is nested more than ~D levels deep (or is cyclic); \c
+                         neurosym passes answers up to ~D levels to Python", [D, D]).
+neurosym_text_(neurosym_answer(big_integer), "an answer holds an integer of more than 4,300 digits, \c
+                                               which Python cannot write as text").
 
 limit_text_(neurosym_limit(timeout(T)), _, Msg) :-
     format(string(Msg), "time limit exceeded: the goal ran longer than ~w s and was stopped", [T]).
@@ -206,13 +223,38 @@ stack_overflow_(What, _) :- memberchk(What, [stack, global_stack, local_stack, t
 stack_overflow_(_, error(_, Context)) :- is_dict(Context, stack_overflow).
 
 prepare_(M, Text, Inputs, Goal, Names, Vars, Missing) :-
+    goal_(M, Text, Goal, Bindings),
+    bind_inputs_(Inputs, Bindings, Missing),
+    outputs_(Bindings, Inputs, Names, Vars).
+
+%   goal_(+M, +Text, -Goal, -Bindings): Text read as one goal; throws
+%   neurosym_goal(Why) for an empty goal, a variable, a number, or text
+%   after the goal's full stop (which would be ignored without a word).
+goal_(M, Text, Goal, Bindings) :-
     term_string(Goal, Text, [variable_names(Bindings), module(M)]),
     (   Goal == end_of_file
     ->  throw(error(syntax_error(empty_goal), _))
+    ;   var(Goal)
+    ->  throw(neurosym_goal(variable))
+    ;   \+ callable(Goal)
+    ->  throw(neurosym_goal(not_callable(Goal)))
+    ;   after_full_stop_(Text, Rest)
+    ->  throw(neurosym_goal(trailing(Rest)))
     ;   true
-    ),
-    bind_inputs_(Inputs, Bindings, Missing),
-    outputs_(Bindings, Inputs, Names, Vars).
+    ).
+
+%   after_full_stop_(+Text, -Rest): Text has a full stop with more text after it.
+after_full_stop_(Text, Rest) :-
+    setup_call_cleanup(
+        open_string(Text, S),
+        (   catch('$raw_read'(S, _), error(syntax_error(_), _), fail),  % no full stop: one goal
+            character_count(S, End),
+            catch('$raw_read'(S, Next), error(syntax_error(_), _), Next = more),
+            Next \== end_of_file
+        ),
+        close(S)),
+    sub_string(Text, End, _, 0, Rest0),
+    normalize_space(string(Rest), Rest0).
 
 % The named variables that are not inputs, in order; no findall: it would copy them.
 outputs_([], _, [], []).
@@ -244,17 +286,44 @@ decode_(X, X).
 
 encode_row_(Template, Row) :-
     Template =.. [v|Values],
-    maplist(encode_, Values, Row).
+    term_variables(Values, Vars),
+    max_depth_(Depth),
+    maplist(encode_top_(Vars, Depth), Values, Row).
 
-% Prolog -> Python, see the module comment.
-encode_(V, @(none)) :- var(V), !.
-encode_(X, X) :- atom(X), !.
-encode_(X, X) :- number(X), !.
-encode_(X, X) :- string(X), !.
-encode_(L, E) :- is_list(L), !, maplist(encode_, L, E).
-encode_(D, S) :- is_dict(D), !, format(string(S), "~q", [D]).
-encode_(T, F-As) :- compound(T), !,
+% An unbound output variable is None; variables inside a value are dicts
+% var:N (N numbering the row's variables from 1), which Python names _G<N>.
+encode_top_(_, _, V, @(none)) :- var(V), !.
+encode_top_(Vars, Depth, X, E) :- encode_(X, Vars, Depth, E).
+
+% Prolog -> Python, see the module comment. Depth: the levels of nesting
+% still allowed; a deeper value (or a cyclic one) throws neurosym_answer(deep),
+% an integer Python cannot print throws neurosym_answer(big_integer).
+encode_(V, Vars, _, _{var:N}) :- var(V), !, nth_var_(Vars, V, 1, N).
+encode_(X, _, _, X) :- atom(X), !.
+encode_(X, _, _, X) :- integer(X), !, small_enough_(X).
+encode_(X, _, _, X) :- number(X), !.
+encode_(X, _, _, X) :- string(X), !.
+encode_(_, _, 0, _) :- !, throw(neurosym_answer(deep)).
+encode_(L, Vars, D, E) :- is_list(L), !, D1 is D - 1, maplist(encode_el_(Vars, D1), L, E).
+encode_(D, _, _, S) :- is_dict(D), !, format(string(S), "~q", [D]).
+encode_(T, Vars, D, F-As) :- compound(T), !,
     compound_name_arguments(T, F, As0),
-    maplist(encode_, As0, As).
-encode_(X, S) :- format(string(S), "~q", [X]).
+    D1 is D - 1,
+    maplist(encode_el_(Vars, D1), As0, As).
+encode_(X, _, _, S) :- format(string(S), "~q", [X]).
+
+encode_el_(Vars, D, X, E) :- encode_(X, Vars, D, E).
+
+nth_var_([V0|Vs], V, I, N) :- ( V0 == V -> N = I ; I1 is I + 1, nth_var_(Vs, V, I1, N) ).
+
+% Python writes integers of up to 4,300 digits as text; 2^14284 has 4,300.
+small_enough_(X) :-
+    (   X > -(1 << 62), X < 1 << 62
+    ->  true
+    ;   msb(abs(X)) < 14284
+    ->  true
+    ;   throw(neurosym_answer(big_integer))
+    ).
 """
+
+SOURCE = _SOURCE + f"\nmax_depth_({MAX_DEPTH}).\n"

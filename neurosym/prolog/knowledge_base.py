@@ -27,7 +27,13 @@ Values cross the boundary as data, never as goal text:
 * outputs: atoms and strings -> ``str``, numbers -> ``int``/``float``,
   lists -> ``list``, compound terms -> :class:`~neurosym.terms.Term` (whose
   ``str()`` is the canonical text that recordings store, e.g.
-  ``picked(sword)``; lists inside a Term are tuples), unbound variables -> None.
+  ``picked(sword)``; lists inside a Term are tuples), an unbound output
+  variable -> None, an unbound variable inside a value ->
+  :class:`~neurosym.terms.Var` (``_G1``, shared within one answer).
+
+Values are at most :data:`~neurosym.terms.MAX_DEPTH` levels deep each way,
+integers in answers at most 4,300 digits (Python's limit for writing one);
+a deeper or larger value is refused with one line.
 
 Output variables are the goal's named variables that are not inputs; names
 starting with ``_`` are left out. Any Prolog error (syntax, unknown
@@ -62,7 +68,7 @@ from neurosym.errors import ConfigError, NeurosymError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
-from neurosym.terms import Term
+from neurosym.terms import MAX_DEPTH, Term, Var
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -70,9 +76,17 @@ if TYPE_CHECKING:
 PathArg = str | PathLike[str]
 _VARIABLE = re.compile(r"[A-Z_][A-Za-z0-9_]*")
 _SCALARS = frozenset({str, int, float, type(None)})
+_INT64_MAX = (1 << 63) - 1
+# A goal's nesting is bounded by its opening brackets; the C stack SWI-Prolog
+# parses it on holds far more than this many levels.
+_GOAL_BRACKETS = 10_000
 _ids = itertools.count(1)
 _bridge_lock = threading.Lock()
 _bridge_loaded = False
+
+
+MAX_TIMEOUT = 1e9
+"""The longest ``timeout`` a query takes, in seconds (about 32 years)."""
 
 
 class Answers(NamedTuple):
@@ -130,8 +144,10 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
-def _to_prolog(value: Any, name: str) -> Any:
+def _to_prolog(value: Any, name: str, depth: int = 0) -> Any:
     """Python input value -> what janus turns into the intended Prolog term."""
+    if depth > MAX_DEPTH:
+        raise ConfigError(f"input {name} is nested more than {MAX_DEPTH} levels deep")
     if isinstance(value, str):
         return value
     if isinstance(value, bool):
@@ -141,12 +157,13 @@ def _to_prolog(value: Any, name: str) -> Any:
     if isinstance(value, Term):
         if not value.args:
             return value.functor
-        return ("$neurosym_term", value.functor, [_to_prolog(a, name) for a in value.args])
+        args = [_to_prolog(a, name, depth + 1) for a in value.args]
+        return ("$neurosym_term", value.functor, args)
     if isinstance(value, list | tuple):
-        return [_to_prolog(v, name) for v in value]
+        return [_to_prolog(v, name, depth + 1) for v in value]
     kind = getattr(getattr(value, "dtype", None), "kind", None)
     if kind in ("b", "i", "u", "f", "U"):  # numpy scalars
-        return _to_prolog(value.item(), name)
+        return _to_prolog(value.item(), name, depth)
     if value is None:
         raise ConfigError(f"input {name} is None; leave it out to keep {name} a free variable")
     raise ConfigError(f"input {name}: cannot pass a {type(value).__name__} to Prolog")
@@ -161,6 +178,8 @@ def _from_prolog(value: Any) -> Any:
         return Term(functor, tuple(_from_prolog(a) for a in args))
     if isinstance(value, list):
         return [_from_prolog(v) for v in value]
+    if isinstance(value, dict):  # the bridge's var:N
+        return Var(f"_G{value['var']}")
     return value
 
 
@@ -170,8 +189,15 @@ def _bounds(
     """The query's bounds as ``Name-Value`` pairs for the bridge, checked."""
     out: list[tuple[str, float | int]] = []
     if timeout is not None:
-        if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
-            raise ConfigError(f"timeout must be a positive number of seconds, not {timeout!r}")
+        if (
+            isinstance(timeout, bool)
+            or not isinstance(timeout, int | float)
+            or not 0 < timeout <= MAX_TIMEOUT
+        ):
+            raise ConfigError(
+                f"timeout must be a positive number of seconds up to {MAX_TIMEOUT:.0e} "
+                f"(a year is 3e7), not {timeout!r}"
+            )
         out.append(("timeout", float(timeout)))
     for name, value, floor in (
         ("inferences", inferences, 1),
@@ -179,8 +205,14 @@ def _bounds(
     ):
         if value is None:
             continue
-        if isinstance(value, bool) or not isinstance(value, int) or value < floor:
-            raise ConfigError(f"{name} must be an integer of at least {floor}, not {value!r}")
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int)
+            or not floor <= value <= _INT64_MAX
+        ):
+            raise ConfigError(
+                f"{name} must be an integer of at least {floor} and at most 2**63-1, not {value!r}"
+            )
         out.append(("inferences" if name == "inferences" else "stack", value))
     return out
 
@@ -482,6 +514,11 @@ class KnowledgeBase:
         if not isinstance(goal, str) or not goal.strip():
             raise ConfigError(
                 f"the goal must be Prolog text such as 'object(Id, Type)', not {goal!r}"
+            )
+        if sum(map(goal.count, "([{")) > _GOAL_BRACKETS:
+            raise ConfigError(
+                f"the goal holds more than {_GOAL_BRACKETS:,} opening brackets; "
+                "pass large values as inputs (keyword arguments), not as goal text"
             )
         return goal
 
