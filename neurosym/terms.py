@@ -39,7 +39,7 @@ from typing import TypeAlias
 
 from neurosym.errors import FactError
 
-MAX_DEPTH = 200
+MAX_DEPTH = 100
 """The deepest nesting of a term that passes between Prolog and Python (facts, answers, inputs)."""
 
 _SOLO_ATOM = re.compile(r"[a-z][A-Za-z0-9_]*")
@@ -114,8 +114,10 @@ class Term:
             return atom_text(self.functor)
         if len(self.args) == 2 and self.functor in _RESERVED_PAIRS:
             raise FactError(_RESERVED_PAIRS[self.functor])
-        inner = ",".join(format_value(a) for a in self.args)
-        return f"{atom_text(self.functor)}({inner})"
+        parts = []
+        for arg in self.args:  # a loop, not a generator: one Python frame per level
+            parts.append(format_value(arg))
+        return f"{atom_text(self.functor)}({','.join(parts)})"
 
 
 # Binary functors whose text SWI-Prolog 7+ reads as something else.
@@ -146,7 +148,10 @@ def format_value(value: object) -> str:
     if isinstance(value, float):
         return float_text(value)
     if isinstance(value, tuple | list):
-        return "[" + ",".join(format_value(v) for v in value) + "]"
+        parts = []
+        for item in value:
+            parts.append(format_value(item))
+        return "[" + ",".join(parts) + "]"
     # numpy scalars and the like, without importing numpy here
     kind = getattr(getattr(value, "dtype", None), "kind", None)
     if kind == "b":

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -393,3 +394,50 @@ def test_cli_timeout_and_limits(run_neurosym, tmp_path: Path) -> None:
         assert proc.stderr.startswith(f"neurosym query: error: {message}"), proc.stderr
     help_text = run_neurosym("query", "--help").stdout
     assert "--timeout SECONDS" in help_text and "(default: none)" in help_text
+
+
+# --- facts that would bring the process down --------------------------------------
+
+
+def _nested(depth: int) -> str:
+    return "f(" * depth + "x" + ")" * depth
+
+
+@pytest.mark.parametrize("depth", [101, 50_000])
+def test_a_deeply_nested_fact_is_refused_and_python_lives_on(tmp_path: Path, depth: int) -> None:
+    """Parsed past the C stack, such a fact killed the process (SIGSEGV): nothing printed."""
+    path = tmp_path / "kb.pl"
+    path.write_text(f"ok(1).\nobject(a, {_nested(depth)}).\n")
+    code = (
+        "import sys\nfrom neurosym.prolog.knowledge_base import KnowledgeBase\n"
+        "from neurosym.errors import PrologError\n"
+        f"try:\n    KnowledgeBase({str(path)!r})\nexcept PrologError as exc:\n    print(exc)\n"
+        "print('alive')\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
+    assert proc.returncode == 0, proc.stderr
+    first, alive = proc.stdout.splitlines()
+    assert first.startswith(f"cannot load {path}:2: found a term nested more than 100 levels deep")
+    assert alive == "alive"
+
+
+def test_a_fact_100_levels_deep_loads(tmp_path: Path) -> None:
+    path = tmp_path / "kb.pl"
+    path.write_text(f"object(a, {_nested(99)}).\nlist([{','.join(['g(1)'] * 5000)}]).\n")
+    with KnowledgeBase(path) as kb:
+        assert str(kb.once("object(a, X)")["X"]).count("f(") == 99
+        assert len(kb.once("list(L)")["L"]) == 5000
+
+
+def test_text_that_is_not_utf8_is_refused_in_one_line(run_neurosym, tmp_path: Path) -> None:
+    path = tmp_path / "kb.pl"
+    path.write_bytes(b"object(a, b).\nobject(\xff\xfe, \x80).\n")
+    proc = run_neurosym("query", "--kb", path, "object(X, Y)")
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}: ")
+    assert "Illegal UTF-8 start" in proc.stderr
+    latin = tmp_path / "latin.pl"
+    latin.write_bytes(b":- encoding(iso_latin_1).\nobject(a, '\xe9t\xe9').\n")
+    with KnowledgeBase(latin) as kb:  # a file that says its encoding reads as it says
+        assert kb.query("object(a, X)") == [{"X": "été"}]

@@ -35,10 +35,12 @@ file is read front to back; ``set_reader_threads/1`` overrides the choice
 
 from __future__ import annotations
 
+from neurosym.terms import MAX_DEPTH
+
 MODULE = "neurosym_facts"
 
-SOURCE = r"""
-:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1, set_reader_threads/1]).
+_SOURCE = r"""
+:- module(neurosym_facts, [load_facts/7, set_chunk_bytes/1, set_reader_threads/1]).
 :- use_module(library(lists), [member/2, append/3]).
 :- use_module(library(apply), [exclude/3]).
 :- use_module(library(error), [must_be/2]).
@@ -71,21 +73,70 @@ set_chunk_bytes(Bytes) :-
     retractall(chunk_bytes_(_)),
     assertz(chunk_bytes_(Bytes)).
 
-%!  load_facts(+Module, +File, +Mode, +RuleFiles, -Count, -Status) is det.
+%!  load_facts(+Module, +File, +Mode, +RuleFiles, +CStack, -Count, -Status) is det.
 %   Mode: assert or check. RuleFiles: the source ids of the KB's rule files.
-%   Count: terms read. Status: ok or error-Text.
-load_facts(M, File, Mode, RuleFiles, Count, Status) :-
-    retractall(touched_(_, _, _)),
+%   CStack: bytes of C stack for the threads that read File. Count: terms
+%   read. Status: ok or error-Text.
+%
+%   Embedded in Python, SWI-Prolog runs without its signal handlers, and
+%   these are what turn a C-stack overflow into an error: parsing a term
+%   nested deeper than the C stack holds would kill the process. So File is
+%   read in a thread of its own whose C stack holds more levels than File has
+%   opening brackets (the caller counts them, in a copy nobody else writes).
+load_facts(M, File, Mode, RuleFiles, CStack, Count, Status) :-
+    catch(thread_create(load_facts_(M, File, Mode, RuleFiles, CStack), Id, [c_stack(CStack)]),
+          E, true),
+    (   nonvar(E)
+    ->  Count = 0, message_(E, File, Text), Status = error-Text
+    ;   thread_join(Id, Exit),
+        (   Exit = exited(Count-Status)
+        ->  true
+        ;   Count = 0, message_(Exit, File, Text), Status = error-Text
+        )
+    ).
+
+load_facts_(M, File, Mode, RuleFiles, CStack) :-
+    thread_self(Me),
+    assertz(reading_(Me)),
     b_setval(neurosym_rule_files, RuleFiles),
-    catch(load_(M, File, Mode, RuleFiles, Count), E, true),
+    b_setval(neurosym_c_stack, CStack),
+    catch(( load_(M, File, Mode, RuleFiles, Count0), no_warnings_(Me) ), E, true),
     (   var(E)
-    ->  Status = ok
+    ->  Count = Count0, Status = ok
     ;   Count = 0,
         ( Mode == assert -> rollback_(M) ; true ),
         message_(E, File, Text),
         Status = error-Text
     ),
-    retractall(touched_(_, _, _)).
+    retractall(warned_(Me, _)),
+    thread_exit(Count-Status).
+
+% Anything SWI-Prolog warns about while reading (text that is not valid in
+% the file's encoding, above all) refuses the file: a warning printed on the
+% way would be the only sign that facts were read wrong.
+:- thread_local reading_/1.   % reading_(Owner): this thread reads for load thread Owner
+:- dynamic warned_/2.         % warned_(Owner, Text): the first warning of a load
+
+:- multifile user:message_hook/3.
+:- dynamic user:message_hook/3.
+user:message_hook(_Term, Kind, Lines) :-
+    ( Kind == warning ; Kind == error ),
+    neurosym_facts:reading_(Owner),
+    !,
+    neurosym_facts:note_warning_(Owner, Lines).
+
+note_warning_(Owner, Lines) :-
+    (   warned_(Owner, _)
+    ->  true
+    ;   lines_text_(Lines, Text),
+        assertz(warned_(Owner, Text))
+    ).
+
+no_warnings_(Owner) :-
+    (   warned_(Owner, Text)
+    ->  throw(neurosym_warned(Text))
+    ;   true
+    ).
 
 % A large file is cut at line starts into one chunk per core; helper threads
 % read and check chunks 1.. into lists while this thread reads chunk 0 and
@@ -130,7 +181,9 @@ start_helpers_(Cuts, File, M, RuleFiles, Helpers) :-
 start_helpers_([], _, _, _, _, []).
 start_helpers_([From|Fs], [_, To|Ts], File, M, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
     message_queue_create(Q, [max_size(64)]),
-    thread_create(read_chunk_(File, M, RuleFiles, Q, From, To), Id, []),
+    b_getval(neurosym_c_stack, CStack),
+    thread_self(Owner),
+    thread_create(read_chunk_(Owner, File, M, RuleFiles, Q, From, To), Id, [c_stack(CStack)]),
     start_helpers_(Fs, [To|Ts], File, M, RuleFiles, Hs).
 
 % A helper blocked on its full queue is woken by the queue's destruction.
@@ -145,7 +198,8 @@ stop_helpers_(Helpers) :-
 % the byte after the last term (eof at the end of the file); it stops at
 % anything but plain facts, so the main thread reads that part itself.
 % Small batches keep the helper's stacks (and its garbage collections) small.
-read_chunk_(File, M, RuleFiles, Q, From, To) :-
+read_chunk_(Owner, File, M, RuleFiles, Q, From, To) :-
+    assertz(reading_(Owner)),
     b_setval(neurosym_rule_files, RuleFiles),
     catch(setup_call_cleanup(
               ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
@@ -168,7 +222,7 @@ chunk_batches_(S, M, Q, To, PName, PArity) :-
 % Up to K terms; End0 is more, eof, or the byte position past To.
 chunk_terms_(_, _, _, PName, PArity, 0, [], PName, PArity, more) :- !.
 chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    read_(S, 0, T, QQ),
     (   T == end_of_file
     ->  Terms = [], LName = PName, LArity = PArity, End = eof
     ;   QQ == [],
@@ -241,10 +295,11 @@ add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
 % Like read_loop_, stopping after the term that reaches byte Stop: End is
 % that byte position, or eof.
 read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    N1 is N0 + 1,
+    read_(S, N1, T, QQ),
     (   T == end_of_file
     ->  N = N0, LName = PName, LArity = PArity, End = eof
-    ;   N1 is N0 + 1,
+    ;
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
         ;   same_(T, PName, PArity)
@@ -270,10 +325,11 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
 % The tight loop: a fact of the same predicate as the previous one needs no
 % check beyond its functor and groundness; a new functor goes through check_/7 once.
 read_loop_(S, M, Mode, PName, PArity, N0, N) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    N1 is N0 + 1,
+    read_(S, N1, T, QQ),
     (   T == end_of_file
     ->  N = N0
-    ;   N1 is N0 + 1,
+    ;
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
         ;   same_(T, PName, PArity)
@@ -285,6 +341,38 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
         ;   ( Mode == assert -> assertz(M:T) ; true ),
             read_loop_(S, M, Mode, Name, Arity, N1, N)
         )
+    ).
+
+%   read_(+S, +N, -T, -QQ): the N-th term of S (end_of_file at the end), refused
+%   when nested more than max_depth_/1 levels deep. Each level takes at least
+%   one opening bracket, so only a term whose text is longer than that limit
+%   is measured. The parse itself is safe: the reading thread's C stack holds
+%   the file's every bracket (load_facts/7).
+read_(S, N, T, QQ) :-
+    byte_count(S, B0),
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    byte_count(S, B),
+    max_depth_(D),
+    (   B - B0 =< D
+    ->  true
+    ;   shallow_(T, D)
+    ->  true
+    ;   format(atom(What), 'a term nested more than ~D levels deep', [D]),
+        refuse_(N, What, T)
+    ).
+
+%   shallow_(+T, +D): T is nested at most D levels deep (a compound or a
+%   proper list is one level, as the bridge counts answers).
+shallow_(T, D) :-
+    (   compound(T)
+    ->  D > 0,
+        D1 is D - 1,
+        (   is_list(T)
+        ->  forall(member(X, T), shallow_(X, D1))
+        ;   compound_name_arguments(T, _, As),
+            forall(member(A, As), shallow_(A, D1))
+        )
+    ;   true
     ).
 
 %   same_(+T, +Name, +Arity): T is a ground fact of the predicate just checked.
@@ -462,6 +550,9 @@ message_(neurosym_refused(N, What, Term), File, Text) :- !,
            "~w:~w: found ~w: ~w; a fact file holds only ground facts such as p(a, 1). and the \c
             writer's :- encoding/dynamic headers (load code as rules, or trust the file)",
            [File, Line, What, Shown]).
+message_(neurosym_warned(Warning), File, Text) :- !,
+    format(string(Text), "~w: ~w (a fact file is UTF-8 text, or says :- encoding(Enc). first)",
+           [File, Warning]).
 message_(error(syntax_error(What), Context), File, Text) :- !,
     (   catch('$messages':translate_message(error(syntax_error(What), _), Lines, []), _, fail),
         lines_text_(Lines, Msg)
@@ -507,3 +598,5 @@ nth_term_line_(S, N, Line) :-
         nth_term_line_(S, N1, Line)
     ).
 """
+
+SOURCE = _SOURCE + f"\nmax_depth_({MAX_DEPTH}).\n"

@@ -68,6 +68,7 @@ from neurosym.errors import ConfigError, NeurosymError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
+from neurosym.prolog.snapshot import Snapshot, snapshot
 from neurosym.terms import MAX_DEPTH, Term, Var
 
 if TYPE_CHECKING:
@@ -80,6 +81,11 @@ _INT64_MAX = (1 << 63) - 1
 # A goal's nesting is bounded by its opening brackets; the C stack SWI-Prolog
 # parses it on holds far more than this many levels.
 _GOAL_BRACKETS = 10_000
+# The C stack of the threads that read a fact file: parsing takes about 300
+# bytes of it per level of nesting, and no term nests deeper than the file has
+# opening brackets (reserved, not used: the memory is taken only as needed).
+_C_STACK_BASE = 16 << 20
+_C_STACK_PER_BRACKET = 1024
 _ids = itertools.count(1)
 _bridge_lock = threading.Lock()
 _bridge_loaded = False
@@ -175,9 +181,15 @@ def _from_prolog(value: Any) -> Any:
         return value
     if isinstance(value, tuple):
         functor, args = value
-        return Term(functor, tuple(_from_prolog(a) for a in args))
+        for i, arg in enumerate(args):  # a loop, not a generator: one Python frame per level
+            if type(arg) not in _SCALARS:
+                args[i] = _from_prolog(arg)
+        return Term(functor, tuple(args))
     if isinstance(value, list):
-        return [_from_prolog(v) for v in value]
+        for i, item in enumerate(value):
+            if type(item) not in _SCALARS:
+                value[i] = _from_prolog(item)
+        return value
     if isinstance(value, dict):  # the bridge's var:N
         return Var(f"_G{value['var']}")
     return value
@@ -331,16 +343,29 @@ class KnowledgeBase:
             errors, notes = self._load_file(path, "qlf")
         self._finish(path, errors, notes)
 
-    def _read_facts(self, path: Path, mode: str) -> int:
-        """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms."""
+    def _read_facts(self, path: Path, mode: str, copy: Snapshot | None = None) -> int:
+        """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms.
+
+        The file is read from a private copy (``copy``, or one made here), so
+        that what is checked is what is loaded.
+        """
+        if copy is None:
+            with snapshot(path) as copy:
+                return self._read_facts(path, mode, copy)
         answer = _call_once(
-            f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, Count, Status)",
-            {"M": self.module, "File": str(path), "Mode": mode, "Rules": self._rule_ids},
+            f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, CStack, Count, Status)",
+            {
+                "M": self.module,
+                "File": str(copy.path),
+                "Mode": mode,
+                "Rules": self._rule_ids,
+                "CStack": _C_STACK_BASE + _C_STACK_PER_BRACKET * copy.brackets,
+            },
         )
         status = answer["Status"]
         if status != "ok":
             _, text = status
-            raise PrologError(f"cannot load {self._clean(text)}")
+            raise PrologError(f"cannot load {self._clean(text.replace(str(copy.path), str(path)))}")
         return int(answer["Count"])
 
     def _finish(self, path: Path, errors: list[str], notes: list[str]) -> None:
