@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from neurosym.errors import ConfigError, PrologError
+from neurosym.errors import ConfigError, NeurosymError, PrologError
 from neurosym.export.prolog_writer import write_prolog
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.prolog.signature import signature_path
@@ -441,3 +441,105 @@ def test_text_that_is_not_utf8_is_refused_in_one_line(run_neurosym, tmp_path: Pa
     latin.write_bytes(b":- encoding(iso_latin_1).\nobject(a, '\xe9t\xe9').\n")
     with KnowledgeBase(latin) as kb:  # a file that says its encoding reads as it says
         assert kb.query("object(a, X)") == [{"X": "été"}]
+
+
+# --- read once: what is checked is what is compiled and loaded ---------------------
+
+
+def test_a_source_swapped_after_its_check_is_not_compiled(
+    tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A writer on a shared drive swaps the file between the check and the compile."""
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    checked = KnowledgeBase._read_facts
+
+    def check_then_swap(self, path, mode, copy=None):
+        count = checked(self, path, mode, copy)
+        if mode == "check":
+            source.write_text(f"ok(666).\n:- initialization({_touch(marker)}).\n")
+        return count
+
+    monkeypatch.setattr(KnowledgeBase, "_read_facts", check_then_swap)
+    with KnowledgeBase(source, qlf=True) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]  # the bytes that were checked
+    assert not marker.exists()
+    monkeypatch.undo()
+    with pytest.raises(PrologError, match=rf"^cannot load {source}:2: found a directive"):
+        KnowledgeBase(source, qlf=True)  # the .qlf is not the new source's: that is checked again
+    assert not marker.exists()
+
+
+def test_a_qlf_swapped_after_its_signature_check_is_not_loaded(
+    swipl: Path, tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    with KnowledgeBase(source, qlf=True) as kb:  # compiled and signed
+        assert kb.query("ok(X)") == [{"X": 1}]
+    evil = _attacker_qlf(swipl, tmp_path, marker, stem="evil")
+    from neurosym.prolog import signature
+
+    checked = signature.check_digests
+
+    def check_then_swap(*args, **kwargs):
+        reason = checked(*args, **kwargs)
+        if evil.exists():
+            os.replace(evil, source.with_suffix(".qlf"))
+        return reason
+
+    monkeypatch.setattr(signature, "check_digests", check_then_swap)
+    with KnowledgeBase(source, qlf=True) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]  # the bytes whose signature was checked
+    assert not marker.exists()
+    monkeypatch.undo()
+    with pytest.raises(PrologError, match="it is not the file kb.qlf.sig signed"):
+        KnowledgeBase(source.with_suffix(".qlf"))  # the swapped-in .qlf, loaded directly
+    assert not marker.exists()
+
+
+def test_a_read_only_folder_for_qlf_is_one_line(
+    run_neurosym, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    import tempfile
+
+    made = tempfile.mkstemp
+
+    def read_only(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir) == tmp_path:
+            raise OSError(30, "Read-only file system")
+        return made(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    with pytest.raises(NeurosymError) as info:
+        KnowledgeBase(source, qlf=True)
+    assert str(info.value) == (
+        f"cannot write {source.with_suffix('.qlf')}: Read-only file system; it was left as it "
+        "was; load kb.pl without --qlf (qlf=False)"
+    )
+    assert not source.with_suffix(".qlf").exists()
+
+
+def test_a_qlf_loaded_directly_is_the_checked_bytes(
+    swipl: Path, tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    with KnowledgeBase(source, qlf=True):
+        pass
+    evil = _attacker_qlf(swipl, tmp_path, marker, stem="evil")
+    from neurosym.prolog import signature
+
+    checked = signature.check_digests
+
+    def check_then_swap(*args, **kwargs):
+        reason = checked(*args, **kwargs)
+        os.replace(evil, source.with_suffix(".qlf"))
+        return reason
+
+    monkeypatch.setattr(signature, "check_digests", check_then_swap)
+    with KnowledgeBase(source.with_suffix(".qlf")) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]
+    assert not marker.exists()

@@ -64,7 +64,7 @@ from os import PathLike
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from neurosym.errors import ConfigError, NeurosymError, PrologError
+from neurosym.errors import ConfigError, NeurosymError, OutputError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
@@ -292,15 +292,10 @@ class KnowledgeBase:
         self._check_open()
         path = _existing(path)
         if path.suffix == ".qlf":
-            if not trusted:
-                reason = signature.check(path)
-                if reason is not None:
-                    raise PrologError(
-                        f"cannot load {path}: a .qlf is compiled code and this one was not "
-                        f"compiled by neurosym on this account ({reason}); load its .pl source "
-                        f"instead, or trust the file (--trust {path.name} / trusted=True)"
-                    )
-            self._finish(path, *self._load_file(path, "qlf"))
+            if trusted:
+                self._finish(path, *self._load_file(path, "qlf"))
+            else:
+                self._load_signed_qlf(path)
         elif qlf:
             self._load_through_qlf(path, trusted)
         elif trusted:
@@ -308,6 +303,18 @@ class KnowledgeBase:
         else:
             self._read_facts(path, "assert")
             self.files.append(path)
+
+    def _load_signed_qlf(self, path: Path) -> None:
+        """Load a ``.qlf`` from a private copy of the very bytes whose signature was checked."""
+        with snapshot(path) as copy:
+            reason = signature.check_digests(path, copy.sha256)
+            if reason is not None:
+                raise PrologError(
+                    f"cannot load {path}: a .qlf is compiled code and this one was not "
+                    f"compiled by neurosym on this account ({reason}); load its .pl source "
+                    f"instead, or trust the file (--trust {path.name} / trusted=True)"
+                )
+            self._finish(path, *self._load_file(path, "qlf", data=copy.path))
 
     def load_rules(self, path: PathArg) -> None:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
@@ -327,21 +334,43 @@ class KnowledgeBase:
         self._rule_ids.extend([*self._source_ids[before:], str(path)])
 
     def _load_through_qlf(self, path: Path, trusted: bool) -> None:
-        if trusted:
-            compiled = not is_fresh(path)
-        else:
-            compiled = signature.check(qlf_path(path), source=path) is not None
-            if compiled:
-                self._read_facts(path, "check")  # nothing of an unchecked source is compiled
-        if compiled:
-            qcompile(path)
-        errors, notes = self._load_file(path, "qlf")
-        if errors and not compiled:  # e.g. a .qlf from another SWI-Prolog version
-            if not trusted:
-                self._read_facts(path, "check")
-            qcompile(path)
+        """Load ``path`` through its ``.qlf``, compiled first when that one will not do.
+
+        The source is read once, into a private copy: that copy is hashed,
+        checked as data and compiled, so the ``.qlf`` comes from the very
+        bytes that were checked; a signed ``.qlf`` is loaded from a private
+        copy of the bytes whose signature was checked.
+        """
+        target = qlf_path(path)
+        if trusted and is_fresh(path):
             errors, notes = self._load_file(path, "qlf")
+            if not errors:
+                self._finish(path, errors, notes)
+                return
+        with snapshot(path) as source:
+            if not trusted and self._load_qlf_if_signed(path, target, source.sha256):
+                return
+            if not trusted:
+                self._read_facts(path, "check", source)  # nothing of an unchecked source is compiled
+            try:
+                qcompile(source.path, target=target)
+            except OutputError as exc:
+                raise OutputError(f"{exc}; load {path.name} without --qlf (qlf=False)") from None
+            built = qlf_path(source.path)  # the private .qlf just copied to target
+            self._finish(path, *self._load_file(path, "qlf", data=built))
+
+    def _load_qlf_if_signed(self, path: Path, target: Path, source_sha: str) -> bool:
+        """Load ``target`` when its signature vouches for it and ``source_sha``; False otherwise."""
+        if not target.is_file():
+            return False
+        with snapshot(target) as copy:
+            if signature.check_digests(target, copy.sha256, source_sha, path.name) is not None:
+                return False
+            errors, notes = self._load_file(path, "qlf", data=copy.path)
+        if errors:  # e.g. a .qlf of another SWI-Prolog version: compiled again
+            return False
         self._finish(path, errors, notes)
+        return True
 
     def _read_facts(self, path: Path, mode: str, copy: Snapshot | None = None) -> int:
         """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms.
@@ -377,17 +406,22 @@ class KnowledgeBase:
             warnings.warn(note, PrologWarning, stacklevel=3)
         self.files.append(path)
 
-    def _load_file(self, path: Path, fmt: str) -> tuple[list[str], list[str]]:
-        """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error."""
+    def _load_file(
+        self, path: Path, fmt: str, data: Path | None = None
+    ) -> tuple[list[str], list[str]]:
+        """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error.
+
+        ``data``: the file to read the bytes from (a private copy), when not ``path`` itself.
+        """
         if fmt == "qlf":
-            load_file = qlf_path(path)
+            load_file = data or qlf_path(path)
             # A per-module directory: SWI-Prolog relocates the .qlf's recorded
             # source path into it, so each KB owns its own copy of the clauses.
             source_id = f"{path.parent}/.{self.module}/{load_file.name}"
             clause_source = f"{path.parent}/.{self.module}/{path.stem}.pl"
             aliases = {clause_source: str(path.with_suffix(".pl")), source_id: str(path)}
         else:
-            load_file = path
+            load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
         answer = _call_once(
