@@ -135,6 +135,27 @@ def test_the_table_shows_data_as_text(run_neurosym, tmp_path: Path) -> None:
     assert "[x,y]" in proc.stdout
 
 
+def test_sword_enemy_link_prints_its_list(run_neurosym, tmp_path: Path) -> None:
+    from conftest import REPO
+
+    facts = tmp_path / "kb.pl"
+    facts.write_text(
+        ":- dynamic attention/6.\nobject(s1, sword).\nobject(e1, enemy).\n"
+        "holds(0, 1, r(1), sword, agent).\nholds(0, 1, r(1), agent, enemy).\n"
+    )
+    proc = run_neurosym("query", "--kb", facts, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(How)")
+    assert proc.returncode == 0, proc.stderr
+    assert "indirect([agent])" in proc.stdout
+
+
+def test_json_writes_infinities_as_text(run_neurosym, tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    proc = run_neurosym("query", "--kb", facts, "--format", "json", "X is inf, Y is -inf, Z is nan")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == [{"X": "inf", "Y": "-inf", "Z": "nan"}]
+
+
 def test_answers_holding_variables_print_with_names(run_neurosym, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")

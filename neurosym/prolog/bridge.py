@@ -17,7 +17,12 @@ package without any package-data settings. What it does, and why in Prolog:
   variable name (values never pass through goal text), runs it under
   ``limit/2`` and returns every answer in one call, each value encoded so
   janus converts it unambiguously: atoms and strings -> str, numbers, lists
-  -> list, compounds -> ``Functor-Args`` (a Python tuple), unbound -> None.
+  -> list, compounds -> ``Functor-Args`` (a Python tuple), an unbound output
+  -> None, a variable inside a value -> the dict ``var:N``. Values nested
+  deeper than ``max_depth_/1`` (or cyclic) and integers of more than 4,300
+  digits are refused with one line: Python could not take them.
+* the goal text must be one goal: a variable, a number or text after its
+  full stop is refused with one line.
 """
 
 from __future__ import annotations

@@ -29,6 +29,7 @@ import argparse
 import csv
 import io
 import json
+import math
 import os
 import signal
 import sys
@@ -136,9 +137,12 @@ def _bindings(specs: list[str]) -> dict[str, Any]:
 
 
 def _plain(value: Any) -> Any:
-    """JSON/CSV-friendly value: compound terms become their Prolog text."""
+    """JSON-friendly value: compound terms become their Prolog text, as do
+    infinities and NaN (JSON has no number for them)."""
     if isinstance(value, list):
         return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
     if isinstance(value, str | int | float) or value is None:
         return value
     return str(value)
@@ -160,7 +164,7 @@ def render(names: list[str], answers: list[dict[str, Any]], fmt: str) -> str:
     """
     if fmt == "json":
         rows = [{k: _plain(v) for k, v in a.items()} for a in answers]
-        return json.dumps(rows, ensure_ascii=False) + "\n"
+        return json.dumps(rows, ensure_ascii=False, allow_nan=False) + "\n"
     if fmt == "csv":
         out = io.StringIO()
         writer = csv.writer(out, lineterminator="\n")

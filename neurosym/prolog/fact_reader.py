@@ -5,22 +5,37 @@ run it. Consulting a file runs its directives (``:- shell(...)``) and lets
 it define ``term_expansion/2`` and other hooks; this reader never consults.
 It reads the file term by term with ``read_term/3`` (syntax errors raise,
 nothing is expanded, quasi-quotations are returned unparsed so no parser
-runs, and a term holding one is refused) and accepts only:
+runs, and a term holding one is refused) and admits only what has the shape
+of a fact, rather than refusing a list of known bad forms (so that a
+clause-like form SWI-Prolog adds one day, as it added ``Head => Body``, is
+refused too):
 
-* facts: a callable term that is not a directive, not ``Head :- Body``, not
-  a grammar rule, not module-qualified, and whose predicate is not built in,
-  not a hook (``term_expansion``, ``goal_expansion``, ``portray``,
-  ``message_hook``, ...), not autoloadable from the library, and not defined
-  by the KB's rule files (static) or imported into its module;
+* facts: a ground atom or compound whose name is a plain predicate name
+  (a lowercase letter, then letters, digits, underscores: never an operator
+  such as ``:-``, ``=>``, ``-->`` or ``:``, never a quoted name), nested at
+  most :data:`~neurosym.terms.MAX_DEPTH` levels, and whose predicate is not
+  built in, not a hook (``term_expansion``, ``goal_expansion``,
+  ``portray``, ``message_hook``, ...), not autoloadable from the library,
+  and not defined by the KB's rule files (static) or imported into its
+  module;
 * the headers neurosym's writer emits: ``:- encoding(Enc).`` (applied to the
   stream) and ``:- dynamic Name/Arity, ...`` (the same checks on each
   predicate).
+
+A file SWI-Prolog warns about while reading it (text that is not valid
+UTF-8, or not valid in the encoding it declares) is refused too. Files are
+read in a thread of their own whose C stack holds a level of nesting for
+every opening bracket of the file: embedded in Python, SWI-Prolog has no
+guard against C-stack overflow, and a term nested 50,000 deep killed the
+process.
 
 Anything else stops the load with ``error-Text``, one line naming file, line
 and what was found. Clauses are added with ``assertz/1`` as they are read;
 a refusal further down erases what this file added, so a refused file
 leaves the KB as it was. With mode ``check`` nothing is asserted (used
-before compiling a source to ``.qlf``). Reading is the cost (``read_term``
+before compiling a source to ``.qlf``). The caller passes a private copy of
+the file (:mod:`neurosym.prolog.snapshot`), so the bytes checked are the
+bytes loaded or compiled. Reading is the cost (``read_term``
 takes about 1.5 us a fact here, consult about 10), so on a machine with 4
 cores or more, files of 8 MB and more are cut at line starts and read by one
 helper thread per core (up to 4 threads in all) in small checked batches,

@@ -2,11 +2,14 @@
 
 Fact files are data, rule files are code (docs/design.md, "Prolog"). A KB is
 something people pass around, so a fact file is never consulted: it is read
-term by term (:mod:`neurosym.prolog.fact_reader`) and only facts and the
-writer's ``:- encoding``/``:- dynamic`` headers are accepted; anything else
-(directives, rules, hooks, built-in or rule-defined predicates) is refused
-with one line naming file and line, and nothing of the file has run or
-stays loaded. Rule files (``rules=``) are consulted as code, before the
+term by term (:mod:`neurosym.prolog.fact_reader`) and only ground facts
+with plain predicate names and the writer's ``:- encoding``/``:- dynamic``
+headers are admitted; anything else (directives, rules of any kind, hooks,
+built-in or rule-defined predicates, terms nested deeper than
+:data:`~neurosym.terms.MAX_DEPTH`, text that is not UTF-8) is refused with one
+line naming file and line, and nothing of the file has run or stays loaded.
+Every file is read once, into a private copy, and checked, loaded and
+compiled from that copy only (:mod:`neurosym.prolog.snapshot`). Rule files (``rules=``) are consulted as code, before the
 facts, so facts for a predicate the rules define are refused. ``trusted=``
 (True, or the fact files to trust) consults fact files as code. A ``.qlf``
 is compiled code and loads only when neurosym signed it on this account
