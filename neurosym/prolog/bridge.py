@@ -6,7 +6,7 @@ package without any package-data settings. What it does, and why in Prolog:
 * ``new_kb/1`` makes a temporary module whose default is ``system`` (not
   ``user``), so a KB sees library predicates but nothing someone else put in
   ``user``; ``close_kb/2`` unloads its files and destroys the module.
-* ``load/5`` loads one file into a KB module under a per-module source id,
+* ``load/6`` loads one file into a KB module under a per-module source id,
   because SWI-Prolog refuses (or silently reconsults) one non-module file in
   two modules. Predicates already loaded are declared multifile first, so
   several fact files add up instead of replacing each other. Errors and
@@ -32,7 +32,7 @@ from neurosym.terms import MAX_DEPTH
 MODULE = "neurosym_bridge"
 
 _SOURCE = r"""
-:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/8, count/7]).
+:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/6, solve/8, count/7]).
 :- use_module(library(time), [call_with_time_limit/2]).
 :- use_module(library(solution_sequences), [limit/2]).
 :- use_module(library(apply), [maplist/3, exclude/3, partition/4]).
@@ -86,23 +86,39 @@ new_kb(M) :-
     set_prolog_flag(M:unknown, error).
 
 %!  close_kb(+Module, +Files) is det.
-%   Files: the source ids load/5 used. Not every file loaded with context M:
+%   Files: the source ids load/6 used. Not every file loaded with context M:
 %   libraries autoloaded from M are shared with everyone else.
 close_kb(M, Files) :-
     forall(member(File, Files), catch(unload_file(File), _, true)),
     retractall(system:'$load_context_module'(_, M, _)),
     '$destroy_module'(M).
 
-%!  load(+Module, +Id, +File, +Format, -Messages) is det.
-%   Messages: list of Kind-Text, Kind error or warning.
-load(M, Id, File, Format, Messages) :-
+%!  load(+Module, +Id, +File, +Format, +CStack, -Messages) is det.
+%   Messages: list of Kind-Text, Kind error or warning. The file is loaded
+%   in a thread whose C stack is CStack bytes (the caller sizes it by the
+%   file's opening brackets): embedded in Python, SWI-Prolog has no guard
+%   against C-stack overflow, and a deeply nested term would kill the process.
+load(M, Id, File, Format, CStack, Messages) :-
+    catch(thread_create(load_thread_(M, Id, File, Format), T, [c_stack(CStack)]), E, true),
+    (   nonvar(E)
+    ->  error_text_(E, Text), Messages = [error-Text]
+    ;   thread_join(T, Exit),
+        (   Exit = exited(Messages)
+        ->  true
+        ;   format(string(Text), "~w: loading stopped: ~q", [File, Exit]),
+            Messages = [error-Text]
+        )
+    ).
+
+load_thread_(M, Id, File, Format) :-
     retractall(collected_(_, _)),
     multifile_loaded_(M),
     setup_call_cleanup(
         assertz(collecting_),
         catch(load_(M, Id, File, Format), E, print_message(error, E)),
         retractall(collecting_)),
-    findall(Kind-Text, retract(collected_(Kind, Text)), Messages).
+    findall(Kind-Text, retract(collected_(Kind, Text)), Messages),
+    thread_exit(Messages).
 
 % Several files of one KB add up: without this a second file with clauses
 % for relation/7 would silently replace those of the first.

@@ -71,7 +71,7 @@ from neurosym.errors import ConfigError, NeurosymError, OutputError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
-from neurosym.prolog.snapshot import Snapshot, snapshot
+from neurosym.prolog.snapshot import Snapshot, count_brackets, snapshot
 from neurosym.terms import MAX_DEPTH, Term, Var
 
 if TYPE_CHECKING:
@@ -427,9 +427,16 @@ class KnowledgeBase:
             load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
+        c_stack = _C_STACK_BASE + _C_STACK_PER_BRACKET * count_brackets(load_file)
         answer = _call_once(
-            f"{bridge.MODULE}:load(M, Id, File, Format, Messages)",
-            {"M": self.module, "Id": source_id, "File": str(load_file), "Format": fmt},
+            f"{bridge.MODULE}:load(M, Id, File, Format, CStack, Messages)",
+            {
+                "M": self.module,
+                "Id": source_id,
+                "File": str(load_file),
+                "Format": fmt,
+                "CStack": c_stack,
+            },
         )
         errors, notes = [], []
         for kind, text in answer["Messages"]:

@@ -48,6 +48,18 @@ def snapshot(source: Path) -> Iterator[Snapshot]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def count_brackets(path: Path) -> int:
+    """How many ``( [ {`` bytes ``path`` holds (0 when it cannot be read: loading it will say why)."""
+    brackets = 0
+    try:
+        with path.open("rb") as fh:
+            while chunk := fh.read(1 << 20):
+                brackets += chunk.count(b"(") + chunk.count(b"[") + chunk.count(b"{")
+    except OSError:
+        return 0
+    return brackets
+
+
 def _copy(source: Path, copy: Path) -> Snapshot:
     digest = hashlib.sha256()
     brackets = 0
