@@ -194,12 +194,6 @@ def _table(names: list[str], answers: list[dict[str, Any]]) -> str:
     return captured.get()
 
 
-def print_answers(names: list[str], answers: list[dict[str, Any]], fmt: str) -> None:
-    """Print answers in ``fmt`` (table, json or csv) to stdout."""
-    sys.stdout.write(render(names, answers, fmt))
-    sys.stdout.flush()
-
-
 def _interruptible(work: Callable[[], Any]) -> Any:
     """``work()`` such that Ctrl-C stops it at once, whatever Prolog goal it runs.
 
@@ -210,6 +204,8 @@ def _interruptible(work: Callable[[], Any]) -> Any:
     other threads run while Prolog works), says so in one line and exits
     with 130 without waiting for Prolog.
     """
+    if threading.current_thread() is not threading.main_thread():
+        return work()  # signals reach the main thread only: nothing to watch here
     read_fd, write_fd = os.pipe()
     os.set_blocking(write_fd, False)
     watcher = threading.Thread(target=_watch, args=(read_fd,), name="neurosym-ctrl-c", daemon=True)
