@@ -367,3 +367,24 @@ def test_a_deeply_nested_term_in_a_rule_file_does_not_take_python_down(tmp_path:
     count, message = proc.stdout.splitlines()
     assert count == "1"
     assert message.startswith("an answer is nested more than 100 levels deep")
+
+
+def test_ctrl_c_stops_a_goal_and_the_kb_still_answers(kb: KnowledgeBase) -> None:
+    """Python handles no signal while Prolog runs; Prolog's heartbeat lets it."""
+    import signal
+
+    def interrupt(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.5)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            kb.query("repeat, fail")
+        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        with pytest.raises(KeyboardInterrupt):
+            kb.count("repeat, fail")
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert kb.count("object(_, _)") == 3

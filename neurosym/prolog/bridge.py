@@ -154,12 +154,27 @@ load_module_(M) :-
     ;   M = neurosym_qlf
     ).
 
+% Ctrl-C: while Prolog runs a goal in Python's main thread, Python handles
+% no signals. Every 100,000 inferences Prolog calls into Python, which then
+% raises KeyboardInterrupt; solve/8 and count/7 pass it on (interrupt_/1)
+% rather than turning it into an error status.
+:- multifile prolog:heartbeat/0.
+prolog:heartbeat :-
+    thread_self(main),
+    !,
+    py_call(janus_swi:heartbeat_tick()).
+prolog:heartbeat.
+
+:- set_prolog_flag(heartbeat, 100000).
+
+interrupt_(error(python_error('KeyboardInterrupt', _), _)).
+
 %!  solve(+M, +Text, +Inputs, +Limit, +Bounds, -Names, -Rows, -Status) is det.
 %   Status: ok, missing-Names, limit-Text or error-Text (pairs: janus makes
 %   them tuples). Bounds: see bounded_/2.
 solve(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
     catch(solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status), E,
-          ( failure_(E, Bounds, Status), Names = [], Rows = [] )).
+          ( interrupt_(E) -> throw(E) ; failure_(E, Bounds, Status), Names = [], Rows = [] )).
 
 solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
     prepare_(M, Text, Inputs, Goal, Names, Vars, Missing),
@@ -184,7 +199,7 @@ count(M, Text, Inputs, Limit, Bounds, N, Status) :-
             ;   bounded_(Bounds, aggregate_all(count, limit(Limit, M:Goal), N)), Status = ok
             )
           ), E,
-          ( failure_(E, Bounds, Status), N = 0 )).
+          ( interrupt_(E) -> throw(E) ; failure_(E, Bounds, Status), N = 0 )).
 
 %   bounded_(+Bounds, :Goal): run the deterministic Goal (a findall) within
 %   Bounds, a list of timeout-Seconds, inferences-N, stack-Bytes. Going

@@ -15,7 +15,9 @@ facts, so facts for a predicate the rules define are refused. ``trusted=``
 is compiled code and loads only when neurosym signed it on this account
 (:mod:`neurosym.prolog.signature`) or when trusted. Queries take
 ``timeout=``, ``inferences=`` and ``stack_limit=``: a goal that goes past
-one stops with a one-line :class:`~neurosym.errors.PrologError`.
+one stops with a one-line :class:`~neurosym.errors.PrologError`. Ctrl-C
+stops a running goal with :class:`KeyboardInterrupt` (Prolog checks for it
+every 100,000 inferences; the KB stays usable).
 
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
 one process even when they load the same rule file. Files are plain Prolog
@@ -146,6 +148,8 @@ def _call_once(goal: str, inputs: dict[str, Any]) -> dict[str, Any]:
     try:
         return janus.query_once(goal, inputs)
     except janus.PrologError as exc:  # the bridge catches user errors; this is a bug or a crash
+        if str(exc).startswith("Python 'KeyboardInterrupt'"):  # Ctrl-C, seen at a heartbeat
+            raise KeyboardInterrupt from None
         raise PrologError(_one_line(str(exc))) from exc
 
 
