@@ -403,11 +403,16 @@ def _nested(depth: int) -> str:
     return "f(" * depth + "x" + ")" * depth
 
 
-@pytest.mark.parametrize("depth", [101, 50_000])
-def test_a_deeply_nested_fact_is_refused_and_python_lives_on(tmp_path: Path, depth: int) -> None:
+
+@pytest.mark.parametrize(
+    "nested",
+    [_nested(101), _nested(50_000), "[" * 400_000 + "x" + "]" * 400_000, "- " * 300_000 + "x"],
+    ids=["101", "50000", "lists", "prefix-operators"],
+)
+def test_a_deeply_nested_fact_is_refused_and_python_lives_on(tmp_path: Path, nested: str) -> None:
     """Parsed past the C stack, such a fact killed the process (SIGSEGV): nothing printed."""
     path = tmp_path / "kb.pl"
-    path.write_text(f"ok(1).\nobject(a, {_nested(depth)}).\n")
+    path.write_text(f"ok(1).\nobject(a, {nested}).\n")
     code = (
         "import sys\nfrom neurosym.prolog.knowledge_base import KnowledgeBase\n"
         "from neurosym.errors import PrologError\n"

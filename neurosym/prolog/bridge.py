@@ -96,7 +96,7 @@ close_kb(M, Files) :-
 %!  load(+Module, +Id, +File, +Format, +CStack, -Messages) is det.
 %   Messages: list of Kind-Text, Kind error or warning. The file is loaded
 %   in a thread whose C stack is CStack bytes (the caller sizes it by the
-%   file's opening brackets): embedded in Python, SWI-Prolog has no guard
+%   file's nesting bound, neurosym.prolog.snapshot): embedded in Python, SWI-Prolog has no guard
 %   against C-stack overflow, and a deeply nested term would kill the process.
 load(M, Id, File, Format, CStack, Messages) :-
     catch(thread_create(load_thread_(M, Id, File, Format), T, [c_stack(CStack)]), E, true),

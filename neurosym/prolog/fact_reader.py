@@ -27,7 +27,8 @@ UTF-8, or not valid in the encoding it declares) is refused too. Files are
 read in a thread of their own whose C stack holds a level of nesting for
 every opening bracket of the file: embedded in Python, SWI-Prolog has no
 guard against C-stack overflow, and a term nested 50,000 deep killed the
-process.
+process. (Each level of nesting takes an opening bracket or a prefix
+operator, so their count bounds the depth.)
 
 Anything else stops the load with ``error-Text``, one line naming file, line
 and what was found. Clauses are added with ``assertz/1`` as they are read;
@@ -96,8 +97,9 @@ set_chunk_bytes(Bytes) :-
 %   Embedded in Python, SWI-Prolog runs without its signal handlers, and
 %   these are what turn a C-stack overflow into an error: parsing a term
 %   nested deeper than the C stack holds would kill the process. So File is
-%   read in a thread of its own whose C stack holds more levels than File has
-%   opening brackets (the caller counts them, in a copy nobody else writes).
+%   read in a thread of its own whose C stack holds more levels than any term
+%   in File can have (the caller bounds them, counting opening brackets and
+%   prefix operators in a copy nobody else writes).
 load_facts(M, File, Mode, RuleFiles, CStack, Count, Status) :-
     catch(thread_create(load_facts_(M, File, Mode, RuleFiles, CStack), Id, [c_stack(CStack)]),
           E, true),
@@ -362,7 +364,7 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
 %   when nested more than max_depth_/1 levels deep. Each level takes at least
 %   one opening bracket, so only a term whose text is longer than that limit
 %   is measured. The parse itself is safe: the reading thread's C stack holds
-%   the file's every bracket (load_facts/7).
+%   as many levels as the file could nest (load_facts/7).
 read_(S, N, T, QQ) :-
     byte_count(S, B0),
     read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),

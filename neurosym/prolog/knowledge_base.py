@@ -73,7 +73,7 @@ from neurosym.errors import ConfigError, NeurosymError, OutputError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
-from neurosym.prolog.snapshot import Snapshot, count_brackets, snapshot
+from neurosym.prolog.snapshot import Snapshot, nesting_bound, nesting_of, snapshot
 from neurosym.terms import MAX_DEPTH, Term, Var
 
 if TYPE_CHECKING:
@@ -83,15 +83,15 @@ PathArg = str | PathLike[str]
 _VARIABLE = re.compile(r"[A-Z_][A-Za-z0-9_]*")
 _SCALARS = frozenset({str, int, float, type(None)})
 _INT64_MAX = (1 << 63) - 1
-# A goal's nesting is bounded by its opening brackets; the C stack SWI-Prolog
-# parses it on holds far more than this many levels.
-_GOAL_BRACKETS = 10_000
-# The C stack of the threads that read a file: parsing took 280 bytes of it
-# per level of nesting (SWI-Prolog 9.2, x86-64), and no term nests deeper than
-# the file has opening brackets. Address space is reserved, not memory: pages
-# are taken only as a parse goes deep.
+# How deeply a goal's text can nest (snapshot.nesting_of); the C stack
+# SWI-Prolog parses it on holds far more than this many levels.
+_GOAL_NESTING = 10_000
+# The C stack of the threads that read a file: parsing took up to 566 bytes
+# of it per level of nesting (SWI-Prolog 9.2, x86-64), and no term nests
+# deeper than the file's nesting_bound. Address space is reserved, not memory:
+# pages are taken only as a parse goes deep.
 _C_STACK_BASE = 16 << 20
-_C_STACK_PER_BRACKET = 512
+_C_STACK_PER_LEVEL = 768
 _ids = itertools.count(1)
 _bridge_lock = threading.Lock()
 _bridge_loaded = False
@@ -396,7 +396,7 @@ class KnowledgeBase:
                 "File": str(copy.path),
                 "Mode": mode,
                 "Rules": self._rule_ids,
-                "CStack": _C_STACK_BASE + _C_STACK_PER_BRACKET * copy.brackets,
+                "CStack": _C_STACK_BASE + _C_STACK_PER_LEVEL * copy.nesting,
             },
         )
         status = answer["Status"]
@@ -432,7 +432,7 @@ class KnowledgeBase:
             load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
-        c_stack = _C_STACK_BASE + _C_STACK_PER_BRACKET * count_brackets(load_file)
+        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting_bound(load_file)
         answer = _call_once(
             f"{bridge.MODULE}:load(M, Id, File, Format, CStack, Messages)",
             {
@@ -589,10 +589,10 @@ class KnowledgeBase:
             raise ConfigError(
                 f"the goal must be Prolog text such as 'object(Id, Type)', not {goal!r}"
             )
-        if sum(map(goal.count, "([{")) > _GOAL_BRACKETS:
+        if nesting_of(goal) > _GOAL_NESTING:
             raise ConfigError(
-                f"the goal holds more than {_GOAL_BRACKETS:,} opening brackets; "
-                "pass large values as inputs (keyword arguments), not as goal text"
+                f"the goal could nest more than {_GOAL_NESTING:,} levels deep (opening brackets "
+                "and prefix operators); pass large values as inputs (keyword arguments), not as goal text"
             )
         return goal
 
