@@ -200,8 +200,8 @@ def test_answers_python_cannot_take_are_one_line_and_print_nothing(
         (["ok(X). halt(3)"], "the goal has text after its full stop (halt(3))"),
         (["ok(X). ok("], "the goal has text after its full stop (ok()"),
         (["--bind", "A=" + "f(" * 150 + "x" + ")" * 150, "ok(A)"], "a term nested more than 100 levels deep"),
-        (["f(" * 20000 + "x" + ")" * 20000], "the goal could nest more than 10,000 levels deep"),
-        (["X = " + "- " * 20000 + "x"], "the goal could nest more than 10,000 levels deep"),
+        (["f(" * 20000 + "x" + ")" * 20000], "the goal could nest more than 5,000 levels deep"),
+        (["X = " + "- " * 20000 + "x"], "the goal could nest more than 5,000 levels deep"),
     ],
 )  # fmt: skip
 def test_bad_bounds_and_goals_are_refused_in_one_line(

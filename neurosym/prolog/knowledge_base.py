@@ -85,7 +85,7 @@ _SCALARS = frozenset({str, int, float, type(None)})
 _INT64_MAX = (1 << 63) - 1
 # How deeply a goal's text can nest (snapshot.nesting_of); the C stack
 # SWI-Prolog parses it on holds far more than this many levels.
-_GOAL_NESTING = 10_000
+_GOAL_NESTING = 5_000
 # The C stack of the threads that read a file: parsing took up to 566 bytes
 # of it per level of nesting (SWI-Prolog 9.2, x86-64), and no term nests
 # deeper than the file's nesting_bound. Address space is reserved, not memory:
