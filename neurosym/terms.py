@@ -20,6 +20,11 @@ Prolog:
 * ``Term`` -> compound in functional notation, no spaces: ``f(a,'B',1.5)``;
   operators are never written infix (``'-'(1)``, not ``-1``).
 * ``tuple`` / ``list`` inside a ``Term`` -> Prolog list ``[a,b]``.
+* :class:`Var` (an unbound variable inside an answer) -> its name, ``_G1``.
+
+Terms cross between Prolog and Python at most :data:`MAX_DEPTH` levels deep
+(a compound or a list is one level): deeper ones are refused with one line,
+where Python's recursion or SWI-Prolog's C stack would otherwise give out.
 
 :func:`parse_term` reads that canonical text back (``parse_term(str(t)) == t``
 for every compound ``t``); a ``Term`` with no arguments is the atom itself.
@@ -33,6 +38,9 @@ from dataclasses import dataclass
 from typing import TypeAlias
 
 from neurosym.errors import FactError
+
+MAX_DEPTH = 100
+"""The deepest nesting of a term that passes between Prolog and Python (facts, answers, inputs)."""
 
 _SOLO_ATOM = re.compile(r"[a-z][A-Za-z0-9_]*")
 # Characters that must be escaped inside a quoted atom: the quote and the
@@ -70,7 +78,20 @@ def float_text(value: float) -> str:
     return f"{mantissa}e{int(exponent)}"
 
 
-TermArg: TypeAlias = "str | int | float | Term | tuple[TermArg, ...]"
+TermArg: TypeAlias = "str | int | float | Term | Var | tuple[TermArg, ...]"
+
+
+@dataclass(frozen=True, slots=True)
+class Var:
+    """An unbound Prolog variable inside an answer; ``str()`` is its name, e.g. ``_G1``.
+
+    Variables of one answer share names: ``X = f(Y, Y)`` gives ``f(_G1,_G1)``.
+    """
+
+    name: str
+
+    def __str__(self) -> str:
+        return self.name
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,8 +114,10 @@ class Term:
             return atom_text(self.functor)
         if len(self.args) == 2 and self.functor in _RESERVED_PAIRS:
             raise FactError(_RESERVED_PAIRS[self.functor])
-        inner = ",".join(format_value(a) for a in self.args)
-        return f"{atom_text(self.functor)}({inner})"
+        parts = []
+        for arg in self.args:  # a loop, not a generator: one Python frame per level
+            parts.append(format_value(arg))
+        return f"{atom_text(self.functor)}({','.join(parts)})"
 
 
 # Binary functors whose text SWI-Prolog 7+ reads as something else.
@@ -116,7 +139,7 @@ def format_value(value: object) -> str:
     """Canonical Prolog text of one Python value (see the module docstring for the mapping)."""
     if isinstance(value, str):
         return atom_text(value)
-    if isinstance(value, Term):
+    if isinstance(value, Term | Var):
         return str(value)
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -125,7 +148,10 @@ def format_value(value: object) -> str:
     if isinstance(value, float):
         return float_text(value)
     if isinstance(value, tuple | list):
-        return "[" + ",".join(format_value(v) for v in value) + "]"
+        parts = []
+        for item in value:
+            parts.append(format_value(item))
+        return "[" + ",".join(parts) + "]"
     # numpy scalars and the like, without importing numpy here
     kind = getattr(getattr(value, "dtype", None), "kind", None)
     if kind == "b":
@@ -186,10 +212,11 @@ class _Parser:
     def __init__(self, text: str) -> None:
         self.text = text
         self.pos = 0
+        self.depth = 0
 
     def fail(self, what: str) -> FactError:
         return FactError(
-            f"cannot read {self.text!r} as a Prolog term: {what} at character {self.pos}"
+            f"cannot read {_shorten(self.text)!r} as a Prolog term: {what} at character {self.pos}"
         )
 
     def next(self) -> tuple[str, str]:
@@ -223,6 +250,15 @@ class _Parser:
         return name
 
     def items(self, close: str) -> tuple[ParsedTerm, ...]:
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise self.fail(f"a term nested more than {MAX_DEPTH} levels deep")
+        try:
+            return self._items(close)
+        finally:
+            self.depth -= 1
+
+    def _items(self, close: str) -> tuple[ParsedTerm, ...]:
         if close == "]" and self.text[self.pos :].lstrip().startswith("]"):
             self.next()
             return ()
@@ -235,6 +271,10 @@ class _Parser:
                 return tuple(out)
             else:
                 raise self.fail(f"expected ',' or {close!r}, found {tok!r}")
+
+
+def _shorten(text: str, most: int = 80) -> str:
+    return text if len(text) <= most else text[: most - 3] + "..."
 
 
 def parse_term(text: str) -> ParsedTerm:

@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
+
+from neurosym.terms import atom_text
 
 FACTS = """\
 object(agent, agent).
@@ -103,3 +110,159 @@ def test_load_warnings_go_to_stderr(run_neurosym, kb_files: tuple[Path, Path]) -
     assert proc.returncode == 0
     assert proc.stdout == "\n\n"  # no output variables: an empty header, one empty row
     assert "neurosym query: warning: " in proc.stderr and "Singleton variables: [X]" in proc.stderr
+
+
+# --- output shown as text, whole or not at all -----------------------------------
+
+HOSTILE = """\
+object(a, '[link=https://evil.example]click[/link]').
+object(b, '\\e[31mred\\e[0m').
+object(c, [x, y]).
+link(indirect([agent])).
+"""
+
+
+def test_the_table_shows_data_as_text(run_neurosym, tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text(HOSTILE)
+    proc = run_neurosym("query", "--kb", facts, "link(How)")
+    assert proc.returncode == 0, proc.stderr
+    assert "indirect([agent])" in proc.stdout
+    proc = run_neurosym("query", "--kb", facts, "object(Id, T)")
+    assert proc.returncode == 0, proc.stderr
+    assert "[link=https://evil.example]click[/link]" in proc.stdout
+    assert "\\e[31mred\\e[0m" in proc.stdout and "\x1b" not in proc.stdout
+    assert "[x,y]" in proc.stdout
+
+
+def test_sword_enemy_link_prints_its_list(run_neurosym, tmp_path: Path) -> None:
+    from conftest import REPO
+
+    facts = tmp_path / "kb.pl"
+    facts.write_text(
+        ":- dynamic attention/6.\nobject(s1, sword).\nobject(e1, enemy).\n"
+        "holds(0, 1, r(1), sword, agent).\nholds(0, 1, r(1), agent, enemy).\n"
+    )
+    proc = run_neurosym("query", "--kb", facts, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(How)")
+    assert proc.returncode == 0, proc.stderr
+    assert "indirect([agent])" in proc.stdout
+
+
+def test_json_writes_infinities_as_text(run_neurosym, tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    proc = run_neurosym("query", "--kb", facts, "--format", "json", "X is inf, Y is -inf, Z is nan")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == [{"X": "inf", "Y": "-inf", "Z": "nan"}]
+
+
+def test_answers_holding_variables_print_with_names(run_neurosym, tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    proc = run_neurosym("query", "--kb", facts, "--format", "json", "X = f(Y, Z, [Y])")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == [{"X": "f(_G1,_G2,[_G1])", "Y": None, "Z": None}]
+    proc = run_neurosym("query", "--kb", facts, "X = f(Y)")
+    assert proc.returncode == 0, proc.stderr
+    assert "f(_G1)" in proc.stdout and proc.stdout.endswith("1 answer\n")
+
+
+@pytest.mark.parametrize(
+    ("goal", "message"),
+    [
+        ("length(L, 10000), foldl([_, A, f(A)]>>true, L, x, T)", "an answer is nested more than 100 levels deep"),
+        ("X = f(X)", "an answer is nested more than 100 levels deep (or is cyclic)"),
+        ("X is 10^5000", "an answer holds an integer of more than 4,300 digits"),
+    ],
+)  # fmt: skip
+@pytest.mark.parametrize("fmt", ["json", "csv", "table"])
+def test_answers_python_cannot_take_are_one_line_and_print_nothing(
+    run_neurosym, tmp_path: Path, goal: str, message: str, fmt: str
+) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    proc = run_neurosym("query", "--kb", facts, "--format", fmt, goal)
+    assert proc.returncode == 1
+    assert proc.stdout == ""
+    assert proc.stderr == f"neurosym query: error: {message}" + proc.stderr.split(message, 1)[1]
+    assert proc.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--timeout", "inf"], "--timeout must be a positive number of seconds up to 1,000,000,000, not inf"),
+        (["--timeout", "nan"], "--timeout must be a positive number"),
+        (["--max-inferences", str(10**23)], "--max-inferences must be from 1 to 2**63-1"),
+        (["--stack-limit", "inf"], "--stack-limit must be from 1 to 1,048,576 (MB)"),
+        (["X"], "the goal is a variable; give a goal such as object(Id, Type)"),
+        (["42"], "the goal 42 is not something to run"),
+        (["ok(X). halt(3)"], "the goal has text after its full stop (halt(3))"),
+        (["ok(X). ok("], "the goal has text after its full stop (ok()"),
+        (["--bind", "A=" + "f(" * 150 + "x" + ")" * 150, "ok(A)"], "a term nested more than 100 levels deep"),
+        (["f(" * 20000 + "x" + ")" * 20000], "the goal could nest more than 5,000 levels deep"),
+        (["X = " + "- " * 20000 + "x"], "the goal could nest more than 5,000 levels deep"),
+    ],
+)  # fmt: skip
+def test_bad_bounds_and_goals_are_refused_in_one_line(
+    run_neurosym, tmp_path: Path, args: list[str], message: str
+) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    if args[0].startswith("--") and not args[0].startswith("--bind"):
+        args = [*args, "ok(X)"]
+    proc = run_neurosym("query", "--kb", facts, *args)
+    assert proc.returncode == 1, proc.stdout
+    assert proc.stdout == ""
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith("neurosym query: error: ")
+    assert message in proc.stderr
+
+
+def test_a_goal_ending_in_a_full_stop_or_comment_is_one_goal(run_neurosym, tmp_path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    for goal in ("ok(X).", "ok(X). % a comment", "X = 'a. b'"):
+        proc = run_neurosym("query", "--kb", facts, "--format", "csv", goal)
+        assert proc.returncode == 0, proc.stderr
+
+
+# --- Ctrl-C and closed pipes ------------------------------------------------------
+
+
+def _popen(tmp_path: Path, *args: object, **kw) -> subprocess.Popen:
+    from conftest import REPO
+
+    path = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH")) if p)
+    return subprocess.Popen(
+        [sys.executable, "-m", "neurosym", "query", *map(str, args)],
+        cwd=REPO, env={**os.environ, "PYTHONPATH": path}, stderr=subprocess.PIPE, text=True, **kw,
+    )  # fmt: skip
+
+
+def test_ctrl_c_stops_any_goal_with_130_and_one_line(tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("ok(1).\n")
+    started = tmp_path / "started"
+    goal = f"open({atom_text(str(started))}, write, S), close(S), repeat, fail"
+    proc = _popen(tmp_path, "--kb", facts, goal, stdout=subprocess.PIPE)
+    try:
+        while not started.exists():  # the goal is running
+            assert proc.poll() is None, proc.stderr.read()
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130
+    assert err == "neurosym query: interrupted\n"
+
+
+def test_a_closed_pipe_ends_quietly(tmp_path: Path) -> None:
+    facts = tmp_path / "kb.pl"
+    facts.write_text("".join(f"ok({i}).\n" for i in range(20000)))
+    for fmt in ("csv", "json", "table"):
+        proc = _popen(tmp_path, "--kb", facts, "--format", fmt, "ok(X)", stdout=subprocess.PIPE)
+        proc.stdout.close()  # the reader is gone before anything is written
+        _, err = proc.communicate(timeout=120)
+        assert err == "" and proc.returncode == 141, (fmt, err)

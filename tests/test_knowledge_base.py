@@ -350,3 +350,41 @@ def test_janus_gets_the_venv_home_despite_an_old_swipl_on_path(tmp_path: Path, s
     )
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["True", str(swipl)]
+
+
+def test_a_deeply_nested_term_in_a_rule_file_does_not_take_python_down(tmp_path: Path) -> None:
+    """Rule files are code, but a term nested past the C stack killed the process (SIGSEGV)."""
+    rules = _write(tmp_path / "rules.pl", "deep(" + "f(" * 50_000 + "x" + ")" * 50_000 + ").\n")
+    facts = _write(tmp_path / "kb.pl", "ok(1).\n")
+    code = (
+        "from neurosym.prolog.knowledge_base import KnowledgeBase\n"
+        f"with KnowledgeBase({str(facts)!r}, rules=[{str(rules)!r}]) as kb:\n"
+        "    print(kb.count('deep(_)'))\n"
+        "    try:\n        kb.query('deep(X)')\n    except Exception as exc:\n        print(exc)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    count, message = proc.stdout.splitlines()
+    assert count == "1"
+    assert message.startswith("an answer is nested more than 100 levels deep")
+
+
+def test_ctrl_c_stops_a_goal_and_the_kb_still_answers(kb: KnowledgeBase) -> None:
+    """Python handles no signal while Prolog runs; Prolog's heartbeat lets it."""
+    import signal
+
+    def interrupt(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.5)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            kb.query("repeat, fail")
+        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        with pytest.raises(KeyboardInterrupt):
+            kb.count("repeat, fail")
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert kb.count("object(_, _)") == 3

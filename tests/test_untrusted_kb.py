@@ -10,16 +10,19 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from neurosym.errors import ConfigError, PrologError
+from neurosym.errors import ConfigError, NeurosymError, PrologError
 from neurosym.export.prolog_writer import write_prolog
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.prolog.signature import signature_path
 from neurosym.terms import atom_text
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _touch(marker: Path) -> str:
@@ -54,6 +57,13 @@ PLANTED = [
     ("library-fact", "member(x, [x]).", "library predicate member/2"),
     ("variable", "_.", "a variable"),
     ("number", "42.", "a term that is not a fact"),
+    ("ssu-rule", "ok(_) => {touch}.", "a rule (Head => Body)"),
+    ("ssu-guard", "ok(X), X > 0 => {touch}.", "a rule (Head => Body)"),
+    ("ssu-quoted", "'=>'(ok(_), {touch}).", "a rule (Head => Body)"),
+    ("operator-fact", "'?=>'(ok(1), true).", "not a plain predicate name"),
+    ("symbol-fact", "'$hidden'(1).", "not a plain predicate name"),
+    ("dynamic-operator", ":- dynamic (=>)/2.", "not a plain predicate name"),
+    ("non-ground", "ok(_).", "a fact with a variable"),
 ]  # fmt: skip
 
 
@@ -97,6 +107,42 @@ def test_the_cli_refuses_planted_code_in_one_line(run_neurosym, tmp_path: Path, 
     assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}:3: found a directive")
     assert not marker.exists()
     assert not path.with_suffix(".qlf").exists()  # nothing of an unchecked source is compiled
+
+
+def _rgw_kb(tmp_path: Path) -> Path:
+    """A small KB as ``neurosym extract`` writes it (the writer's headers and shapes)."""
+    tables = {
+        "object": pd.DataFrame({"id": ["s1", "e1"], "type": ["sword", "enemy"]}),
+        "holds": pd.DataFrame(
+            {"e": [0, 0], "t": [1, 1], "r": ["r(1)", "r(1)"], "a": ["sword", "agent"], "b": ["agent", "enemy"]}
+        ),
+    }
+    return write_prolog(
+        tmp_path / "K.pl", tables, dynamic=["attention/6"], term_columns={"holds": ["r"]}
+    )
+
+
+@pytest.mark.parametrize("qlf", [False, True])
+def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
+    run_neurosym, tmp_path: Path, marker: Path, qlf: bool
+) -> None:
+    path = _rgw_kb(tmp_path)
+    with KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"]) as kb:  # the KB as written works
+        assert str(kb.once("sword_enemy_link(L)")["L"]) == "indirect([agent])"
+    line = path.read_text().count("\n") + 1
+    with path.open("a") as fh:
+        fh.write(f"attention(_,_,_,_,_,_) => {_touch(marker)}, fail.\n")
+    args = ["query", "--kb", path, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(L)"]
+    proc = run_neurosym(*args, *(["--qlf"] if qlf else []))
+    assert proc.returncode == 1, proc.stdout
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(
+        f"neurosym query: error: cannot load {path}:{line}: found a rule (Head => Body)"
+    )
+    with pytest.raises(PrologError, match=rf"^cannot load {path}:{line}: found a rule"):
+        KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"], qlf=qlf)
+    assert not marker.exists()
+    assert not path.with_suffix(".qlf").exists()
 
 
 def test_trust_and_rules_load_the_same_file_as_code(run_neurosym, tmp_path, marker) -> None:
@@ -348,3 +394,157 @@ def test_cli_timeout_and_limits(run_neurosym, tmp_path: Path) -> None:
         assert proc.stderr.startswith(f"neurosym query: error: {message}"), proc.stderr
     help_text = run_neurosym("query", "--help").stdout
     assert "--timeout SECONDS" in help_text and "(default: none)" in help_text
+
+
+# --- facts that would bring the process down --------------------------------------
+
+
+def _nested(depth: int) -> str:
+    return "f(" * depth + "x" + ")" * depth
+
+
+
+@pytest.mark.parametrize(
+    "nested",
+    [_nested(101), _nested(50_000), "[" * 400_000 + "x" + "]" * 400_000, "- " * 300_000 + "x"],
+    ids=["101", "50000", "lists", "prefix-operators"],
+)
+def test_a_deeply_nested_fact_is_refused_and_python_lives_on(tmp_path: Path, nested: str) -> None:
+    """Parsed past the C stack, such a fact killed the process (SIGSEGV): nothing printed."""
+    path = tmp_path / "kb.pl"
+    path.write_text(f"ok(1).\nobject(a, {nested}).\n")
+    code = (
+        "import sys\nfrom neurosym.prolog.knowledge_base import KnowledgeBase\n"
+        "from neurosym.errors import PrologError\n"
+        f"try:\n    KnowledgeBase({str(path)!r})\nexcept PrologError as exc:\n    print(exc)\n"
+        "print('alive')\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
+    assert proc.returncode == 0, proc.stderr
+    first, alive = proc.stdout.splitlines()
+    assert first.startswith(f"cannot load {path}:2: found a term nested more than 100 levels deep")
+    assert alive == "alive"
+
+
+def test_a_fact_100_levels_deep_loads(tmp_path: Path) -> None:
+    path = tmp_path / "kb.pl"
+    path.write_text(f"object(a, {_nested(99)}).\nlist([{','.join(['g(1)'] * 5000)}]).\n")
+    with KnowledgeBase(path) as kb:
+        assert str(kb.once("object(a, X)")["X"]).count("f(") == 99
+        assert len(kb.once("list(L)")["L"]) == 5000
+
+
+def test_text_that_is_not_utf8_is_refused_in_one_line(run_neurosym, tmp_path: Path) -> None:
+    path = tmp_path / "kb.pl"
+    path.write_bytes(b"object(a, b).\nobject(\xff\xfe, \x80).\n")
+    proc = run_neurosym("query", "--kb", path, "object(X, Y)")
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}: ")
+    assert "Illegal UTF-8 start" in proc.stderr
+    latin = tmp_path / "latin.pl"
+    latin.write_bytes(b":- encoding(iso_latin_1).\nobject(a, '\xe9t\xe9').\n")
+    with KnowledgeBase(latin) as kb:  # a file that says its encoding reads as it says
+        assert kb.query("object(a, X)") == [{"X": "été"}]
+
+
+# --- read once: what is checked is what is compiled and loaded ---------------------
+
+
+def test_a_source_swapped_after_its_check_is_not_compiled(
+    tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A writer on a shared drive swaps the file between the check and the compile."""
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    checked = KnowledgeBase._read_facts
+
+    def check_then_swap(self, path, mode, copy=None):
+        count = checked(self, path, mode, copy)
+        if mode == "check":
+            source.write_text(f"ok(666).\n:- initialization({_touch(marker)}).\n")
+        return count
+
+    monkeypatch.setattr(KnowledgeBase, "_read_facts", check_then_swap)
+    with KnowledgeBase(source, qlf=True) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]  # the bytes that were checked
+    assert not marker.exists()
+    monkeypatch.undo()
+    with pytest.raises(PrologError, match=rf"^cannot load {source}:2: found a directive"):
+        KnowledgeBase(source, qlf=True)  # the .qlf is not the new source's: that is checked again
+    assert not marker.exists()
+
+
+def test_a_qlf_swapped_after_its_signature_check_is_not_loaded(
+    swipl: Path, tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    with KnowledgeBase(source, qlf=True) as kb:  # compiled and signed
+        assert kb.query("ok(X)") == [{"X": 1}]
+    evil = _attacker_qlf(swipl, tmp_path, marker, stem="evil")
+    from neurosym.prolog import signature
+
+    checked = signature.check_digests
+
+    def check_then_swap(*args, **kwargs):
+        reason = checked(*args, **kwargs)
+        if evil.exists():
+            os.replace(evil, source.with_suffix(".qlf"))
+        return reason
+
+    monkeypatch.setattr(signature, "check_digests", check_then_swap)
+    with KnowledgeBase(source, qlf=True) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]  # the bytes whose signature was checked
+    assert not marker.exists()
+    monkeypatch.undo()
+    with pytest.raises(PrologError, match="it is not the file kb.qlf.sig signed"):
+        KnowledgeBase(source.with_suffix(".qlf"))  # the swapped-in .qlf, loaded directly
+    assert not marker.exists()
+
+
+def test_a_read_only_folder_for_qlf_is_one_line(
+    run_neurosym, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    import tempfile
+
+    made = tempfile.mkstemp
+
+    def read_only(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir) == tmp_path:
+            raise OSError(30, "Read-only file system")
+        return made(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    with pytest.raises(NeurosymError) as info:
+        KnowledgeBase(source, qlf=True)
+    assert str(info.value) == (
+        f"cannot write {source.with_suffix('.qlf')}: Read-only file system; it was left as it "
+        "was; load kb.pl without --qlf (qlf=False)"
+    )
+    assert not source.with_suffix(".qlf").exists()
+
+
+def test_a_qlf_loaded_directly_is_the_checked_bytes(
+    swipl: Path, tmp_path: Path, marker: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "kb.pl"
+    source.write_text("ok(1).\n")
+    with KnowledgeBase(source, qlf=True):
+        pass
+    evil = _attacker_qlf(swipl, tmp_path, marker, stem="evil")
+    from neurosym.prolog import signature
+
+    checked = signature.check_digests
+
+    def check_then_swap(*args, **kwargs):
+        reason = checked(*args, **kwargs)
+        os.replace(evil, source.with_suffix(".qlf"))
+        return reason
+
+    monkeypatch.setattr(signature, "check_digests", check_then_swap)
+    with KnowledgeBase(source.with_suffix(".qlf")) as kb:
+        assert kb.query("ok(X)") == [{"X": 1}]
+    assert not marker.exists()

@@ -6,7 +6,7 @@ package without any package-data settings. What it does, and why in Prolog:
 * ``new_kb/1`` makes a temporary module whose default is ``system`` (not
   ``user``), so a KB sees library predicates but nothing someone else put in
   ``user``; ``close_kb/2`` unloads its files and destroys the module.
-* ``load/5`` loads one file into a KB module under a per-module source id,
+* ``load/6`` loads one file into a KB module under a per-module source id,
   because SWI-Prolog refuses (or silently reconsults) one non-module file in
   two modules. Predicates already loaded are declared multifile first, so
   several fact files add up instead of replacing each other. Errors and
@@ -17,15 +17,22 @@ package without any package-data settings. What it does, and why in Prolog:
   variable name (values never pass through goal text), runs it under
   ``limit/2`` and returns every answer in one call, each value encoded so
   janus converts it unambiguously: atoms and strings -> str, numbers, lists
-  -> list, compounds -> ``Functor-Args`` (a Python tuple), unbound -> None.
+  -> list, compounds -> ``Functor-Args`` (a Python tuple), an unbound output
+  -> None, a variable inside a value -> the dict ``var:N``. Values nested
+  deeper than ``max_depth_/1`` (or cyclic) and integers of more than 4,300
+  digits are refused with one line: Python could not take them.
+* the goal text must be one goal: a variable, a number or text after its
+  full stop is refused with one line.
 """
 
 from __future__ import annotations
 
+from neurosym.terms import MAX_DEPTH
+
 MODULE = "neurosym_bridge"
 
-SOURCE = r"""
-:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/5, solve/8, count/7]).
+_SOURCE = r"""
+:- module(neurosym_bridge, [new_kb/1, close_kb/2, load/6, solve/8, count/7]).
 :- use_module(library(time), [call_with_time_limit/2]).
 :- use_module(library(solution_sequences), [limit/2]).
 :- use_module(library(apply), [maplist/3, exclude/3, partition/4]).
@@ -79,23 +86,39 @@ new_kb(M) :-
     set_prolog_flag(M:unknown, error).
 
 %!  close_kb(+Module, +Files) is det.
-%   Files: the source ids load/5 used. Not every file loaded with context M:
+%   Files: the source ids load/6 used. Not every file loaded with context M:
 %   libraries autoloaded from M are shared with everyone else.
 close_kb(M, Files) :-
     forall(member(File, Files), catch(unload_file(File), _, true)),
     retractall(system:'$load_context_module'(_, M, _)),
     '$destroy_module'(M).
 
-%!  load(+Module, +Id, +File, +Format, -Messages) is det.
-%   Messages: list of Kind-Text, Kind error or warning.
-load(M, Id, File, Format, Messages) :-
+%!  load(+Module, +Id, +File, +Format, +CStack, -Messages) is det.
+%   Messages: list of Kind-Text, Kind error or warning. The file is loaded
+%   in a thread whose C stack is CStack bytes (the caller sizes it by the
+%   file's nesting bound, neurosym.prolog.snapshot): embedded in Python, SWI-Prolog has no guard
+%   against C-stack overflow, and a deeply nested term would kill the process.
+load(M, Id, File, Format, CStack, Messages) :-
+    catch(thread_create(load_thread_(M, Id, File, Format), T, [c_stack(CStack)]), E, true),
+    (   nonvar(E)
+    ->  error_text_(E, Text), Messages = [error-Text]
+    ;   thread_join(T, Exit),
+        (   Exit = exited(Messages)
+        ->  true
+        ;   format(string(Text), "~w: loading stopped: ~q", [File, Exit]),
+            Messages = [error-Text]
+        )
+    ).
+
+load_thread_(M, Id, File, Format) :-
     retractall(collected_(_, _)),
     multifile_loaded_(M),
     setup_call_cleanup(
         assertz(collecting_),
         catch(load_(M, Id, File, Format), E, print_message(error, E)),
         retractall(collecting_)),
-    findall(Kind-Text, retract(collected_(Kind, Text)), Messages).
+    findall(Kind-Text, retract(collected_(Kind, Text)), Messages),
+    thread_exit(Messages).
 
 % Several files of one KB add up: without this a second file with clauses
 % for relation/7 would silently replace those of the first.
@@ -131,12 +154,27 @@ load_module_(M) :-
     ;   M = neurosym_qlf
     ).
 
+% Ctrl-C: while Prolog runs a goal in Python's main thread, Python handles
+% no signals. Every 100,000 inferences Prolog calls into Python, which then
+% raises KeyboardInterrupt; solve/8 and count/7 pass it on (interrupt_/1)
+% rather than turning it into an error status.
+:- multifile prolog:heartbeat/0.
+prolog:heartbeat :-
+    thread_self(main),
+    !,
+    py_call(janus_swi:heartbeat_tick()).
+prolog:heartbeat.
+
+:- set_prolog_flag(heartbeat, 100000).
+
+interrupt_(error(python_error('KeyboardInterrupt', _), _)).
+
 %!  solve(+M, +Text, +Inputs, +Limit, +Bounds, -Names, -Rows, -Status) is det.
 %   Status: ok, missing-Names, limit-Text or error-Text (pairs: janus makes
 %   them tuples). Bounds: see bounded_/2.
 solve(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
     catch(solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status), E,
-          ( failure_(E, Bounds, Status), Names = [], Rows = [] )).
+          ( interrupt_(E) -> throw(E) ; failure_(E, Bounds, Status), Names = [], Rows = [] )).
 
 solve_(M, Text, Inputs, Limit, Bounds, Names, Rows, Status) :-
     prepare_(M, Text, Inputs, Goal, Names, Vars, Missing),
@@ -161,7 +199,7 @@ count(M, Text, Inputs, Limit, Bounds, N, Status) :-
             ;   bounded_(Bounds, aggregate_all(count, limit(Limit, M:Goal), N)), Status = ok
             )
           ), E,
-          ( failure_(E, Bounds, Status), N = 0 )).
+          ( interrupt_(E) -> throw(E) ; failure_(E, Bounds, Status), N = 0 )).
 
 %   bounded_(+Bounds, :Goal): run the deterministic Goal (a findall) within
 %   Bounds, a list of timeout-Seconds, inferences-N, stack-Bytes. Going
@@ -185,9 +223,24 @@ bounded_([stack-Bytes|Bs], Goal) :- !,
 failure_(E, Bounds, Status) :-
     (   limit_text_(E, Bounds, Msg)
     ->  Status = limit-Msg
+    ;   neurosym_text_(E, Msg)
+    ->  Status = error-Msg
     ;   error_text_(E, Msg),
         Status = error-Msg
     ).
+
+neurosym_text_(neurosym_goal(variable), "the goal is a variable; give a goal such as object(Id, Type)").
+neurosym_text_(neurosym_goal(not_callable(G)), Msg) :-
+    format(string(Msg), "the goal ~q is not something to run; give a goal such as object(Id, Type)", [G]).
+neurosym_text_(neurosym_goal(trailing(Rest)), Msg) :-
+    format(string(Msg), "the goal has text after its full stop (~w); give one goal, \c
+                         joining goals with ',' rather than '.'", [Rest]).
+neurosym_text_(neurosym_answer(deep), Msg) :-
+    max_depth_(D),
+    format(string(Msg), "an answer is nested more than ~D levels deep (or is cyclic); \c
+                         neurosym passes answers up to ~D levels to Python", [D, D]).
+neurosym_text_(neurosym_answer(big_integer), "an answer holds an integer of more than 4,300 digits, \c
+                                               which Python cannot write as text").
 
 limit_text_(neurosym_limit(timeout(T)), _, Msg) :-
     format(string(Msg), "time limit exceeded: the goal ran longer than ~w s and was stopped", [T]).
@@ -206,13 +259,38 @@ stack_overflow_(What, _) :- memberchk(What, [stack, global_stack, local_stack, t
 stack_overflow_(_, error(_, Context)) :- is_dict(Context, stack_overflow).
 
 prepare_(M, Text, Inputs, Goal, Names, Vars, Missing) :-
+    goal_(M, Text, Goal, Bindings),
+    bind_inputs_(Inputs, Bindings, Missing),
+    outputs_(Bindings, Inputs, Names, Vars).
+
+%   goal_(+M, +Text, -Goal, -Bindings): Text read as one goal; throws
+%   neurosym_goal(Why) for an empty goal, a variable, a number, or text
+%   after the goal's full stop (which would be ignored without a word).
+goal_(M, Text, Goal, Bindings) :-
     term_string(Goal, Text, [variable_names(Bindings), module(M)]),
     (   Goal == end_of_file
     ->  throw(error(syntax_error(empty_goal), _))
+    ;   var(Goal)
+    ->  throw(neurosym_goal(variable))
+    ;   \+ callable(Goal)
+    ->  throw(neurosym_goal(not_callable(Goal)))
+    ;   after_full_stop_(Text, Rest)
+    ->  throw(neurosym_goal(trailing(Rest)))
     ;   true
-    ),
-    bind_inputs_(Inputs, Bindings, Missing),
-    outputs_(Bindings, Inputs, Names, Vars).
+    ).
+
+%   after_full_stop_(+Text, -Rest): Text has a full stop with more text after it.
+after_full_stop_(Text, Rest) :-
+    setup_call_cleanup(
+        open_string(Text, S),
+        (   catch('$raw_read'(S, _), error(syntax_error(_), _), fail),  % no full stop: one goal
+            character_count(S, End),
+            catch('$raw_read'(S, Next), error(syntax_error(_), _), Next = more),
+            Next \== end_of_file
+        ),
+        close(S)),
+    sub_string(Text, End, _, 0, Rest0),
+    normalize_space(string(Rest), Rest0).
 
 % The named variables that are not inputs, in order; no findall: it would copy them.
 outputs_([], _, [], []).
@@ -244,17 +322,44 @@ decode_(X, X).
 
 encode_row_(Template, Row) :-
     Template =.. [v|Values],
-    maplist(encode_, Values, Row).
+    term_variables(Values, Vars),
+    max_depth_(Depth),
+    maplist(encode_top_(Vars, Depth), Values, Row).
 
-% Prolog -> Python, see the module comment.
-encode_(V, @(none)) :- var(V), !.
-encode_(X, X) :- atom(X), !.
-encode_(X, X) :- number(X), !.
-encode_(X, X) :- string(X), !.
-encode_(L, E) :- is_list(L), !, maplist(encode_, L, E).
-encode_(D, S) :- is_dict(D), !, format(string(S), "~q", [D]).
-encode_(T, F-As) :- compound(T), !,
+% An unbound output variable is None; variables inside a value are dicts
+% var:N (N numbering the row's variables from 1), which Python names _G<N>.
+encode_top_(_, _, V, @(none)) :- var(V), !.
+encode_top_(Vars, Depth, X, E) :- encode_(X, Vars, Depth, E).
+
+% Prolog -> Python, see the module comment. Depth: the levels of nesting
+% still allowed; a deeper value (or a cyclic one) throws neurosym_answer(deep),
+% an integer Python cannot print throws neurosym_answer(big_integer).
+encode_(V, Vars, _, _{var:N}) :- var(V), !, nth_var_(Vars, V, 1, N).
+encode_(X, _, _, X) :- atom(X), !.
+encode_(X, _, _, X) :- integer(X), !, small_enough_(X).
+encode_(X, _, _, X) :- number(X), !.
+encode_(X, _, _, X) :- string(X), !.
+encode_(_, _, 0, _) :- !, throw(neurosym_answer(deep)).
+encode_(L, Vars, D, E) :- is_list(L), !, D1 is D - 1, maplist(encode_el_(Vars, D1), L, E).
+encode_(D, _, _, S) :- is_dict(D), !, format(string(S), "~q", [D]).
+encode_(T, Vars, D, F-As) :- compound(T), !,
     compound_name_arguments(T, F, As0),
-    maplist(encode_, As0, As).
-encode_(X, S) :- format(string(S), "~q", [X]).
+    D1 is D - 1,
+    maplist(encode_el_(Vars, D1), As0, As).
+encode_(X, _, _, S) :- format(string(S), "~q", [X]).
+
+encode_el_(Vars, D, X, E) :- encode_(X, Vars, D, E).
+
+nth_var_([V0|Vs], V, I, N) :- ( V0 == V -> N = I ; I1 is I + 1, nth_var_(Vs, V, I1, N) ).
+
+% Python writes integers of up to 4,300 digits as text; 2^14284 has 4,300.
+small_enough_(X) :-
+    (   X > -(1 << 62), X < 1 << 62
+    ->  true
+    ;   msb(abs(X)) < 14284
+    ->  true
+    ;   throw(neurosym_answer(big_integer))
+    ).
 """
+
+SOURCE = _SOURCE + f"\nmax_depth_({MAX_DEPTH}).\n"

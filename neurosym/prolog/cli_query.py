@@ -16,21 +16,36 @@ loaded only when neurosym compiled it on this account or it is trusted.
 Rule files (``--rules``) are code; a bare name (``rgw``) is a shipped one.
 ``--timeout``, ``--max-inferences`` and ``--stack-limit`` stop a runaway goal
 with one line (no limit by default, beyond SWI-Prolog's own 1 GB stack).
+Ctrl-C stops any goal: one line, exit 130. Output is rendered whole before
+it is written (a value that cannot be shown prints nothing but one error
+line); a closed stdout (``| head``) ends the command quietly with 141. The
+table shows data as text: rich markup in atoms is escaped and control
+characters are written as visible escapes.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
+import math
+import os
+import signal
 import sys
+import threading
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from neurosym.errors import ConfigError, FactError
 
 FORMATS = ("table", "json", "csv")
+INTERRUPTED = 130  # Ctrl-C
+BROKEN_PIPE = 141  # stdout's reader went away (128 + SIGPIPE)
+MAX_INFERENCES = (1 << 63) - 1
+MAX_STACK_MB = 1 << 20  # 1 TB
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -81,18 +96,27 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def _bounds(args: argparse.Namespace) -> dict[str, Any]:
     """--timeout / --max-inferences / --stack-limit as KnowledgeBase.solve's keywords, checked."""
+    from neurosym.prolog.knowledge_base import MAX_TIMEOUT
+
     out: dict[str, Any] = {}
     if args.timeout is not None:
-        if not args.timeout > 0:
-            raise ConfigError(f"--timeout must be a positive number of seconds, not {args.timeout}")
+        if not 0 < args.timeout <= MAX_TIMEOUT:  # also nan and inf
+            raise ConfigError(
+                f"--timeout must be a positive number of seconds up to {int(MAX_TIMEOUT):,}, "
+                f"not {args.timeout}"
+            )
         out["timeout"] = args.timeout
     if args.max_inferences is not None:
-        if args.max_inferences < 1:
-            raise ConfigError(f"--max-inferences must be at least 1, not {args.max_inferences}")
+        if not 1 <= args.max_inferences <= MAX_INFERENCES:
+            raise ConfigError(
+                f"--max-inferences must be from 1 to 2**63-1, not {args.max_inferences}"
+            )
         out["inferences"] = args.max_inferences
     if args.stack_limit is not None:
-        if not args.stack_limit >= 1:
-            raise ConfigError(f"--stack-limit must be at least 1 (MB), not {args.stack_limit}")
+        if not 1 <= args.stack_limit <= MAX_STACK_MB:
+            raise ConfigError(
+                f"--stack-limit must be from 1 to {MAX_STACK_MB:,} (MB), not {args.stack_limit}"
+            )
         out["stack_limit"] = int(args.stack_limit * 1024 * 1024)
     return out
 
@@ -108,14 +132,17 @@ def _bindings(specs: list[str]) -> dict[str, Any]:
         try:
             out[name.strip()] = parse_term(text)
         except FactError as exc:
-            raise ConfigError(f"--bind {spec!r}: {exc}") from None
+            raise ConfigError(f"--bind {name.strip()}: {exc}") from None
     return out
 
 
 def _plain(value: Any) -> Any:
-    """JSON/CSV-friendly value: compound terms become their Prolog text."""
+    """JSON-friendly value: compound terms become their Prolog text, as do
+    infinities and NaN (JSON has no number for them)."""
     if isinstance(value, list):
         return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
     if isinstance(value, str | int | float) or value is None:
         return value
     return str(value)
@@ -129,36 +156,94 @@ def _text(value: Any) -> str:
     return "" if value is None else str(value)
 
 
-def print_answers(names: list[str], answers: list[dict[str, Any]], fmt: str) -> None:
-    """Print answers in ``fmt`` (table, json or csv) to stdout."""
+def render(names: list[str], answers: list[dict[str, Any]], fmt: str) -> str:
+    """The whole output for ``answers`` in ``fmt`` (table, json or csv), as one string.
+
+    Rendered before anything is written, so that a value that cannot be
+    shown ends the command with one line and no half-printed output.
+    """
     if fmt == "json":
-        json.dump(
-            [{k: _plain(v) for k, v in a.items()} for a in answers], sys.stdout, ensure_ascii=False
-        )
-        sys.stdout.write("\n")
-    elif fmt == "csv":
-        writer = csv.writer(sys.stdout, lineterminator="\n")
+        rows = [{k: _plain(v) for k, v in a.items()} for a in answers]
+        return json.dumps(rows, ensure_ascii=False, allow_nan=False) + "\n"
+    if fmt == "csv":
+        out = io.StringIO()
+        writer = csv.writer(out, lineterminator="\n")
         writer.writerow(names)
         for a in answers:
             writer.writerow([_text(a[n]) for n in names])
-    elif not names:
-        print("true" if answers else "false")
-    else:
-        from rich.console import Console
-        from rich.table import Table
+        return out.getvalue()
+    if not names:
+        return "true\n" if answers else "false\n"
+    return _table(names, answers)
 
-        table = Table(*names)
-        for a in answers:
-            table.add_row(*(_text(a[n]) for n in names))
-        console = Console()
+
+def _table(names: list[str], answers: list[dict[str, Any]]) -> str:
+    """A rich table whose cells are data shown as text (markup escaped, control characters visible)."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from neurosym.display import show
+
+    table = Table(*(show(n) for n in names))
+    for a in answers:
+        table.add_row(*(show(_text(a[n])) for n in names))
+    console = Console()
+    with console.capture() as captured:
         console.print(table)
         console.print(f"{len(answers)} answer{'s' if len(answers) != 1 else ''}", style="dim")
+    return captured.get()
 
 
-def run(args: argparse.Namespace) -> int:
+def _interruptible(work: Callable[[], Any]) -> Any:
+    """``work()`` such that Ctrl-C stops it at once, whatever Prolog goal it runs.
+
+    Python runs signal handlers in the main thread between its own steps, so
+    while SWI-Prolog runs a goal there (``repeat, fail``), Ctrl-C would wait
+    for the goal to end. Python's C-level handler also writes the signal's
+    number to the wakeup fd at once; a watcher thread reads it (janus lets
+    other threads run while Prolog works), says so in one line and exits
+    with 130 without waiting for Prolog.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return work()  # signals reach the main thread only: nothing to watch here
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(write_fd, False)
+    watcher = threading.Thread(target=_watch, args=(read_fd,), name="neurosym-ctrl-c", daemon=True)
+    old_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    old_handler = signal.signal(signal.SIGINT, lambda *_: None)  # the watcher handles it
+    watcher.start()
+    try:
+        return work()
+    finally:
+        signal.signal(signal.SIGINT, old_handler)
+        signal.set_wakeup_fd(old_fd)
+        os.close(write_fd)  # the watcher reads end-of-file and ends
+        watcher.join()
+        os.close(read_fd)
+
+
+def _watch(read_fd: int) -> None:
+    while data := os.read(read_fd, 64):
+        if signal.SIGINT in data:
+            print("neurosym query: interrupted", file=sys.stderr, flush=True)
+            os._exit(INTERRUPTED)
+
+
+def _solve(args: argparse.Namespace, bounds: dict[str, Any], inputs: dict[str, Any]) -> Any:
+    """Load the KB and run the goal: (names, rows, load warnings)."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
     from neurosym.shipped import rule_file
 
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rules = [rule_file(name) for name in args.rules]
+        kb = KnowledgeBase(args.kb, rules=rules, qlf=args.qlf, trusted=args.trust)
+    with kb:
+        names, rows = kb.solve(args.goal, limit=args.limit, **bounds, **inputs)
+    return names, rows, [str(w.message) for w in caught]
+
+
+def run(args: argparse.Namespace) -> int:
     if args.limit is not None and args.limit < 1:
         raise ConfigError(f"--limit must be at least 1, not {args.limit}")
     bounds = _bounds(args)
@@ -169,13 +254,22 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(
                 f"--trust {name}: not one of the --kb files (trust names a --kb FILE)"
             )
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        rules = [rule_file(name) for name in args.rules]
-        kb = KnowledgeBase(args.kb, rules=rules, qlf=args.qlf, trusted=args.trust)
-    for w in caught:
-        print(f"neurosym query: warning: {w.message}", file=sys.stderr)
-    with kb:
-        names, rows = kb.solve(args.goal, limit=args.limit, **bounds, **inputs)
-    print_answers(names, [dict(zip(names, row, strict=True)) for row in rows], args.format)
+    names, rows, notes = _interruptible(lambda: _solve(args, bounds, inputs))
+    for note in notes:
+        print(f"neurosym query: warning: {note}", file=sys.stderr)
+    text = render(names, [dict(zip(names, row, strict=True)) for row in rows], args.format)
+    try:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    except BrokenPipeError:  # the reader went away (| head): stop quietly
+        _stdout_to_devnull()
+        return BROKEN_PIPE
     return 0
+
+
+def _stdout_to_devnull() -> None:
+    """Point stdout at devnull, so that Python's flush at exit finds no closed pipe."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass

@@ -5,22 +5,38 @@ run it. Consulting a file runs its directives (``:- shell(...)``) and lets
 it define ``term_expansion/2`` and other hooks; this reader never consults.
 It reads the file term by term with ``read_term/3`` (syntax errors raise,
 nothing is expanded, quasi-quotations are returned unparsed so no parser
-runs, and a term holding one is refused) and accepts only:
+runs, and a term holding one is refused) and admits only what has the shape
+of a fact, rather than refusing a list of known bad forms (so that a
+clause-like form SWI-Prolog adds one day, as it added ``Head => Body``, is
+refused too):
 
-* facts: a callable term that is not a directive, not ``Head :- Body``, not
-  a grammar rule, not module-qualified, and whose predicate is not built in,
-  not a hook (``term_expansion``, ``goal_expansion``, ``portray``,
-  ``message_hook``, ...), not autoloadable from the library, and not defined
-  by the KB's rule files (static) or imported into its module;
+* facts: a ground atom or compound whose name is a plain predicate name
+  (a lowercase letter, then letters, digits, underscores: never an operator
+  such as ``:-``, ``=>``, ``-->`` or ``:``, never a quoted name), nested at
+  most :data:`~neurosym.terms.MAX_DEPTH` levels, and whose predicate is not
+  built in, not a hook (``term_expansion``, ``goal_expansion``,
+  ``portray``, ``message_hook``, ...), not autoloadable from the library,
+  and not defined by the KB's rule files (static) or imported into its
+  module;
 * the headers neurosym's writer emits: ``:- encoding(Enc).`` (applied to the
   stream) and ``:- dynamic Name/Arity, ...`` (the same checks on each
   predicate).
+
+A file SWI-Prolog warns about while reading it (text that is not valid
+UTF-8, or not valid in the encoding it declares) is refused too. Files are
+read in a thread of their own whose C stack holds a level of nesting for
+every opening bracket of the file: embedded in Python, SWI-Prolog has no
+guard against C-stack overflow, and a term nested 50,000 deep killed the
+process. (Each level of nesting takes an opening bracket or a prefix
+operator, so their count bounds the depth.)
 
 Anything else stops the load with ``error-Text``, one line naming file, line
 and what was found. Clauses are added with ``assertz/1`` as they are read;
 a refusal further down erases what this file added, so a refused file
 leaves the KB as it was. With mode ``check`` nothing is asserted (used
-before compiling a source to ``.qlf``). Reading is the cost (``read_term``
+before compiling a source to ``.qlf``). The caller passes a private copy of
+the file (:mod:`neurosym.prolog.snapshot`), so the bytes checked are the
+bytes loaded or compiled. Reading is the cost (``read_term``
 takes about 1.5 us a fact here, consult about 10), so on a machine with 4
 cores or more, files of 8 MB and more are cut at line starts and read by one
 helper thread per core (up to 4 threads in all) in small checked batches,
@@ -35,10 +51,12 @@ file is read front to back; ``set_reader_threads/1`` overrides the choice
 
 from __future__ import annotations
 
+from neurosym.terms import MAX_DEPTH
+
 MODULE = "neurosym_facts"
 
-SOURCE = r"""
-:- module(neurosym_facts, [load_facts/6, set_chunk_bytes/1, set_reader_threads/1]).
+_SOURCE = r"""
+:- module(neurosym_facts, [load_facts/7, set_chunk_bytes/1, set_reader_threads/1]).
 :- use_module(library(lists), [member/2, append/3]).
 :- use_module(library(apply), [exclude/3]).
 :- use_module(library(error), [must_be/2]).
@@ -71,21 +89,71 @@ set_chunk_bytes(Bytes) :-
     retractall(chunk_bytes_(_)),
     assertz(chunk_bytes_(Bytes)).
 
-%!  load_facts(+Module, +File, +Mode, +RuleFiles, -Count, -Status) is det.
+%!  load_facts(+Module, +File, +Mode, +RuleFiles, +CStack, -Count, -Status) is det.
 %   Mode: assert or check. RuleFiles: the source ids of the KB's rule files.
-%   Count: terms read. Status: ok or error-Text.
-load_facts(M, File, Mode, RuleFiles, Count, Status) :-
-    retractall(touched_(_, _, _)),
+%   CStack: bytes of C stack for the threads that read File. Count: terms
+%   read. Status: ok or error-Text.
+%
+%   Embedded in Python, SWI-Prolog runs without its signal handlers, and
+%   these are what turn a C-stack overflow into an error: parsing a term
+%   nested deeper than the C stack holds would kill the process. So File is
+%   read in a thread of its own whose C stack holds more levels than any term
+%   in File can have (the caller bounds them, counting opening brackets and
+%   prefix operators in a copy nobody else writes).
+load_facts(M, File, Mode, RuleFiles, CStack, Count, Status) :-
+    catch(thread_create(load_facts_(M, File, Mode, RuleFiles, CStack), Id, [c_stack(CStack)]),
+          E, true),
+    (   nonvar(E)
+    ->  Count = 0, message_(E, File, Text), Status = error-Text
+    ;   thread_join(Id, Exit),
+        (   Exit = exited(Count-Status)
+        ->  true
+        ;   Count = 0, message_(Exit, File, Text), Status = error-Text
+        )
+    ).
+
+load_facts_(M, File, Mode, RuleFiles, CStack) :-
+    thread_self(Me),
+    assertz(reading_(Me)),
     b_setval(neurosym_rule_files, RuleFiles),
-    catch(load_(M, File, Mode, RuleFiles, Count), E, true),
+    b_setval(neurosym_c_stack, CStack),
+    catch(( load_(M, File, Mode, RuleFiles, Count0), no_warnings_(Me) ), E, true),
     (   var(E)
-    ->  Status = ok
+    ->  Count = Count0, Status = ok
     ;   Count = 0,
         ( Mode == assert -> rollback_(M) ; true ),
         message_(E, File, Text),
         Status = error-Text
     ),
-    retractall(touched_(_, _, _)).
+    retractall(warned_(Me, _)),
+    thread_exit(Count-Status).
+
+% Anything SWI-Prolog warns about while reading (text that is not valid in
+% the file's encoding, above all) refuses the file: a warning printed on the
+% way would be the only sign that facts were read wrong.
+:- thread_local reading_/1.   % reading_(Owner): this thread reads for load thread Owner
+:- dynamic warned_/2.         % warned_(Owner, Text): the first warning of a load
+
+:- multifile user:message_hook/3.
+:- dynamic user:message_hook/3.
+user:message_hook(_Term, Kind, Lines) :-
+    ( Kind == warning ; Kind == error ),
+    neurosym_facts:reading_(Owner),
+    !,
+    neurosym_facts:note_warning_(Owner, Lines).
+
+note_warning_(Owner, Lines) :-
+    (   warned_(Owner, _)
+    ->  true
+    ;   lines_text_(Lines, Text),
+        assertz(warned_(Owner, Text))
+    ).
+
+no_warnings_(Owner) :-
+    (   warned_(Owner, Text)
+    ->  throw(neurosym_warned(Text))
+    ;   true
+    ).
 
 % A large file is cut at line starts into one chunk per core; helper threads
 % read and check chunks 1.. into lists while this thread reads chunk 0 and
@@ -130,7 +198,9 @@ start_helpers_(Cuts, File, M, RuleFiles, Helpers) :-
 start_helpers_([], _, _, _, _, []).
 start_helpers_([From|Fs], [_, To|Ts], File, M, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
     message_queue_create(Q, [max_size(64)]),
-    thread_create(read_chunk_(File, M, RuleFiles, Q, From, To), Id, []),
+    b_getval(neurosym_c_stack, CStack),
+    thread_self(Owner),
+    thread_create(read_chunk_(Owner, File, M, RuleFiles, Q, From, To), Id, [c_stack(CStack)]),
     start_helpers_(Fs, [To|Ts], File, M, RuleFiles, Hs).
 
 % A helper blocked on its full queue is woken by the queue's destruction.
@@ -145,7 +215,8 @@ stop_helpers_(Helpers) :-
 % the byte after the last term (eof at the end of the file); it stops at
 % anything but plain facts, so the main thread reads that part itself.
 % Small batches keep the helper's stacks (and its garbage collections) small.
-read_chunk_(File, M, RuleFiles, Q, From, To) :-
+read_chunk_(Owner, File, M, RuleFiles, Q, From, To) :-
+    assertz(reading_(Owner)),
     b_setval(neurosym_rule_files, RuleFiles),
     catch(setup_call_cleanup(
               ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
@@ -168,11 +239,11 @@ chunk_batches_(S, M, Q, To, PName, PArity) :-
 % Up to K terms; End0 is more, eof, or the byte position past To.
 chunk_terms_(_, _, _, PName, PArity, 0, [], PName, PArity, more) :- !.
 chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    read_(S, 0, T, QQ),
     (   T == end_of_file
     ->  Terms = [], LName = PName, LArity = PArity, End = eof
     ;   QQ == [],
-        (   nonvar(T), functor(T, PName, PArity)
+        (   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   T \= (:- _),
             check_(T, S, M, check, 0, Name, Arity)
@@ -231,7 +302,7 @@ take_batches_(Q, S, M, Mode, Pos, PName, PArity, N0, N, Name, Arity, End) :-
 add_terms_([], _, _, _, PName, PArity, N, N, PName, PArity).
 add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
     N1 is N0 + 1,
-    (   functor(T, PName, PArity)
+    (   same_(T, PName, PArity)
     ->  Name1 = PName, Arity1 = PArity
     ;   check_(T, S, M, Mode, N1, Name1, Arity1)
     ),
@@ -241,13 +312,14 @@ add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
 % Like read_loop_, stopping after the term that reaches byte Stop: End is
 % that byte position, or eof.
 read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    N1 is N0 + 1,
+    read_(S, N1, T, QQ),
     (   T == end_of_file
     ->  N = N0, LName = PName, LArity = PArity, End = eof
-    ;   N1 is N0 + 1,
+    ;
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
-        ;   nonvar(T), functor(T, PName, PArity)
+        ;   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   check_(T, S, M, Mode, N1, Name, Arity),
             (   T = (:- encoding(Enc)), Enc \== utf8
@@ -268,15 +340,16 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
     ).
 
 % The tight loop: a fact of the same predicate as the previous one needs no
-% check beyond its functor; a new functor goes through check_/7 once.
+% check beyond its functor and groundness; a new functor goes through check_/7 once.
 read_loop_(S, M, Mode, PName, PArity, N0, N) :-
-    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    N1 is N0 + 1,
+    read_(S, N1, T, QQ),
     (   T == end_of_file
     ->  N = N0
-    ;   N1 is N0 + 1,
+    ;
         (   QQ \== []
         ->  refuse_(N1, 'a quasi-quotation', T)
-        ;   nonvar(T), functor(T, PName, PArity)
+        ;   same_(T, PName, PArity)
         ->  Name = PName, Arity = PArity
         ;   check_(T, S, M, Mode, N1, Name, Arity)
         ),
@@ -287,27 +360,100 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
         )
     ).
 
+%   read_(+S, +N, -T, -QQ): the N-th term of S (end_of_file at the end), refused
+%   when nested more than max_depth_/1 levels deep. Each level takes at least
+%   one opening bracket, so only a term whose text is longer than that limit
+%   is measured. The parse itself is safe: the reading thread's C stack holds
+%   as many levels as the file could nest (load_facts/7).
+read_(S, N, T, QQ) :-
+    byte_count(S, B0),
+    read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
+    byte_count(S, B),
+    max_depth_(D),
+    (   B - B0 =< D
+    ->  true
+    ;   shallow_(T, D)
+    ->  true
+    ;   format(atom(What), 'a term nested more than ~D levels deep', [D]),
+        refuse_(N, What, T)
+    ).
+
+%   shallow_(+T, +D): T is nested at most D levels deep (a compound or a
+%   proper list is one level, as the bridge counts answers).
+shallow_(T, D) :-
+    (   compound(T)
+    ->  D > 0,
+        D1 is D - 1,
+        (   is_list(T)
+        ->  forall(member(X, T), shallow_(X, D1))
+        ;   compound_name_arguments(T, _, As),
+            forall(member(A, As), shallow_(A, D1))
+        )
+    ;   true
+    ).
+
+%   same_(+T, +Name, +Arity): T is a ground fact of the predicate just checked.
+same_(T, Name, Arity) :- nonvar(T), functor(T, Name, Arity), ground(T).
+
 %   check_(+Term, +Stream, +M, +Mode, +N, -Name, -Arity): the predicate of a
 %   fact, or (:-)/1 for an accepted header; throws neurosym_refused/3.
-check_(T, _, _, _, N, _, _) :- var(T), !, refuse_(N, 'a variable where a fact should be', T).
-check_((:- D), S, M, Mode, N, (:-), 1) :- !, header_(D, S, M, Mode, N).
-check_(T, _, _, _, N, _, _) :- T = (?- _), !, refuse_(N, 'a directive', T).
-check_(T, _, _, _, N, _, _) :- T = (_ :- _), !, refuse_(N, 'a clause with a body (a rule)', T).
-check_(T, _, _, _, N, _, _) :- T = (_ --> _), !, refuse_(N, 'a grammar rule', T).
-check_(T, _, _, _, N, _, _) :- T = (_ : _), !, refuse_(N, 'a module-qualified clause', T).
-check_(T, _, _, _, N, _, _) :- \+ callable(T), !, refuse_(N, 'a term that is not a fact', T).
+%   A term is admitted when it has the shape of a fact (fact_shape_/1), not
+%   when it misses a list of known bad forms: a clause-like form SWI-Prolog
+%   adds one day has an operator for a name, and is refused as it is today.
+check_((:- D), S, M, Mode, N, (:-), 1) :- nonvar(D), !, header_(D, S, M, Mode, N).
 check_(T, _, M, _, N, Name, Arity) :-
+    (   fact_shape_(T)
+    ->  functor(T, Name, Arity),
+        predicate_check_(M, Name, Arity, N, T),
+        ( ground(T) -> true ; refuse_(N, 'a fact with a variable (facts are ground)', T) ),
+        note_touched_(M, Name, Arity)
+    ;   not_a_fact_(T, What),
+        refuse_(N, What, T)
+    ).
+
+%   fact_shape_(+T): T is an atom or compound whose name is a plain
+%   predicate name (plain_name_/1); check_/7 then asks for it to be ground.
+fact_shape_(T) :-
+    callable(T),
+    functor(T, Name, _),
+    plain_name_(Name).
+
+%   plain_name_(+Name): a name written without quotes that is no operator:
+%   a lowercase letter, then letters, digits and underscores (p, kb_meta,
+%   ключ). Operators (:-, =>, -->, ?-, :) and quoted names are not.
+plain_name_(Name) :-
+    atom(Name),
+    atom_codes(Name, [C|Cs]),
+    code_type(C, csymf), C \== 0'_, \+ code_type(C, upper),
+    forall(member(X, Cs), code_type(X, csym)).
+
+%   not_a_fact_(+T, -What): what T is, for the message.
+not_a_fact_(T, 'a variable where a fact should be') :- var(T), !.
+not_a_fact_((?- _), 'a directive') :- !.
+not_a_fact_((:- _), 'a directive') :- !.
+not_a_fact_((_ :- _), 'a clause with a body (a rule)') :- !.
+not_a_fact_((_ => _), 'a rule (Head => Body)') :- !.
+not_a_fact_((_ --> _), 'a grammar rule') :- !.
+not_a_fact_((_ : _), 'a module-qualified clause') :- !.
+not_a_fact_(T, 'a term that is not a fact') :- \+ callable(T), !.
+not_a_fact_(T, What) :-
     functor(T, Name, Arity),
-    predicate_check_(M, Name, Arity, N, T),
-    note_touched_(M, Name, Arity).
+    \+ plain_name_(Name), !,
+    format(atom(What), 'a term whose name ~q (~q/~w) is not a plain predicate name', [Name, Name, Arity]).
 
 header_(D, S, M, Mode, N) :-
-    (   nonvar(D), D = encoding(Enc), atom(Enc),
+    (   D = encoding(Enc), atom(Enc),
         catch(set_stream(S, encoding(Enc)), _, fail)
     ->  true
-    ;   nonvar(D), D = dynamic(Spec), specs_(Spec, PIs)
+    ;   D = dynamic(Spec), specs_(Spec, PIs)
     ->  forall(member(Name/Arity, PIs),
-               (   predicate_check_(M, Name, Arity, N, (:- D)),
+               (   (   plain_name_(Name)
+                   ->  true
+                   ;   format(atom(What), 'a declaration of ~q/~w, which is not a plain predicate name',
+                              [Name, Arity]),
+                       refuse_(N, What, (:- D))
+                   ),
+                   predicate_check_(M, Name, Arity, N, (:- D)),
                    note_touched_(M, Name, Arity),
                    ( Mode == assert -> dynamic(M:Name/Arity) ; true )
                ))
@@ -418,9 +564,12 @@ message_(neurosym_refused(N, What, Term), File, Text) :- !,
                            write_term(Term, [quoted(true), max_depth(8), portray(false),
                                              numbervars(true), spacing(next_argument)]) )),
     format(string(Text),
-           "~w:~w: found ~w: ~w; a fact file holds only facts such as p(a, 1). and the \c
+           "~w:~w: found ~w: ~w; a fact file holds only ground facts such as p(a, 1). and the \c
             writer's :- encoding/dynamic headers (load code as rules, or trust the file)",
            [File, Line, What, Shown]).
+message_(neurosym_warned(Warning), File, Text) :- !,
+    format(string(Text), "~w: ~w (a fact file is UTF-8 text, or says :- encoding(Enc). first)",
+           [File, Warning]).
 message_(error(syntax_error(What), Context), File, Text) :- !,
     (   catch('$messages':translate_message(error(syntax_error(What), _), Lines, []), _, fail),
         lines_text_(Lines, Msg)
@@ -466,3 +615,5 @@ nth_term_line_(S, N, Line) :-
         nth_term_line_(S, N1, Line)
     ).
 """
+
+SOURCE = _SOURCE + f"\nmax_depth_({MAX_DEPTH}).\n"

@@ -2,17 +2,22 @@
 
 Fact files are data, rule files are code (docs/design.md, "Prolog"). A KB is
 something people pass around, so a fact file is never consulted: it is read
-term by term (:mod:`neurosym.prolog.fact_reader`) and only facts and the
-writer's ``:- encoding``/``:- dynamic`` headers are accepted; anything else
-(directives, rules, hooks, built-in or rule-defined predicates) is refused
-with one line naming file and line, and nothing of the file has run or
-stays loaded. Rule files (``rules=``) are consulted as code, before the
+term by term (:mod:`neurosym.prolog.fact_reader`) and only ground facts
+with plain predicate names and the writer's ``:- encoding``/``:- dynamic``
+headers are admitted; anything else (directives, rules of any kind, hooks,
+built-in or rule-defined predicates, terms nested deeper than
+:data:`~neurosym.terms.MAX_DEPTH`, text that is not UTF-8) is refused with one
+line naming file and line, and nothing of the file has run or stays loaded.
+Every file is read once, into a private copy, and checked, loaded and
+compiled from that copy only (:mod:`neurosym.prolog.snapshot`). Rule files (``rules=``) are consulted as code, before the
 facts, so facts for a predicate the rules define are refused. ``trusted=``
 (True, or the fact files to trust) consults fact files as code. A ``.qlf``
 is compiled code and loads only when neurosym signed it on this account
 (:mod:`neurosym.prolog.signature`) or when trusted. Queries take
 ``timeout=``, ``inferences=`` and ``stack_limit=``: a goal that goes past
-one stops with a one-line :class:`~neurosym.errors.PrologError`.
+one stops with a one-line :class:`~neurosym.errors.PrologError`. Ctrl-C
+stops a running goal with :class:`KeyboardInterrupt` (Prolog checks for it
+every 100,000 inferences; the KB stays usable).
 
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
 one process even when they load the same rule file. Files are plain Prolog
@@ -27,7 +32,13 @@ Values cross the boundary as data, never as goal text:
 * outputs: atoms and strings -> ``str``, numbers -> ``int``/``float``,
   lists -> ``list``, compound terms -> :class:`~neurosym.terms.Term` (whose
   ``str()`` is the canonical text that recordings store, e.g.
-  ``picked(sword)``; lists inside a Term are tuples), unbound variables -> None.
+  ``picked(sword)``; lists inside a Term are tuples), an unbound output
+  variable -> None, an unbound variable inside a value ->
+  :class:`~neurosym.terms.Var` (``_G1``, shared within one answer).
+
+Values are at most :data:`~neurosym.terms.MAX_DEPTH` levels deep each way,
+integers in answers at most 4,300 digits (Python's limit for writing one);
+a deeper or larger value is refused with one line.
 
 Output variables are the goal's named variables that are not inputs; names
 starting with ``_`` are left out. Any Prolog error (syntax, unknown
@@ -58,11 +69,12 @@ from os import PathLike
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from neurosym.errors import ConfigError, NeurosymError, PrologError
+from neurosym.errors import ConfigError, NeurosymError, OutputError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
 from neurosym.prolog.locate import import_janus
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
-from neurosym.terms import Term
+from neurosym.prolog.snapshot import Snapshot, nesting_bound, nesting_of, snapshot
+from neurosym.terms import MAX_DEPTH, Term, Var
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -70,9 +82,23 @@ if TYPE_CHECKING:
 PathArg = str | PathLike[str]
 _VARIABLE = re.compile(r"[A-Z_][A-Za-z0-9_]*")
 _SCALARS = frozenset({str, int, float, type(None)})
+_INT64_MAX = (1 << 63) - 1
+# How deeply a goal's text can nest (snapshot.nesting_of); the C stack
+# SWI-Prolog parses it on holds far more than this many levels.
+_GOAL_NESTING = 5_000
+# The C stack of the threads that read a file: parsing took up to 566 bytes
+# of it per level of nesting (SWI-Prolog 9.2, x86-64), and no term nests
+# deeper than the file's nesting_bound. Address space is reserved, not memory:
+# pages are taken only as a parse goes deep.
+_C_STACK_BASE = 16 << 20
+_C_STACK_PER_LEVEL = 768
 _ids = itertools.count(1)
 _bridge_lock = threading.Lock()
 _bridge_loaded = False
+
+
+MAX_TIMEOUT = 1e9
+"""The longest ``timeout`` a query takes, in seconds (about 32 years)."""
 
 
 class Answers(NamedTuple):
@@ -123,6 +149,8 @@ def _call_once(goal: str, inputs: dict[str, Any]) -> dict[str, Any]:
     try:
         return janus.query_once(goal, inputs)
     except janus.PrologError as exc:  # the bridge catches user errors; this is a bug or a crash
+        if str(exc).startswith("Python 'KeyboardInterrupt'"):  # Ctrl-C, seen at a heartbeat
+            raise KeyboardInterrupt from None
         raise PrologError(_one_line(str(exc))) from exc
 
 
@@ -130,8 +158,10 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
-def _to_prolog(value: Any, name: str) -> Any:
+def _to_prolog(value: Any, name: str, depth: int = 0) -> Any:
     """Python input value -> what janus turns into the intended Prolog term."""
+    if depth > MAX_DEPTH:
+        raise ConfigError(f"input {name} is nested more than {MAX_DEPTH} levels deep")
     if isinstance(value, str):
         return value
     if isinstance(value, bool):
@@ -141,12 +171,13 @@ def _to_prolog(value: Any, name: str) -> Any:
     if isinstance(value, Term):
         if not value.args:
             return value.functor
-        return ("$neurosym_term", value.functor, [_to_prolog(a, name) for a in value.args])
+        args = [_to_prolog(a, name, depth + 1) for a in value.args]
+        return ("$neurosym_term", value.functor, args)
     if isinstance(value, list | tuple):
-        return [_to_prolog(v, name) for v in value]
+        return [_to_prolog(v, name, depth + 1) for v in value]
     kind = getattr(getattr(value, "dtype", None), "kind", None)
     if kind in ("b", "i", "u", "f", "U"):  # numpy scalars
-        return _to_prolog(value.item(), name)
+        return _to_prolog(value.item(), name, depth)
     if value is None:
         raise ConfigError(f"input {name} is None; leave it out to keep {name} a free variable")
     raise ConfigError(f"input {name}: cannot pass a {type(value).__name__} to Prolog")
@@ -158,9 +189,17 @@ def _from_prolog(value: Any) -> Any:
         return value
     if isinstance(value, tuple):
         functor, args = value
-        return Term(functor, tuple(_from_prolog(a) for a in args))
+        for i, arg in enumerate(args):  # a loop, not a generator: one Python frame per level
+            if type(arg) not in _SCALARS:
+                args[i] = _from_prolog(arg)
+        return Term(functor, tuple(args))
     if isinstance(value, list):
-        return [_from_prolog(v) for v in value]
+        for i, item in enumerate(value):
+            if type(item) not in _SCALARS:
+                value[i] = _from_prolog(item)
+        return value
+    if isinstance(value, dict):  # the bridge's var:N
+        return Var(f"_G{value['var']}")
     return value
 
 
@@ -170,8 +209,15 @@ def _bounds(
     """The query's bounds as ``Name-Value`` pairs for the bridge, checked."""
     out: list[tuple[str, float | int]] = []
     if timeout is not None:
-        if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
-            raise ConfigError(f"timeout must be a positive number of seconds, not {timeout!r}")
+        if (
+            isinstance(timeout, bool)
+            or not isinstance(timeout, int | float)
+            or not 0 < timeout <= MAX_TIMEOUT
+        ):
+            raise ConfigError(
+                f"timeout must be a positive number of seconds up to {MAX_TIMEOUT:.0e} "
+                f"(a year is 3e7), not {timeout!r}"
+            )
         out.append(("timeout", float(timeout)))
     for name, value, floor in (
         ("inferences", inferences, 1),
@@ -179,8 +225,14 @@ def _bounds(
     ):
         if value is None:
             continue
-        if isinstance(value, bool) or not isinstance(value, int) or value < floor:
-            raise ConfigError(f"{name} must be an integer of at least {floor}, not {value!r}")
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int)
+            or not floor <= value <= _INT64_MAX
+        ):
+            raise ConfigError(
+                f"{name} must be an integer of at least {floor} and at most 2**63-1, not {value!r}"
+            )
         out.append(("inferences" if name == "inferences" else "stack", value))
     return out
 
@@ -248,15 +300,10 @@ class KnowledgeBase:
         self._check_open()
         path = _existing(path)
         if path.suffix == ".qlf":
-            if not trusted:
-                reason = signature.check(path)
-                if reason is not None:
-                    raise PrologError(
-                        f"cannot load {path}: a .qlf is compiled code and this one was not "
-                        f"compiled by neurosym on this account ({reason}); load its .pl source "
-                        f"instead, or trust the file (--trust {path.name} / trusted=True)"
-                    )
-            self._finish(path, *self._load_file(path, "qlf"))
+            if trusted:
+                self._finish(path, *self._load_file(path, "qlf"))
+            else:
+                self._load_signed_qlf(path)
         elif qlf:
             self._load_through_qlf(path, trusted)
         elif trusted:
@@ -264,6 +311,18 @@ class KnowledgeBase:
         else:
             self._read_facts(path, "assert")
             self.files.append(path)
+
+    def _load_signed_qlf(self, path: Path) -> None:
+        """Load a ``.qlf`` from a private copy of the very bytes whose signature was checked."""
+        with snapshot(path) as copy:
+            reason = signature.check_digests(path, copy.sha256)
+            if reason is not None:
+                raise PrologError(
+                    f"cannot load {path}: a .qlf is compiled code and this one was not "
+                    f"compiled by neurosym on this account ({reason}); load its .pl source "
+                    f"instead, or trust the file (--trust {path.name} / trusted=True)"
+                )
+            self._finish(path, *self._load_file(path, "qlf", data=copy.path))
 
     def load_rules(self, path: PathArg) -> None:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
@@ -283,32 +342,67 @@ class KnowledgeBase:
         self._rule_ids.extend([*self._source_ids[before:], str(path)])
 
     def _load_through_qlf(self, path: Path, trusted: bool) -> None:
-        if trusted:
-            compiled = not is_fresh(path)
-        else:
-            compiled = signature.check(qlf_path(path), source=path) is not None
-            if compiled:
-                self._read_facts(path, "check")  # nothing of an unchecked source is compiled
-        if compiled:
-            qcompile(path)
-        errors, notes = self._load_file(path, "qlf")
-        if errors and not compiled:  # e.g. a .qlf from another SWI-Prolog version
-            if not trusted:
-                self._read_facts(path, "check")
-            qcompile(path)
-            errors, notes = self._load_file(path, "qlf")
-        self._finish(path, errors, notes)
+        """Load ``path`` through its ``.qlf``, compiled first when that one will not do.
 
-    def _read_facts(self, path: Path, mode: str) -> int:
-        """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms."""
+        The source is read once, into a private copy: that copy is hashed,
+        checked as data and compiled, so the ``.qlf`` comes from the very
+        bytes that were checked; a signed ``.qlf`` is loaded from a private
+        copy of the bytes whose signature was checked.
+        """
+        target = qlf_path(path)
+        if trusted and is_fresh(path):
+            errors, notes = self._load_file(path, "qlf")
+            if not errors:
+                self._finish(path, errors, notes)
+                return
+        with snapshot(path) as source:
+            if not trusted and self._load_qlf_if_signed(path, target, source.sha256):
+                return
+            if not trusted:
+                self._read_facts(path, "check", source)  # nothing of an unchecked source is compiled
+            try:
+                qcompile(source.path, target=target)
+            except OutputError as exc:
+                raise OutputError(f"{exc}; load {path.name} without --qlf (qlf=False)") from None
+            built = qlf_path(source.path)  # the private .qlf just copied to target
+            self._finish(path, *self._load_file(path, "qlf", data=built))
+
+    def _load_qlf_if_signed(self, path: Path, target: Path, source_sha: str) -> bool:
+        """Load ``target`` when its signature vouches for it and ``source_sha``; False otherwise."""
+        if not target.is_file():
+            return False
+        with snapshot(target) as copy:
+            if signature.check_digests(target, copy.sha256, source_sha, path.name) is not None:
+                return False
+            errors, notes = self._load_file(path, "qlf", data=copy.path)
+        if errors:  # e.g. a .qlf of another SWI-Prolog version: compiled again
+            return False
+        self._finish(path, errors, notes)
+        return True
+
+    def _read_facts(self, path: Path, mode: str, copy: Snapshot | None = None) -> int:
+        """Read ``path`` as data (mode 'assert') or only check it ('check'); the number of terms.
+
+        The file is read from a private copy (``copy``, or one made here), so
+        that what is checked is what is loaded.
+        """
+        if copy is None:
+            with snapshot(path) as copy:
+                return self._read_facts(path, mode, copy)
         answer = _call_once(
-            f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, Count, Status)",
-            {"M": self.module, "File": str(path), "Mode": mode, "Rules": self._rule_ids},
+            f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, CStack, Count, Status)",
+            {
+                "M": self.module,
+                "File": str(copy.path),
+                "Mode": mode,
+                "Rules": self._rule_ids,
+                "CStack": _C_STACK_BASE + _C_STACK_PER_LEVEL * copy.nesting,
+            },
         )
         status = answer["Status"]
         if status != "ok":
             _, text = status
-            raise PrologError(f"cannot load {self._clean(text)}")
+            raise PrologError(f"cannot load {self._clean(text.replace(str(copy.path), str(path)))}")
         return int(answer["Count"])
 
     def _finish(self, path: Path, errors: list[str], notes: list[str]) -> None:
@@ -320,22 +414,34 @@ class KnowledgeBase:
             warnings.warn(note, PrologWarning, stacklevel=3)
         self.files.append(path)
 
-    def _load_file(self, path: Path, fmt: str) -> tuple[list[str], list[str]]:
-        """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error."""
+    def _load_file(
+        self, path: Path, fmt: str, data: Path | None = None
+    ) -> tuple[list[str], list[str]]:
+        """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error.
+
+        ``data``: the file to read the bytes from (a private copy), when not ``path`` itself.
+        """
         if fmt == "qlf":
-            load_file = qlf_path(path)
+            load_file = data or qlf_path(path)
             # A per-module directory: SWI-Prolog relocates the .qlf's recorded
             # source path into it, so each KB owns its own copy of the clauses.
             source_id = f"{path.parent}/.{self.module}/{load_file.name}"
             clause_source = f"{path.parent}/.{self.module}/{path.stem}.pl"
             aliases = {clause_source: str(path.with_suffix(".pl")), source_id: str(path)}
         else:
-            load_file = path
+            load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
+        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting_bound(load_file)
         answer = _call_once(
-            f"{bridge.MODULE}:load(M, Id, File, Format, Messages)",
-            {"M": self.module, "Id": source_id, "File": str(load_file), "Format": fmt},
+            f"{bridge.MODULE}:load(M, Id, File, Format, CStack, Messages)",
+            {
+                "M": self.module,
+                "Id": source_id,
+                "File": str(load_file),
+                "Format": fmt,
+                "CStack": c_stack,
+            },
         )
         errors, notes = [], []
         for kind, text in answer["Messages"]:
@@ -482,6 +588,11 @@ class KnowledgeBase:
         if not isinstance(goal, str) or not goal.strip():
             raise ConfigError(
                 f"the goal must be Prolog text such as 'object(Id, Type)', not {goal!r}"
+            )
+        if nesting_of(goal) > _GOAL_NESTING:
+            raise ConfigError(
+                f"the goal could nest more than {_GOAL_NESTING:,} levels deep (opening brackets "
+                "and prefix operators); pass large values as inputs (keyword arguments), not as goal text"
             )
         return goal
 

@@ -67,7 +67,8 @@ def signature_path(qlf: Path | str) -> Path:
     return qlf.with_name(qlf.name + ".sig")
 
 
-def _sha256(path: Path) -> str:
+def sha256(path: Path) -> str:
+    """The SHA-256 of a file's bytes, hex."""
     digest = hashlib.sha256()
     with path.open("rb") as fh:
         while chunk := fh.read(1 << 20):
@@ -86,10 +87,14 @@ def sign(qlf: Path | str, source: Path | str) -> Path | None:
     Returns None (and writes nothing) when no key can be read or created; such
     a ``.qlf`` is then simply never trusted, which costs speed, not safety.
     """
+    return sign_digests(qlf, sha256(Path(qlf)), sha256(Path(source)))
+
+
+def sign_digests(qlf: Path | str, qlf_sha: str, source_sha: str) -> Path | None:
+    """Like :func:`sign`, for the SHA-256 of the very bytes compiled and written (no file read)."""
     key = _key(create=True)
     if key is None:
         return None
-    qlf_sha, source_sha = _sha256(Path(qlf)), _sha256(Path(source))
     body = {
         "format": FORMAT,
         "version": VERSION,
@@ -104,6 +109,23 @@ def sign(qlf: Path | str, source: Path | str) -> Path | None:
 
 def check(qlf: Path | str, source: Path | str | None = None) -> str | None:
     """None when ``qlf`` carries a valid signature (for ``source``, if given), else why not."""
+    qlf = Path(qlf)
+    qlf_sha = sha256(qlf) if qlf.is_file() else ""  # "" matches no signature
+    if source is None:
+        return check_digests(qlf, qlf_sha)
+    source = Path(source)
+    source_sha = sha256(source) if source.is_file() else ""
+    return check_digests(qlf, qlf_sha, source_sha, source.name)
+
+
+def check_digests(
+    qlf: Path | str, qlf_sha: str, source_sha: str | None = None, source_name: str | None = None
+) -> str | None:
+    """Like :func:`check`, for bytes already read and hashed: None when the
+    signature beside ``qlf`` vouches for ``qlf_sha`` (and ``source_sha``), else why not.
+
+    Loading then reads those same bytes (a private copy), never ``qlf`` again.
+    """
     qlf = Path(qlf)
     sig = signature_path(qlf)
     try:
@@ -120,11 +142,11 @@ def check(qlf: Path | str, source: Path | str | None = None) -> str | None:
     fields = [body.get(k) for k in ("qlf_sha256", "source_sha256", "hmac_sha256")]
     if not all(isinstance(f, str) for f in fields):
         return f"{sig.name} is incomplete"
-    qlf_sha, source_sha, mac = fields
-    if not hmac.compare_digest(_mac(key, qlf_sha, source_sha), mac):
+    signed_qlf, signed_source, mac = fields
+    if not hmac.compare_digest(_mac(key, signed_qlf, signed_source), mac):
         return f"{sig.name} was not made with this account's key"
-    if not qlf.is_file() or _sha256(qlf) != qlf_sha:
+    if qlf_sha != signed_qlf:
         return f"it is not the file {sig.name} signed"
-    if source is not None and (not Path(source).is_file() or _sha256(Path(source)) != source_sha):
-        return f"it was compiled from another version of {Path(source).name}"
+    if source_sha is not None and source_sha != signed_source:
+        return f"it was compiled from another version of {source_name or 'its source'}"
     return None
