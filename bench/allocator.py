@@ -1,4 +1,4 @@
-"""What keeping freed memory (neurosym.agent.allocator) saves in an update's forward and backward.
+"""What keeping freed memory (neurosym.agent.learners.allocator) saves in an update's forward and backward.
 
 Each measurement runs in a fresh process (the malloc settings are process-wide
 and stay), one torch thread, on the batch one A3C update sees: K envs x 40
@@ -20,10 +20,10 @@ import sys
 CHILD = r"""
 import json, resource, sys, time
 import torch
-from neurosym.agent.allocator import keep_freed_memory
+from neurosym.agent.learners.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig, preset_env_kwargs
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.trainer import probe_env
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.run.trainer import probe_env
 from neurosym.envs import env_family, make_batched
 
 env, k, module, keep, iters = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1", int(sys.argv[5])

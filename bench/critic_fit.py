@@ -77,7 +77,8 @@ def main(argv: list[str] | None = None) -> int:
     from sklearn.model_selection import cross_val_score
 
     from neurosym.agent.checkpoint import load_agent
-    from neurosym.agent.diagnostics import explained_variance, gradient_report
+    from neurosym.agent.diagnostics import gradient_report
+    from neurosym.agent.learners.returns import explained_variance
 
     agent = load_agent(args.checkpoint)
     model = agent.model

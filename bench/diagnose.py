@@ -23,7 +23,7 @@ import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.diagnostics import gradient_report, input_signal, signal_after_ppo_updates
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import env_family, make_batched
 
 

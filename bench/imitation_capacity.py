@@ -32,10 +32,10 @@ from typing import Any
 import numpy as np
 import torch
 
-from neurosym.agent.augment import augment_batch
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.imitation import imitation_loss, planner_choice
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.learners.augment import augment_batch
+from neurosym.agent.learners.imitation import imitation_loss, planner_choice
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
 

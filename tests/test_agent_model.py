@@ -6,9 +6,9 @@ import pytest
 import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.encoder import Encoder, coordinates
-from neurosym.agent.introspection import MHDPAIntrospection, PrediNetIntrospection
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.encoder import Encoder, coordinates
+from neurosym.agent.networks.introspection import MHDPAIntrospection, PrediNetIntrospection
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.errors import ConfigError
 
 RGW = ((9, 10, 10), "rgw", 1.0)
@@ -190,7 +190,7 @@ def _reference_attention(L, w_q, w_k, scale):
 
 
 def test_predinet_attention_backward_matches_autograd() -> None:
-    from neurosym.agent.predinet import PrediNetAttention
+    from neurosym.agent.networks.predinet import PrediNetAttention
 
     g = torch.Generator().manual_seed(0)
     B, N, F, H, D = 3, 7, 5, 2, 4
@@ -243,7 +243,7 @@ def test_recorded_queries_give_the_same_update_and_go_stale_with_the_weights() -
 def test_learned_queries_are_one_vector_for_every_scene() -> None:
     """ModelConfig.query "learned": no query projection, the same Q for every scene, the same
     gradients as plain autograd, and heads that still attend by what is in each scene."""
-    from neurosym.agent.predinet import PrediNetAttention
+    from neurosym.agent.networks.predinet import PrediNetAttention
 
     net = make("predinet", query="learned")
     rel = net.relational
@@ -343,7 +343,7 @@ def test_switching_keys_keeps_every_weight_but_w_k() -> None:
 
 
 def test_agent_window_is_the_cells_around_the_agent_zero_off_the_grid() -> None:
-    from neurosym.agent.model import agent_window
+    from neurosym.agent.networks.model import agent_window
 
     x = torch.zeros(2, 2, 4, 5)
     x[0, 0, 0, 0] = 1  # agent in the top-left corner
@@ -358,7 +358,7 @@ def test_agent_window_is_the_cells_around_the_agent_zero_off_the_grid() -> None:
 
 @pytest.mark.parametrize("module", ["predinet", "mhdpa"])
 def test_local_view_feeds_the_mlp_what_is_next_to_the_agent(module: str) -> None:
-    from neurosym.agent.model import agent_window
+    from neurosym.agent.networks.model import agent_window
 
     net = make(module, local_view=3)
     assert net.config.agent_plane == 0 and net.config.local_size == 9 * 9

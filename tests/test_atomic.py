@@ -26,10 +26,10 @@ import pandas as pd
 from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
 from neurosym.export.prolog_writer import write_prolog
 from neurosym.export.recording import Recording
-from neurosym.agent.trainer import _write_rows
+from neurosym.agent.run.trainer import _write_rows
 from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 
 out = Path(sys.argv[1])
 write_bytes_atomic(out / "bytes.bin", b"x")
@@ -79,7 +79,7 @@ from pathlib import Path
 import numpy as np, pandas as pd
 from neurosym.errors import NeurosymError
 from neurosym.export.prolog_writer import write_prolog
-from neurosym.agent.trainer import _write_rows
+from neurosym.agent.run.trainer import _write_rows
 
 out = Path(sys.argv[1])
 what = sys.argv[2]
@@ -91,7 +91,7 @@ try:
     else:
         from neurosym.agent.checkpoint import save_checkpoint
         from neurosym.agent.config import ModelConfig
-        from neurosym.agent.model import ActorCritic
+        from neurosym.agent.networks.model import ActorCritic
 
         config = ModelConfig.for_family("rgw", "predinet", (10, 10, 10), 1.0)
         save_checkpoint(out / "checkpoint.pt", model=ActorCritic(config), config=config, env_name="rgw2")

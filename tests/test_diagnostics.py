@@ -14,7 +14,7 @@ from neurosym.agent.diagnostics import (
     random_observations,
     signal_after_ppo_updates,
 )
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 
 
 @pytest.fixture(scope="module")

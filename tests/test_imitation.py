@@ -14,13 +14,13 @@ import torch
 from neurosym.agent.checkpoint import load_agent, read_checkpoint
 from neurosym.agent.cli_eval import score
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.imitation import (
+from neurosym.agent.learners.imitation import (
     LabelBuffer,
     expert_share,
     imitation_loss,
     imitation_update,
 )
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
 from neurosym.errors import ConfigError
@@ -123,7 +123,7 @@ def test_updates_fit_the_planners_labels() -> None:
 def test_augmented_updates_fit_the_turned_levels_too() -> None:
     """--augment: fitted on random turns and mirrors, the network also knows the levels turned;
     fitted on the levels as they come, it knows them less well."""
-    from neurosym.agent.augment import action_permutation, transform_grid
+    from neurosym.agent.learners.augment import action_permutation, transform_grid
 
     buf, _ = labelled_buffer()
     turned_obs = transform_grid(torch.from_numpy(buf.obs), 1, False).contiguous()
@@ -300,7 +300,7 @@ def test_safe_coef_adds_the_loss_of_the_set_that_gives_nothing_up() -> None:
 
 def test_augmented_safe_sets_turn_with_the_optimal_sets() -> None:
     """Stacked (B, 4, 2) sets move as one: each column pair stays with its action."""
-    from neurosym.agent.augment import augment_batch
+    from neurosym.agent.learners.augment import augment_batch
 
     optimal = torch.tensor([[True, False, False, False], [False, False, True, False]])
     safe = torch.tensor([[True, True, False, False], [False, True, True, True]])

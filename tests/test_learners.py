@@ -7,18 +7,16 @@ import math
 import pytest
 import torch
 
-from neurosym.agent.a3c import (
+from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
+from neurosym.agent.learners.a3c import a3c_loss
+from neurosym.agent.learners.optimizers import SharedAdam, SharedRMSprop, shared_optimizer
+from neurosym.agent.learners.ppo import ppo_update
+from neurosym.agent.learners.returns import (
     AdvantageScale,
-    SharedAdam,
-    SharedRMSprop,
-    a3c_loss,
+    explained_variance,
     gae_advantages,
     n_step_returns,
-    shared_optimizer,
 )
-from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.diagnostics import explained_variance
-from neurosym.agent.ppo import ppo_update
 from neurosym.agent.rollout import Rollout
 from neurosym.errors import ConfigError
 

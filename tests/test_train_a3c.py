@@ -6,12 +6,15 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.a3c import SharedRMSprop, a3c_loss, apply_update, n_step_returns
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.exploration import CountBonus
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.rollout import EpisodeTracker, Rollout, play_episodes, select_actions
-from neurosym.agent.sil import EpisodeMemory, SILBatch
+from neurosym.agent.evaluation import play_episodes
+from neurosym.agent.learners.a3c import a3c_loss, apply_update
+from neurosym.agent.learners.exploration import CountBonus
+from neurosym.agent.learners.optimizers import SharedRMSprop
+from neurosym.agent.learners.returns import n_step_returns
+from neurosym.agent.learners.sil import EpisodeMemory, SILBatch
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.rollout import EpisodeTracker, Rollout, select_actions
 
 
 class Lookup(torch.nn.Module):
@@ -339,7 +342,7 @@ def test_recorded_queries_give_the_recomputed_loss() -> None:
 
 def test_critic_warmup_update_moves_the_value_head_alone() -> None:
     """critic_only + only_prefix: the value loss, and only value.* weights (and their Adam state) move."""
-    from neurosym.agent.a3c import SharedAdam
+    from neurosym.agent.learners.optimizers import SharedAdam
 
     torch.manual_seed(0)
     config = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
@@ -377,7 +380,7 @@ def test_critic_warmup_update_moves_the_value_head_alone() -> None:
 
 
 def test_optimal_set_nll_is_minus_log_of_the_sets_probability() -> None:
-    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.agent.learners.planner_loss import optimal_set_nll
 
     logits = torch.tensor([[1.0, 2.0, 3.0, 4.0], [0.0, 0.0, 0.0, 0.0], [5.0, -1.0, 0.0, 2.0]])
     optimal = torch.tensor(
@@ -389,7 +392,7 @@ def test_optimal_set_nll_is_minus_log_of_the_sets_probability() -> None:
 
 
 def test_planner_coef_adds_the_masked_planner_loss() -> None:
-    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.agent.learners.planner_loss import optimal_set_nll
 
     torch.manual_seed(0)
     model = Lookup()
@@ -418,7 +421,7 @@ def test_planner_coef_adds_the_masked_planner_loss() -> None:
 
 
 def test_rollout_keeps_the_planners_optimal_actions() -> None:
-    from neurosym.agent.a3c import planner_labels
+    from neurosym.agent.learners.a3c import planner_labels
     from neurosym.agent.rollout import RolloutState, collect_rollout
     from neurosym.envs import make_batched
     from neurosym.envs.rgw_solver import Planner
@@ -441,12 +444,17 @@ def test_rollout_keeps_the_planners_optimal_actions() -> None:
 def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it() -> None:
     """A3C reports no PPO parts (blank), and one PPO update without an explained variance
     (its returns did not vary) does not blank the row's mean of the others."""
-    from neurosym.agent.trainer import _Stats
+    from neurosym.agent.learners.messages import LossStats, Update
+    from neurosym.agent.rollout import Finished
+    from neurosym.agent.run.trainer import _Stats
+
+    def update(*losses: float) -> Update:
+        return Update(0, 8, Finished.empty(), LossStats(*losses))
 
     nan = float("nan")
     stats = _Stats(0, 0, window=10)
-    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, 1e-3, 0.1, nan))
-    stats.add(8, [], [], [], (3.0, 4.0, 1.1, 0.7, 3e-3, 0.3, 0.6))
+    stats.add(update(1.0, 2.0, 1.3, 0.5, 1e-3, 0.1, nan))
+    stats.add(update(3.0, 4.0, 1.1, 0.7, 3e-3, 0.3, 0.6))
     row = stats.row(1.0, 8.0, None, None)
     assert (row["policy_loss"], row["entropy"], row["grad_norm"]) == ("2", "1.2", "0.6")
     assert (row["approx_kl"], row["clip_fraction"], row["explained_variance"]) == (
@@ -454,7 +462,7 @@ def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it()
         "0.2",
         "0.6",
     )
-    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, nan, nan, nan))  # an A3C worker's report
+    stats.add(update(1.0, 2.0, 1.3, 0.5))  # an A3C worker's report
     row = stats.row(2.0, 8.0, None, None)
     assert row["policy_loss"] == "1" and row["approx_kl"] == row["explained_variance"] == ""
     assert stats.row(3.0, 8.0, None, None)["policy_loss"] == ""  # no update since the last row
@@ -465,7 +473,7 @@ def test_frame_rate_spans_updates_not_one_log_row() -> None:
 
     Logged every 2 s over the row's own interval, the rate read 4,000 on one
     row in four and 0 on the others (PPO's metrics.csv before the window)."""
-    from neurosym.agent.trainer import FrameRate
+    from neurosym.agent.run.trainer import FrameRate
 
     rate = FrameRate(0.0, 0, window=30.0)
     frames, rates = 0, []

@@ -207,7 +207,7 @@ def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
     with the README's fine-tuning settings but a 10x learning rate, without and with the planner's
     loss beside it: A3C alone throws the planner's actions away within a few updates; with the
     planner's loss the policy keeps them (nll on the start states of levels neither run played)."""
-    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.agent.learners.planner_loss import optimal_set_nll
     from neurosym.envs import make_batched
     from neurosym.envs.rgw_solver import Planner
 

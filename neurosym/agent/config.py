@@ -415,7 +415,7 @@ class TrainConfig:
     ppo_advantages: str = "minibatch"
     """PPO, with ``normalize_advantages``: "minibatch" centres and scales each minibatch's
     advantages (SB3, CleanRL); "running" divides each rollout's by a running RMS of the
-    advantages seen so far (A3C's :class:`~neurosym.agent.a3c.AdvantageScale`), so that a
+    advantages seen so far (A3C's :class:`~neurosym.agent.learners.a3c.AdvantageScale`), so that a
     rollout without reward keeps its small advantages small instead of scaled to unit size.
     Measured on bw1 (PrediNet, 64 steps x 2 passes, README "Measured"): per minibatch with
     ``--attention-gain 32`` the policy collapsed below random (0.4 % success); "running" did not

@@ -6,7 +6,6 @@
   episode ends is not a real transition; ``valid`` says which are).
 * :func:`collect_rollout`: n steps of K envs acted without a graph; the A3C
   update runs the model once over the stacked rollout.
-* :func:`play_episodes`: play N whole episodes, one per sub-env, for evaluation.
 """
 
 from __future__ import annotations
@@ -214,26 +213,3 @@ def collect_rollout(
         queries=queries,
     )
     return rollout, finished
-
-
-def play_episodes(
-    act: Callable[[np.ndarray], np.ndarray],
-    make_venv: Callable[[int], Any],
-    episodes: int,
-    seed: int,
-    batch: int = 64,
-    max_steps: int = 100_000,
-) -> Finished:
-    """Play ``episodes`` whole episodes in waves of at most ``batch`` sub-envs.
-
-    Episode k is played from ``reset(seed=seed + k)``. ``act`` maps a batch of
-    observations to actions; ``make_venv(n)`` builds a batched env of n.
-    Results are in episode order. The loop is
-    :func:`neurosym.agent.evaluation.play_scored`'s, without its level scores.
-    """
-    from neurosym.agent.evaluation import play_scored
-
-    done = play_scored(
-        lambda obs, _venv: act(obs), make_venv, episodes, seed, batch, max_steps, levels=False
-    )
-    return Finished(done.returns, done.lengths, done.outcomes)

@@ -1,11 +1,11 @@
 """``neurosym train``: train a PrediNet or MHDPA agent with A3C (or PPO).
 
-A thin wrapper over :func:`neurosym.agent.trainer.train`. Unset options take
+A thin wrapper over :func:`neurosym.agent.run.trainer.train`. Unset options take
 the preset's defaults for the env family (``neurosym.agent.config``;
 ``--preset thesis`` is Table 4 exactly); with ``--resume`` they take the
 checkpoint's settings. The command line is stored in the checkpoint.
 Under ``torchrun`` (``--algo ppo``) every rank runs this command and rank 0
-writes (:mod:`neurosym.agent.distributed`).
+writes (:mod:`neurosym.agent.learners.distributed`).
 """
 
 from __future__ import annotations
@@ -338,7 +338,7 @@ def command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from neurosym.agent.trainer import RunOptions, train
+    from neurosym.agent.run.trainer import RunOptions, train
 
     overrides: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
     for _, dest, kind in _OVERRIDES:

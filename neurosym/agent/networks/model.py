@@ -21,10 +21,10 @@ import torch.nn.functional as F
 from torch import nn
 
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.encoder import Encoder
-from neurosym.agent.introspection import Introspection
-from neurosym.agent.mhdpa import MHDPA
-from neurosym.agent.predinet import PrediNet, QueryRecord
+from neurosym.agent.networks.encoder import Encoder
+from neurosym.agent.networks.introspection import Introspection
+from neurosym.agent.networks.mhdpa import MHDPA
+from neurosym.agent.networks.predinet import PrediNet, QueryRecord
 from neurosym.errors import ConfigError
 
 

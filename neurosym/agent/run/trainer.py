@@ -1,7 +1,7 @@
 """The training run: start the learner processes, watch them, evaluate, checkpoint, stop.
 
-The learners are the A3C workers (:func:`neurosym.agent.a3c.worker`, W of
-them) or one PPO learner (:func:`neurosym.agent.ppo.ppo_learner`); both write
+The learners are the A3C workers (:func:`neurosym.agent.learners.a3c.worker`, W of
+them) or one PPO learner (:func:`neurosym.agent.learners.ppo.ppo_learner`); both write
 into one shared model and report through one queue, so everything below is
 the same for both.
 
@@ -19,7 +19,7 @@ success rate over the last ``window`` training episodes reaching
 
 Under torchrun (PPO only) every rank runs this function; rank 0 alone
 evaluates and writes, the others only run their learner and stop when it
-does (:mod:`neurosym.agent.distributed` says how the ranks agree).
+does (:mod:`neurosym.agent.learners.distributed` says how the ranks agree).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import signal
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import astuple, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -43,17 +43,18 @@ import numpy as np
 import torch
 import torch.multiprocessing as mp
 
-from neurosym.agent import distributed
-from neurosym.agent.a3c import (
-    LossStats,
-    set_optimizer_hyperparameters,
-    shared_optimizer,
-    worker,
-)
 from neurosym.agent.checkpoint import build_model, read_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, play_episodes, select_actions
+from neurosym.agent.evaluation import play_episodes
+from neurosym.agent.learners import distributed
+from neurosym.agent.learners.a3c import worker
+from neurosym.agent.learners.imitation import imitation_learner
+from neurosym.agent.learners.messages import Failed, LossStats, Stopped, Update
+from neurosym.agent.learners.optimizers import set_optimizer_hyperparameters, shared_optimizer
+from neurosym.agent.learners.ppo import ppo_learner
+from neurosym.agent.learners.process import Learner, LearnerContext
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.rollout import SUCCESS_OUTCOMES, Finished, select_actions
 from neurosym.atomic import write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 
@@ -78,8 +79,20 @@ METRIC_COLUMNS = (
     "clip_fraction",
     "explained_variance",
 )
+LOSS_FORMATS = {
+    "policy_loss": ".5g",
+    "value_loss": ".5g",
+    "entropy": ".5g",
+    "grad_norm": ".5g",
+    "approx_kl": ".3g",
+    "clip_fraction": ".3g",
+    "explained_variance": ".3g",
+}
+"""metrics.csv's loss columns (:class:`LossStats` fields) and their number formats"""
 INIT_KEYS = ("init_from", "init_env", "init_frames", "init_wall_s")
 """What a run started with --init-from records of its source, in its metrics (kept on resume)."""
+LEARNERS: dict[str, Learner] = {"a3c": worker, "ppo": ppo_learner, "imitate": imitation_learner}
+"""Each ``--algo``'s learner process (:mod:`neurosym.agent.learners`)."""
 TARGET_TOLERANCE = 1e-6
 """A greedy mean return within this of the target counts as reaching it (10.7 is not exact in binary)."""
 
@@ -291,22 +304,16 @@ class _Stats:
         self.returns: collections.deque[float] = collections.deque(maxlen=window)
         self.success: collections.deque[bool] = collections.deque(maxlen=window)
         self.lengths: collections.deque[int] = collections.deque(maxlen=window)
-        self.losses: list[tuple[float, ...]] = []
+        self.losses: list[LossStats] = []
 
-    def add(
-        self,
-        frames: int,
-        returns: list[float],
-        lengths: list[int],
-        outcomes: list[str],
-        losses: tuple,
-    ) -> None:
-        self.frames += frames
-        self.episodes += len(returns)
-        self.returns.extend(returns)
-        self.lengths.extend(lengths)
-        self.success.extend(o in SUCCESS_OUTCOMES for o in outcomes)
-        self.losses.append(losses)
+    def add(self, update: Update) -> None:
+        done = update.finished
+        self.frames += update.frames
+        self.episodes += len(done.returns)
+        self.returns.extend(done.returns)
+        self.lengths.extend(done.lengths)
+        self.success.extend(o in SUCCESS_OUTCOMES for o in done.outcomes)
+        self.losses.append(update.stats)
 
     def mean_return(self) -> float | None:
         return float(np.mean(self.returns)) if self.returns else None
@@ -321,7 +328,7 @@ class _Stats:
         self, wall: float, fps: float, greedy: float | None, greedy_success: float | None
     ) -> dict[str, Any]:
         """One metrics.csv row (strings, blank where unknown); takes the losses since the last row."""
-        losses = self.take_losses() or (None,) * len(LossStats._fields)
+        losses = self.take_losses()
         return {
             "wall_s": _fmt(wall, ".2f"),
             "frames": self.frames,
@@ -332,25 +339,25 @@ class _Stats:
             "mean_length": _fmt(float(np.mean(self.lengths)) if self.lengths else None, ".2f"),
             "greedy_return": _fmt(greedy, ".4f"),
             "greedy_success": _fmt(greedy_success, ".4f"),
-            "policy_loss": _fmt(losses[0], ".5g"),
-            "value_loss": _fmt(losses[1], ".5g"),
-            "entropy": _fmt(losses[2], ".5g"),
-            "grad_norm": _fmt(losses[3], ".5g"),
-            "approx_kl": _fmt(losses[4], ".3g"),
-            "clip_fraction": _fmt(losses[5], ".3g"),
-            "explained_variance": _fmt(losses[6], ".3g"),
+            **{
+                name: _fmt(None if losses is None else getattr(losses, name), spec)
+                for name, spec in LOSS_FORMATS.items()
+            },
         }
 
-    def take_losses(self) -> tuple[float, ...] | None:
+    def take_losses(self) -> LossStats | None:
+        """The mean of each loss part over the updates since the last call (None: no update)."""
         if not self.losses:
             return None
-        losses = np.asarray(self.losses, dtype=np.float64)  # (updates, parts)
+        losses = np.asarray([astuple(s) for s in self.losses], dtype=np.float64)  # (updates, parts)
         # a part an update could not measure (NaN: a learner without it, or returns that did
         # not vary for explained_variance) is left out of the mean, not allowed to blank it
         counts = (~np.isnan(losses)).sum(axis=0)
         sums = np.nansum(losses, axis=0)
         self.losses = []
-        return tuple(float(s / c) if c else math.nan for s, c in zip(sums, counts, strict=True))
+        return LossStats(
+            *(float(s / c) if c else math.nan for s, c in zip(sums, counts, strict=True))
+        )
 
 
 class FrameRate:
@@ -646,36 +653,30 @@ def train(
     messages = ctx.Queue()
     procs = []
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # children start with Ctrl-C ignored
-    if train_config.algo == "ppo":
-        from neurosym.agent.ppo import ppo_learner as learner
-    elif train_config.algo == "imitate":
-        from neurosym.agent.imitation import imitation_learner as learner
-    else:
-        learner = worker
+    learner = LEARNERS[train_config.algo]
     try:
         for rank in range(learners):
             # under torchrun each rank's learner has its own seeds
             seed = _env_seed(train_config.seed, rank + world.rank, frames0)
-            args = (
-                rank,
-                shared,
-                optimizer,
-                model_config,
-                train_config,
-                name,
-                kwargs,
-                seed,
-                stop,
-                messages,
-            ) + (
-                (device,)
-                if train_config.algo == "ppo"
-                else (device, frames0)
-                if train_config.algo == "imitate"
-                else (frames0,)
+            args = LearnerContext(
+                rank=rank,
+                shared=shared,
+                optimizer=optimizer,
+                model_config=model_config,
+                train_config=train_config,
+                env_name=name,
+                env_kwargs=kwargs,
+                env_seed=seed,
+                stop=stop,
+                queue=messages,
+                device=device,
+                frames0=frames0,
             )
             proc = ctx.Process(
-                target=learner, args=args, daemon=True, name=f"neurosym-{train_config.algo}-{rank}"
+                target=learner,
+                args=(args,),
+                daemon=True,
+                name=f"neurosym-{train_config.algo}-{rank}",
             )
             proc.start()
             procs.append(proc)
@@ -727,14 +728,13 @@ def train(
                 msg = messages.get(timeout=timeout) if timeout > 0 else messages.get_nowait()
             except _queue.Empty:
                 return
-            if msg[0] == "update":
-                _, _, frames, rets, lens, outs, losses = msg
-                stats.add(frames, rets, lens, outs, losses)
-            elif msg[0] == "stopped":
-                learner_stopped, digests = True, list(msg[2])
-            elif msg[0] == "error" and failure is None:
+            if isinstance(msg, Update):
+                stats.add(msg)
+            elif isinstance(msg, Stopped):
+                learner_stopped, digests = True, list(msg.digests)
+            elif isinstance(msg, Failed) and failure is None:
                 where = f"rank {world.rank} " if world.distributed else ""
-                failure = f"{where}worker {msg[1]} failed:\n{msg[2]}"
+                failure = f"{where}worker {msg.rank} failed:\n{msg.traceback}"
 
     # Ctrl-C and SIGTERM (kill, a batch scheduler) stop the run: workers stopped, checkpoint written
     stop_signal = _StopSignal()

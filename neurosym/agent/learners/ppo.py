@@ -15,7 +15,7 @@ al. 2017)::
 
 with A normalised when ``normalize_advantages``: per minibatch (``ppo_advantages``
 "minibatch", as SB3 and CleanRL do) or per rollout by a running RMS kept across
-updates ("running", A3C's :class:`~neurosym.agent.a3c.AdvantageScale`). It writes
+updates ("running", :class:`~neurosym.agent.learners.returns.AdvantageScale`). It writes
 straight into the trainer's shared model with the trainer's optimiser and
 reports to the trainer through the same queue messages as an A3C worker, so
 evaluation, metrics, checkpoints, resume and stopping are one code path for
@@ -27,31 +27,23 @@ with its own optimiser, and after every update copies the weights and the
 optimiser's statistics into the trainer's shared ones, which the trainer
 evaluates and checkpoints: one code path for the CPU and a GPU. Under
 torchrun the copy is wrapped in ``DistributedDataParallel`` and the learners
-of all ranks form the process group (:mod:`neurosym.agent.distributed`).
+of all ranks form the process group (:mod:`neurosym.agent.learners.distributed`).
 """
 
 from __future__ import annotations
 
-import copy
 import os
-from typing import Any
 
 import torch
 import torch.nn.functional as F
 
-from neurosym.agent import distributed
-from neurosym.agent.a3c import (
-    AdvantageScale,
-    LossStats,
-    gae_advantages,
-    learner_process,
-    report_update,
-    shared_optimizer,
-)
-from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.diagnostics import explained_variance
-from neurosym.agent.exploration import CountBonus
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.config import TrainConfig
+from neurosym.agent.learners import distributed
+from neurosym.agent.learners.exploration import CountBonus
+from neurosym.agent.learners.messages import LossStats, Stopped
+from neurosym.agent.learners.optimizers import copy_into_shared, private_copy
+from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
+from neurosym.agent.learners.returns import AdvantageScale, explained_variance, gae_advantages
 from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 
 
@@ -145,117 +137,85 @@ def ppo_update(
     return LossStats(*mean, explained_variance=explained)
 
 
-@torch.no_grad()
-def copy_into_shared(
-    local: torch.nn.Module,
-    local_opt: torch.optim.Optimizer,
-    shared: torch.nn.Module,
-    shared_opt: torch.optim.Optimizer,
-) -> None:
-    """The learner's weights and optimiser statistics into the trainer's shared ones."""
-    for dst, src in zip(shared.parameters(), local.parameters(), strict=True):
-        dst.copy_(src)
-    for dst, src in zip(shared.buffers(), local.buffers(), strict=True):
-        dst.copy_(src)
-    for g_dst, g_src in zip(shared_opt.param_groups, local_opt.param_groups, strict=True):
-        for p_dst, p_src in zip(g_dst["params"], g_src["params"], strict=True):
-            s_dst, s_src = shared_opt.state[p_dst], local_opt.state[p_src]
-            for key, value in s_src.items():
-                if torch.is_tensor(value) and key in s_dst:
-                    s_dst[key].copy_(value)
+def ppo_learner(ctx: LearnerContext) -> None:
+    """The PPO learner process: rollouts and updates until ``ctx.stop`` is set (here or on any rank).
 
-
-def private_copy(
-    shared: ActorCritic,
-    optimizer: torch.optim.Optimizer,
-    train_config: TrainConfig,
-    device: torch.device,
-) -> tuple[ActorCritic, torch.optim.Optimizer]:
-    """A synchronous learner's own model and optimiser on ``device``, from the shared ones.
-
-    It trains these and copies them back (:func:`copy_into_shared`) after
-    each update, so that the trainer's evaluation and checkpoints see them.
-    """
-    local = copy.deepcopy(shared).to(device)
-    local_opt = shared_optimizer(local.parameters(), train_config)
-    local_opt.load_state_dict(optimizer.state_dict())
-    return local, local_opt
-
-
-def ppo_learner(
-    rank: int,
-    shared: ActorCritic,
-    optimizer: torch.optim.Optimizer,
-    model_config: ModelConfig,
-    train_config: TrainConfig,
-    env_name: str,
-    env_kwargs: dict[str, Any],
-    env_seed: int,
-    stop: Any,
-    queue: Any,
-    device: str = "cpu",
-) -> None:
-    """The PPO learner process: rollouts and updates until ``stop`` is set (here or on any rank).
-
-    Same signature and messages as :func:`neurosym.agent.a3c.worker`, plus
-    ``("stopped", rank, digests)`` when it ends on a stop: ``digests`` are
+    Ends with a :class:`~neurosym.agent.learners.messages.Stopped` carrying
     every rank's parameter digest (rank 0; identical when the ranks agree).
-    Under torchrun only rank 0 sends ``update`` messages, with the frames and
-    episodes of every rank.
+    Under torchrun only rank 0 reports updates, with the frames and episodes
+    of every rank.
     """
     world = distributed.world_from_env()
     threads = len(os.sched_getaffinity(0)) // max(world.local_size, 1)
     torch.set_num_threads(max(1, threads))
-    with learner_process(queue, rank, cleanup=distributed.leave_group):
+    with learner_process(ctx.queue, ctx.rank, cleanup=distributed.leave_group):
         from neurosym.envs import make_batched
 
-        dev = distributed.learner_device(device, world)
-        torch.manual_seed(env_seed)
-        generator = torch.Generator().manual_seed(env_seed)
-        local, local_opt = private_copy(shared, optimizer, train_config, dev)
+        config = ctx.train_config
+        dev = distributed.learner_device(ctx.device, world)
+        torch.manual_seed(ctx.env_seed)
+        generator = torch.Generator().manual_seed(ctx.env_seed)
+        local, local_opt = private_copy(ctx.shared, ctx.optimizer, config, dev)
         model: torch.nn.Module = local
         if world.distributed:
-            from torch.nn.parallel import DistributedDataParallel
-
-            distributed.init_group(dev)
-            distributed.check_same_config(model_config, train_config, env_name, env_kwargs)
-            # DDP starts every rank from rank 0's weights; the statistics follow
-            model = DistributedDataParallel(
-                local, device_ids=[dev.index] if dev.type == "cuda" else None
-            )
-            distributed.broadcast_optimizer_state(local_opt)
-            copy_into_shared(local, local_opt, shared, optimizer)
-        venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
-        state = RolloutState(venv, env_seed)
+            model = _join_group(ctx, local, local_opt, dev)
+        venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
+        state = RolloutState(venv, ctx.env_seed)
         scale = AdvantageScale()  # used when ppo_advantages is "running"
         bonus = None
-        if train_config.explore > 0:
-            bonus = CountBonus(train_config.explore, half_life=train_config.explore_half_life)
+        if config.explore > 0:
+            bonus = CountBonus(config.explore, half_life=config.explore_half_life)
         parent = os.getppid()
         while True:
-            halt = stop.is_set() or os.getppid() != parent
+            halt = ctx.stop.is_set() or os.getppid() != parent
             if world.distributed:
                 halt = distributed.any_rank(halt, dev)
             if halt:
                 break
             rollout, finished = collect_rollout(
-                local, state, train_config.n_steps, generator, bonus, record=True, device=dev
+                local, state, config.n_steps, generator, bonus, record=True, device=dev
             )
-            stats = ppo_update(model, local_opt, rollout, train_config, generator, scale)
-            copy_into_shared(local, local_opt, shared, optimizer)
+            stats = ppo_update(model, local_opt, rollout, config, generator, scale)
+            copy_into_shared(local, local_opt, ctx.shared, ctx.optimizer)
             frames = int(rollout.valid.sum())
             if world.distributed:
-                every = distributed.gather_to_leader(
-                    (frames, finished.returns, finished.lengths, finished.outcomes)
-                )
-                if every is None:
+                gathered = _gather_episodes(frames, finished)
+                if gathered is None:
                     continue
-                frames = sum(e[0] for e in every)
-                finished = Finished.empty()
-                for _, returns, lengths, outcomes in every:
-                    finished.extend(Finished(returns, lengths, outcomes))
-            report_update(queue, rank, frames, finished, stats)
+                frames, finished = gathered
+            report_update(ctx, frames, finished, stats)
         digests = [distributed.parameter_digest(local)]
         if world.distributed:
             digests = distributed.gather_to_leader(digests[0]) or digests
-        queue.put(("stopped", rank, digests))
+        ctx.queue.put(Stopped(ctx.rank, tuple(digests)))
+
+
+def _join_group(
+    ctx: LearnerContext,
+    local: torch.nn.Module,
+    local_opt: torch.optim.Optimizer,
+    dev: torch.device,
+) -> torch.nn.Module:
+    """Join the torchrun process group; the DDP-wrapped model, started from rank 0's weights."""
+    from torch.nn.parallel import DistributedDataParallel
+
+    distributed.init_group(dev)
+    distributed.check_same_config(ctx.model_config, ctx.train_config, ctx.env_name, ctx.env_kwargs)
+    # DDP starts every rank from rank 0's weights; the statistics follow
+    model = DistributedDataParallel(local, device_ids=[dev.index] if dev.type == "cuda" else None)
+    distributed.broadcast_optimizer_state(local_opt)
+    copy_into_shared(local, local_opt, ctx.shared, ctx.optimizer)
+    return model
+
+
+def _gather_episodes(frames: int, finished: Finished) -> tuple[int, Finished] | None:
+    """Every rank's frames and finished episodes, on rank 0 (None on the others)."""
+    every = distributed.gather_to_leader(
+        (frames, finished.returns, finished.lengths, finished.outcomes)
+    )
+    if every is None:
+        return None
+    total = Finished.empty()
+    for _, returns, lengths, outcomes in every:
+        total.extend(Finished(returns, lengths, outcomes))
+    return sum(e[0] for e in every), total

@@ -79,7 +79,7 @@ from typing import NamedTuple
 import torch
 from torch import nn
 
-from neurosym.agent.introspection import PrediNetIntrospection
+from neurosym.agent.networks.introspection import PrediNetIntrospection
 
 
 class QueryRecord(NamedTuple):
