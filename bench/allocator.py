@@ -23,7 +23,7 @@ import torch
 from neurosym.agent.learners.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig, preset_env_kwargs
 from neurosym.agent.networks.model import ActorCritic
-from neurosym.agent.run.trainer import probe_env
+from neurosym.agent.run.plan import probe_env
 from neurosym.envs import env_family, make_batched
 
 env, k, module, keep, iters = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1", int(sys.argv[5])

@@ -169,7 +169,7 @@ def bench_distributed(env: str, modules: tuple[str, ...], ranks: list[int], seco
     """PPO frames/s under torchrun for each rank count, and the all-reduce volume per update."""
     from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
     from neurosym.agent.networks.model import ActorCritic
-    from neurosym.agent.run.trainer import probe_env
+    from neurosym.agent.run.plan import probe_env
     from neurosym.envs import env_family
 
     kwargs = preset_env_kwargs(env_family(env))

@@ -26,7 +26,7 @@ import pandas as pd
 from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
 from neurosym.export.prolog_writer import write_prolog
 from neurosym.export.recording import Recording
-from neurosym.agent.run.trainer import _write_rows
+from neurosym.agent.run.metrics import write_rows as _write_rows
 from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.networks.model import ActorCritic
@@ -79,7 +79,7 @@ from pathlib import Path
 import numpy as np, pandas as pd
 from neurosym.errors import NeurosymError
 from neurosym.export.prolog_writer import write_prolog
-from neurosym.agent.run.trainer import _write_rows
+from neurosym.agent.run.metrics import write_rows as _write_rows
 
 out = Path(sys.argv[1])
 what = sys.argv[2]

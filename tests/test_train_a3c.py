@@ -446,7 +446,7 @@ def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it()
     (its returns did not vary) does not blank the row's mean of the others."""
     from neurosym.agent.learners.messages import LossStats, Update
     from neurosym.agent.rollout import Finished
-    from neurosym.agent.run.trainer import _Stats
+    from neurosym.agent.run.metrics import RunningStats as _Stats
 
     def update(*losses: float) -> Update:
         return Update(0, 8, Finished.empty(), LossStats(*losses))
@@ -473,7 +473,7 @@ def test_frame_rate_spans_updates_not_one_log_row() -> None:
 
     Logged every 2 s over the row's own interval, the rate read 4,000 on one
     row in four and 0 on the others (PPO's metrics.csv before the window)."""
-    from neurosym.agent.run.trainer import FrameRate
+    from neurosym.agent.run.metrics import FrameRate
 
     rate = FrameRate(0.0, 0, window=30.0)
     frames, rates = 0, []
