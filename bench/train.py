@@ -180,7 +180,7 @@ def bench_distributed(env: str, modules: tuple[str, ...], ranks: list[int], seco
             p.numel()
             for p in ActorCritic(ModelConfig.for_family(family, module, shape, scale)).parameters()
         )
-        reductions = config.ppo_epochs * config.ppo_minibatches  # one gradient all-reduce each
+        reductions = config.ppo.ppo_epochs * config.ppo.ppo_minibatches  # one gradient all-reduce each
         for r in ranks:
             with run_dir(f"distributed-{module}-r{r}") as out:
                 t0 = time.monotonic()

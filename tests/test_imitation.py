@@ -172,7 +172,7 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     assert first.returncode == 0, first.stderr[-2000:]
     payload = read_checkpoint(out / "checkpoint.pt")
     assert payload["train_config"]["algo"] == "imitate"
-    assert payload["train_config"]["dagger_steps"] == 2
+    assert payload["train_config"]["learner"]["dagger_steps"] == 2
     frames = int(payload["frames"])
     assert frames >= 300
     again = neurosym("train", "--out", out, "--resume", "--frames", frames + 200, "--quiet")
@@ -183,31 +183,6 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     load_agent(out / "checkpoint.pt")
     ev = neurosym("eval", "--checkpoint", out / "checkpoint.pt", "--episodes", "4", "--json")
     assert ev.returncode == 0, ev.stderr[-2000:]
-
-
-def test_train_with_a_local_view_records_it_and_resumes_with_it(
-    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
-) -> None:
-    """--local-view is a model switch: in the checkpoint's config and command, kept on --resume."""
-    out = tmp_path / "run"
-    first = neurosym("train", "--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
-                     "--envs", "4", "--n-steps", "8", "--dagger-steps", "1", "--frames", "64",
-                     "--kernel-size", "1", "--local-view", "3", "--quiet", "--eval-episodes", "1",
-                     "--out", out)  # fmt: skip
-    assert first.returncode == 0, first.stderr[-2000:]
-    frames = int(read_checkpoint(out / "checkpoint.pt")["frames"])  # whole updates: past 64
-    again = neurosym("train", "--out", out, "--resume", "--frames", frames + 64, "--quiet",
-                     "--eval-episodes", "1")  # fmt: skip
-    assert again.returncode == 0, again.stderr[-2000:]
-    agent = load_agent(out / "checkpoint.pt")
-    config = agent.config
-    assert (config.local_view, config.agent_plane, config.kernel_size) == (3, 0, 1)
-    assert "--kernel-size 1 --local-view 3" in agent.meta["command"]
-    assert agent.model.body[0].in_features == agent.config.output_size + 9 * 9
-    more = int(agent.meta["frames"]) + 64
-    other = neurosym("train", "--out", out, "--resume", "--frames", more, "--local-view", "5")
-    assert other.returncode != 0
-    assert "local_view 3 (asked for 5)" in other.stderr, other.stderr[-2000:]
 
 
 def test_train_imitate_on_box_world_is_one_line(
@@ -292,7 +267,7 @@ def test_safe_coef_adds_the_loss_of_the_set_that_gives_nothing_up() -> None:
         losses[coef] = stats.policy_loss
     assert losses[0.0] == pytest.approx(fast, rel=1e-4)
     assert losses[3.0] == pytest.approx(fast + 3.0 * kept, rel=1e-4)
-    with pytest.raises(ConfigError, match="--safe-coef weighs DAgger's labels; it needs --algo"):
+    with pytest.raises(ConfigError, match="--safe-coef is a setting of --algo imitate; this run's learner is a3c"):
         TrainConfig.for_family("rgw", safe_coef=1.0)
     with pytest.raises(ConfigError, match="safe_coef must be >= 0, got -1"):
         TrainConfig.for_family("rgw", algo="imitate", safe_coef=-1.0)

@@ -115,8 +115,6 @@ class Rollout(NamedTuple):
     when only recorded (PPO's behaviour policy); None when neither (the update recomputes)"""
     values: torch.Tensor | None = None
     """(T, K) the acting values, likewise"""
-    optimal: torch.Tensor | None = None
-    """(T, K, A) bool: the planner's optimal actions in each observation, when ``labels`` was given"""
     queries: Any | None = None
     """what the model kept of its acting forwards (``ActorCritic.recording``: PrediNet's
     queries), for an update that runs the model over ``obs`` again with the same weights"""
@@ -142,7 +140,6 @@ def collect_rollout(
     keep_graph: bool = False,
     record: bool = False,
     device: torch.device | None = None,
-    labels: Callable[[Any], np.ndarray] | None = None,
 ) -> tuple[Rollout, Finished]:
     """Act ``n_steps`` steps in every sub-env with sampled actions.
 
@@ -160,21 +157,16 @@ def collect_rollout(
     ``device``: where the model lives (observations go there, actions are
     drawn on the CPU so that the generator's stream is the same on any device);
     the recorded logits and values stay there, the rest of the rollout is on the CPU.
-    ``labels(venv) -> (K, A) bool``: the optimal actions in the current state
-    of every sub-env (a planner's), asked before each step and kept in the
-    rollout's ``optimal``.
     """
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
-    logits_t, values_t, optimal_t = [], [], []
+    logits_t, values_t = [], []
     finished = Finished.empty()
     # no graph kept and nothing recorded: the update will run the model over these
     # observations again, and may take back what the model remembers of acting
     reuse = not keep_graph and not record and hasattr(model, "recording")
     with model.recording() if reuse else contextlib.nullcontext() as queries:
         for _ in range(n_steps):
-            if labels is not None:
-                optimal_t.append(labels(venv))
             with torch.set_grad_enabled(keep_graph):
                 obs_in = torch.from_numpy(state.obs)
                 logits, value = model(
@@ -209,7 +201,6 @@ def collect_rollout(
         valid=torch.from_numpy(np.stack(valids)),
         logits=torch.stack(logits_t) if logits_t else None,
         values=torch.stack(values_t) if values_t else None,
-        optimal=torch.from_numpy(np.stack(optimal_t)) if optimal_t else None,
         queries=queries,
     )
     return rollout, finished

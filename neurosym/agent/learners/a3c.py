@@ -27,19 +27,14 @@ root-mean-square of the advantages when ``normalize_advantages`` is on
 the usual per-batch normalisation). With lambda = 1, s = 1 and no normalisation this is Table 4's n-step
 A3C: A_t = G_t - V(o_t) with G_t the bootstrapped n-step return.
 Truncated episodes (time limit) bootstrap from V of their final observation.
-With ``config.sil > 0`` the self-imitation loss (:mod:`neurosym.agent.learners.sil`)
+With ``sil > 0`` (:class:`~neurosym.agent.config.A3CConfig`) the self-imitation loss (:mod:`neurosym.agent.learners.sil`)
 on a batch of M remembered transitions is added, scaled to T transitions.
-With ``config.planner_coef = c > 0`` (RGW), ``c * sum -log pi(optimal set|o_t)``
-over the rollout's valid transitions is added (per env, like the rest): the
-env planner's optimal actions in each visited state, as DAgger labels them.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Callable
-from typing import Any
 
 import torch
 import torch.nn.functional as F
@@ -47,7 +42,6 @@ import torch.nn.functional as F
 from neurosym.agent.config import TrainConfig
 from neurosym.agent.learners.exploration import CountBonus
 from neurosym.agent.learners.messages import LossStats
-from neurosym.agent.learners.planner_loss import optimal_set_nll
 from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
 from neurosym.agent.learners.returns import AdvantageScale, gae_advantages
 from neurosym.agent.learners.sil import EpisodeMemory, SILBatch, sil_loss
@@ -61,14 +55,11 @@ def a3c_loss(
     config: TrainConfig,
     sil_batch: SILBatch | None = None,
     scale: AdvantageScale | None = None,
-    critic_only: bool = False,
 ) -> tuple[torch.Tensor, LossStats]:
     """The scalar loss of one rollout (plus self-imitation on ``sil_batch``) and its parts.
 
     With ``config.normalize_advantages`` the advantages are divided by
     ``scale``'s running RMS (a worker keeps one; without it, this rollout's RMS).
-    ``critic_only`` (``config.critic_warmup``): the loss is the value loss
-    alone; the other parts are still reported.
 
     The model runs once over what it has not seen with a graph: the rollout's
     T * K observations (unless acting kept their graph), the last observation
@@ -109,20 +100,12 @@ def a3c_loss(
     policy_loss = -(logp_a * advantages * mask).sum() / K
     value_loss = 0.5 * ((returns - values).pow(2) * mask).sum() / K
     entropy_sum = (entropy * mask).sum() / K
-    if critic_only:
-        loss = config.value_coef * value_loss
-    else:
-        loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
-    if config.planner_coef > 0 and not critic_only:
-        if rollout.optimal is None:
-            raise ValueError("planner_coef > 0 needs a rollout collected with the planner's labels")
-        nll = optimal_set_nll(logits, rollout.optimal)  # (T, K)
-        loss = loss + config.planner_coef * (nll * mask).sum() / K
-    if sil_batch is not None and not critic_only:
+    loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy_sum
+    if sil_batch is not None:
         M = sil_batch.actions.shape[0]
         scaled = sil_batch._replace(returns=sil_batch.returns * config.reward_scale)
         sil = sil_loss(logits_all[n + K :], values_all[n + K :], scaled, config.value_coef)
-        loss = loss + config.sil * sil * (T / M)
+        loss = loss + config.a3c.sil * sil * (T / M)
     numbers = torch.stack([policy_loss, value_loss, entropy_sum]).tolist()
     return loss, LossStats(numbers[0], numbers[1], numbers[2], grad_norm=0.0)
 
@@ -133,20 +116,10 @@ def apply_update(
     optimizer: torch.optim.Optimizer,
     loss: torch.Tensor,
     clip: float,
-    only_prefix: str | None = None,
 ) -> float:
-    """Backpropagate on the local model, hand its gradients to the shared one, step; the gradient norm.
-
-    ``only_prefix`` (e.g. ``"value."``): only parameters whose names start with
-    it get a gradient; the optimiser leaves every other weight, and its
-    statistics, as they are.
-    """
+    """Backpropagate on the local model, hand its gradients to the shared one, step; the gradient norm."""
     local.zero_grad(set_to_none=True)
     loss.backward()
-    if only_prefix is not None:
-        for name, p in local.named_parameters():
-            if not name.startswith(only_prefix):
-                p.grad = None
     norm = torch.nn.utils.clip_grad_norm_(local.parameters(), clip)
     for shared_p, local_p in zip(shared.parameters(), local.parameters(), strict=True):
         shared_p.grad = local_p.grad
@@ -154,21 +127,8 @@ def apply_update(
     return float(norm)
 
 
-def planner_labels() -> Callable[[Any], Any]:
-    """``venv -> (K, 4) bool``: the RGW planner's optimal actions in each sub-env's state
-    (plans cached per level, as DAgger's)."""
-    from neurosym.envs.rgw_solver import Planner
-
-    planner = Planner()
-    return lambda venv: planner.action_sets(venv)[0]
-
-
 def worker(ctx: LearnerContext) -> None:
-    """One A3C worker: rollouts and updates of the shared model until ``ctx.stop`` is set.
-
-    A worker does its share (1 / W) of what is left of
-    ``train_config.critic_warmup`` after ``ctx.frames0`` with the value head alone.
-    """
+    """One A3C worker: rollouts and updates of the shared model until ``ctx.stop`` is set."""
     torch.set_num_threads(1)
     with learner_process(ctx.queue, ctx.rank):
         from neurosym.envs import make_batched
@@ -183,32 +143,20 @@ def worker(ctx: LearnerContext) -> None:
         if config.explore > 0:
             bonus = CountBonus(config.explore, half_life=config.explore_half_life)
         memory = None
-        if config.sil > 0:
-            memory = EpisodeMemory(config.envs, config.gamma, config.sil_episodes)
+        if config.a3c.sil > 0:
+            memory = EpisodeMemory(config.envs, config.gamma, config.a3c.sil_episodes)
         # MHDPA's cost is per-sample attention, cheapest in small batches: from 8 envs up,
         # keeping each acting step's graph beats a second forward over the rollout
         keep_graph = ctx.model_config.module == "mhdpa" and config.envs >= 8
-        labels = planner_labels() if config.planner_coef > 0 else None
         scale = AdvantageScale()
-        warmup = -(-max(0, config.critic_warmup - ctx.frames0) // config.workers)
-        frames = 0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:  # also stop if the parent died
             local.load_state_dict(shared.state_dict())
             rollout, finished = collect_rollout(
-                local, state, config.n_steps, generator, bonus, memory, keep_graph, labels=labels
+                local, state, config.n_steps, generator, bonus, memory, keep_graph
             )
             batch = memory.sample(config.n_steps, generator) if memory is not None else None
-            warming = frames < warmup
-            loss, stats = a3c_loss(local, rollout, config, batch, scale, critic_only=warming)
-            norm = apply_update(
-                local,
-                shared,
-                ctx.optimizer,
-                loss,
-                config.grad_clip,
-                only_prefix="value." if warming else None,
-            )
-            n = int(rollout.valid.sum())
-            frames += n
-            report_update(ctx, n, finished, dataclasses.replace(stats, grad_norm=norm))
+            loss, stats = a3c_loss(local, rollout, config, batch, scale)
+            norm = apply_update(local, shared, ctx.optimizer, loss, config.grad_clip)
+            frames = int(rollout.valid.sum())
+            report_update(ctx, frames, finished, dataclasses.replace(stats, grad_norm=norm))

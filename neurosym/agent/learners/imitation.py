@@ -113,16 +113,16 @@ def imitation_update(
 ) -> LossStats:
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
-    for _ in range(config.dagger_steps):
-        obs, optimal, values, safe = buffer.sample(config.dagger_batch, rng)
-        if config.augment:  # the level turned or mirrored; the return still to earn is the same
+    for _ in range(config.imitate.dagger_steps):
+        obs, optimal, values, safe = buffer.sample(config.imitate.dagger_batch, rng)
+        if config.imitate.augment:  # the level turned or mirrored; the return still to earn is the same
             obs, sets = augment_batch(obs, torch.stack((optimal, safe), dim=-1), generator)
             optimal, safe = sets.unbind(-1)
         obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
         logits, value = model(obs)
         policy_loss = imitation_loss(logits, optimal)
-        if config.safe_coef:
-            policy_loss = policy_loss + config.safe_coef * imitation_loss(logits, safe.to(device))
+        if config.imitate.safe_coef:
+            policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(logits, safe.to(device))
         value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
         loss = policy_loss + config.value_coef * value_loss
         optimizer.zero_grad(set_to_none=True)
@@ -133,7 +133,7 @@ def imitation_update(
             logp = torch.log_softmax(logits, dim=-1)
             entropy = -(logp.exp() * logp).sum(-1).mean()
         totals += [policy_loss.item(), value_loss.item(), entropy.item(), float(norm)]
-    return LossStats(*(totals / config.dagger_steps).tolist())
+    return LossStats(*(totals / config.imitate.dagger_steps).tolist())
 
 
 def imitation_learner(ctx: LearnerContext) -> None:
@@ -156,13 +156,13 @@ def imitation_learner(ctx: LearnerContext) -> None:
         obs, _ = venv.reset(seed=ctx.env_seed)
         planner = Planner()
         tracker = EpisodeTracker(venv.num_envs)
-        buffer = LabelBuffer(config.dagger_buffer, obs.shape[1:], obs.dtype)
-        safe_loss = config.safe_coef > 0  # regrets only where the loss reads them
+        buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype)
+        safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
         frames = ctx.frames0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:
             finished = Finished.empty()
-            beta = expert_share(frames, config.dagger_beta_frames)
+            beta = expert_share(frames, config.imitate.dagger_beta_frames)
             steps = 0
             for _ in range(config.n_steps):
                 optimal, values, regret = planner.labels(venv, regret=safe_loss)

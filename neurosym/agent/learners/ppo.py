@@ -86,16 +86,16 @@ def ppo_update(
     b_values = values.flatten()[valid]  # (M,)
     b_returns = b_adv + b_values  # (M,)
     explained = explained_variance(b_values, b_returns)
-    per_minibatch = config.normalize_advantages and config.ppo_advantages == "minibatch"
-    if config.normalize_advantages and config.ppo_advantages == "running":
+    per_minibatch = config.normalize_advantages and config.ppo.ppo_advantages == "minibatch"
+    if config.normalize_advantages and config.ppo.ppo_advantages == "running":
         scale = scale if scale is not None else AdvantageScale()
         b_adv = scale(b_adv, torch.ones_like(b_adv))  # the returns above keep the raw ones
     M = b_obs.shape[0]
     totals = torch.zeros(6)
     steps = 0
-    for _ in range(config.ppo_epochs):
+    for _ in range(config.ppo.ppo_epochs):
         order = torch.randperm(M, generator=generator).to(device)
-        for mb in order.tensor_split(config.ppo_minibatches):
+        for mb in order.tensor_split(config.ppo.ppo_minibatches):
             # an empty minibatch (fewer transitions than minibatches) still takes its step with
             # weight 0, so that every rank of a distributed run makes the same collectives
             weight = 1.0 if mb.numel() else 0.0
@@ -110,7 +110,7 @@ def ppo_update(
                 adv = (adv - adv.mean()) / (adv.std() + 1e-8)
             log_ratio = logp - b_logp[mb]
             ratio = log_ratio.exp()
-            clipped = ratio.clamp(1.0 - config.clip_range, 1.0 + config.clip_range)
+            clipped = ratio.clamp(1.0 - config.ppo.clip_range, 1.0 + config.ppo.clip_range)
             policy_loss = -torch.min(ratio * adv, clipped * adv).mean()
             value_loss = 0.5 * (value - b_returns[mb]).pow(2).mean()
             loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy
@@ -121,7 +121,7 @@ def ppo_update(
             with torch.no_grad():
                 # Schulman's low-variance estimator of KL(old || new), as SB3 and CleanRL log it
                 approx_kl = ((ratio - 1.0) - log_ratio).mean()
-                clip_fraction = ((ratio - 1.0).abs() > config.clip_range).float().mean()
+                clip_fraction = ((ratio - 1.0).abs() > config.ppo.clip_range).float().mean()
             totals += torch.stack(
                 [
                     policy_loss.detach(),

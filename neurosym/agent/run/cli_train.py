@@ -1,65 +1,71 @@
-"""``neurosym train``: train a PrediNet or MHDPA agent with A3C (or PPO).
+"""``neurosym train``: train a PrediNet or MHDPA agent with A3C, PPO or DAgger.
 
-A thin wrapper over :func:`neurosym.agent.run.trainer.train`. Unset options take
-the preset's defaults for the env family (``neurosym.agent.config``;
-``--preset thesis`` is Table 4 exactly); with ``--resume`` they take the
-checkpoint's settings. The command line is stored in the checkpoint.
-Under ``torchrun`` (``--algo ppo``) every rank runs this command and rank 0
-writes (:mod:`neurosym.agent.learners.distributed`).
+A thin wrapper over :func:`neurosym.agent.run.trainer.train`. The settings'
+flags are generated from the config dataclasses (:mod:`neurosym.agent.config`,
+:class:`~neurosym.agent.run.options.RunOptions`): a field whose metadata says
+``flag`` gets ``--its-name`` with its docstring as help; every other field is
+set with ``--set NAME=VALUE``. Unset options take the preset's defaults for
+the env family (``--preset thesis`` is Table 4 exactly); with ``--resume``
+they take the checkpoint's settings. The command line, rebuilt from what was
+given, is stored in the checkpoint. Under ``torchrun`` (``--algo ppo``) every
+rank runs this command and rank 0 writes
+(:mod:`neurosym.agent.learners.distributed`).
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import shlex
+from dataclasses import Field, fields
 from typing import Any
 
-from neurosym.cli import parse_env_options
-
-# (flag, dest, kind) for the settings passed through as overrides; kind: train | model
-_OVERRIDES = (
-    ("--workers", "workers", "train"),
-    ("--envs", "envs", "train"),
-    ("--seed", "seed", "train"),
-    ("--lr", "lr", "train"),
-    ("--entropy", "entropy", "train"),
-    ("--gamma", "gamma", "train"),
-    ("--n-steps", "n_steps", "train"),
-    ("--grad-clip", "grad_clip", "train"),
-    ("--value-coef", "value_coef", "train"),
-    ("--rms-eps", "rms_eps", "train"),
-    ("--explore", "explore", "train"),
-    ("--sil", "sil", "train"),
-    ("--sil-episodes", "sil_episodes", "train"),
-    ("--optimizer", "optimizer", "train"),
-    ("--adam-eps", "adam_eps", "train"),
-    ("--reward-scale", "reward_scale", "train"),
-    ("--gae-lambda", "gae_lambda", "train"),
-    ("--normalize-advantages", "normalize_advantages", "train"),
-    ("--ppo-epochs", "ppo_epochs", "train"),
-    ("--ppo-minibatches", "ppo_minibatches", "train"),
-    ("--clip-range", "clip_range", "train"),
-    ("--ppo-advantages", "ppo_advantages", "train"),
-    ("--critic-warmup", "critic_warmup", "train"),
-    ("--planner-coef", "planner_coef", "train"),
-    ("--dagger-beta-frames", "dagger_beta_frames", "train"),
-    ("--dagger-steps", "dagger_steps", "train"),
-    ("--augment", "augment", "train"),
-    ("--safe-coef", "safe_coef", "train"),
-    ("--attention-gain", "attention_gain", "model"),
-    ("--entity-norm", "entity_norm", "model"),
-    ("--init", "init", "model"),
-    ("--query", "query", "model"),
-    ("--keys", "keys", "model"),
-    ("--heads", "heads", "model"),
-    ("--key-size", "key_size", "model"),
-    ("--relations", "relations", "model"),
-    ("--value-size", "value_size", "model"),
-    ("--conv-channels", "conv_channels", "model"),
-    ("--kernel-size", "kernel_size", "model"),
-    ("--local-view", "local_view", "model"),
+from neurosym.agent.config import (
+    A3CConfig,
+    ImitationConfig,
+    ModelConfig,
+    PPOConfig,
+    TrainConfig,
+    field_docs,
+    option_name,
 )
+from neurosym.agent.run.options import RunOptions
+from neurosym.cli import parse_env_options
+from neurosym.errors import ConfigError
+
+SETTINGS: tuple[tuple[str, type, str], ...] = (
+    (
+        "settings every learner shares (default: the preset's for the env family)",
+        TrainConfig,
+        "train",
+    ),
+    ("--algo a3c", A3CConfig, "train"),
+    ("--algo ppo", PPOConfig, "train"),
+    ("--algo imitate (DAgger from the env's optimal planner; RGW only)", ImitationConfig, "train"),
+    ("model (default: Table 4 and the preset's switches)", ModelConfig, "model"),
+)
+"""(argument group title, config class, train | model) of the settings' flags, in help order"""
+FIXED = {"algo", "preset", "learner", "module", "obs_shape", "obs_scale"}
+"""config fields that are not settings of a run (own flags, derived, or nested)"""
+GROUPS = {
+    "stop": "stopping (any that is reached; none: run until Ctrl-C)",
+    "watch": "watching",
+}
+
+
+def _help(cls: type, f: Field[Any]) -> str:
+    """The field's docstring up to its first top-level '. ', '; ' or ': ', plus the default."""
+    text, depth = field_docs(cls).get(f.name, ""), 0
+    for i, char in enumerate(text):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if depth == 0 and char in ".;:" and text[i + 1 : i + 2] in (" ", ""):
+            text = text[:i]
+            break
+    text = text.replace("``", "")
+    if cls is RunOptions and f.default is not None and not isinstance(f.default, bool):
+        text += f" (default {f.default})"  # the settings' defaults are the preset's
+    return text.replace("%", "%%")
 
 
 def _channels(text: str) -> tuple[int, ...]:
@@ -75,15 +81,52 @@ def _channels(text: str) -> tuple[int, ...]:
     return widths
 
 
+def _kind(f: Field[Any]) -> str:
+    """bool, channels, int, float or str: how a field's value is read from text."""
+    declared = str(f.type)
+    for kind in ("bool", "tuple", "int", "float"):
+        if kind in declared:
+            return "channels" if kind == "tuple" else kind
+    return "str"
+
+
+def _add_flag(group: Any, cls: type, f: Field[Any]) -> None:
+    meta, kind = f.metadata, _kind(f)
+    extra: dict[str, Any] = {}
+    if kind == "bool":
+        extra["action"] = argparse.BooleanOptionalAction
+    else:
+        extra["type"] = {"channels": _channels, "int": int, "float": float, "str": str}[kind]
+    for key in ("choices", "metavar"):
+        if key in meta:
+            extra[key] = meta[key]
+    group.add_argument(option_name(f.name), dest=f.name, default=None, help=_help(cls, f), **extra)
+
+
+def flag_fields() -> list[tuple[type, Field[Any]]]:
+    """Every config field with a flag of its own."""
+    classes = [cls for _, cls, _ in SETTINGS] + [RunOptions]
+    return [(cls, f) for cls in classes for f in fields(cls) if f.metadata.get("flag")]
+
+
+def settable() -> dict[str, tuple[type, Field[Any]]]:
+    """Every setting ``--set`` takes: name -> (its config class, its field)."""
+    out: dict[str, tuple[type, Field[Any]]] = {}
+    for _, cls, _ in SETTINGS:
+        for f in fields(cls):
+            if f.name not in FIXED:
+                out[f.name] = (cls, f)
+    return out
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--env", help="environment short name or id, e.g. rgw2 (required unless --resume)"
     )
     parser.add_argument(
-        "--module",
-        choices=("predinet", "mhdpa"),
+        "--module", choices=("predinet", "mhdpa"),
         help="relational module (required unless --resume or --init-from)",
-    )
+    )  # fmt: skip
     parser.add_argument(
         "--out", required=True, help="run directory: checkpoint.pt and metrics.csv go here"
     )
@@ -91,245 +134,127 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--resume", action="store_true", help="continue the run in --out from its checkpoint"
     )
     parser.add_argument(
-        "--init-from",
-        metavar="CHECKPOINT",
+        "--init-from", metavar="CHECKPOINT",
         help="start a new run from this checkpoint's weights and model (a curriculum: e.g. a bw1 "
         "agent on bw2); any env of its family with its observation shape; frames count afresh",
-    )
+    )  # fmt: skip
     parser.add_argument(
-        "--algo",
-        choices=("a3c", "ppo", "imitate"),
+        "--algo", choices=("a3c", "ppo", "imitate"),
         help="learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or "
         "imitate (DAgger from the env's optimal planner; RGW only)",
-    )
+    )  # fmt: skip
     parser.add_argument(
-        "--preset",
-        choices=("default", "thesis"),
-        default="default",
+        "--preset", choices=("default", "thesis"), default="default",
         help="settings to start from: default (what learns best here) or thesis (Table 4 exactly)",
-    )
+    )  # fmt: skip
     parser.add_argument(
-        "--tensorboard",
-        action="store_true",
-        help="also write TensorBoard event files to OUT/tensorboard",
-    )
+        "--set", action="append", default=[], metavar="NAME=VALUE", dest="settings",
+        help="any other setting of neurosym/agent/config.py, e.g. --set attention_gain=32 "
+        "(repeatable)",
+    )  # fmt: skip
     parser.add_argument(
-        "--device",
-        choices=("cpu", "cuda", "auto"),
-        default="cpu",
-        help="where the PPO learner acts and learns: cpu (default), cuda (falls back to the CPU "
-        "with a warning when no GPU is visible) or auto (cuda when one is visible); A3C is CPU-only",
-    )
-    stop = parser.add_argument_group("stopping (any that is reached; none: run until Ctrl-C)")
-    stop.add_argument(
-        "--frames", type=int, help="total training frames (env steps), counting resumed ones"
-    )
-    stop.add_argument("--minutes", type=float, help="wall-clock minutes for this session")
-    stop.add_argument(
-        "--target-return", type=float, help="stop when the greedy policy's mean return reaches this"
-    )
-    stop.add_argument(
-        "--target-success",
-        type=float,
-        help="stop when the success rate over the last --window training episodes reaches this (0-1)",
-    )
-    a3c = parser.add_argument_group(
-        "learner (defaults: the preset's for the env family, see neurosym/agent/config.py)"
-    )
-    a3c.add_argument("--workers", type=int, help="worker processes W (default: CPU cores)")
-    a3c.add_argument("--envs", type=int, help="environments per worker K (1 = classic A3C)")
-    a3c.add_argument("--seed", type=int, help="base seed (default 0)")
-    a3c.add_argument("--lr", type=float, help="learning rate")
-    a3c.add_argument("--optimizer", choices=("adam", "rmsprop"), help="shared optimiser")
-    a3c.add_argument("--adam-eps", type=float, help="Adam epsilon")
-    a3c.add_argument("--reward-scale", type=float, help="factor on rewards in the training signal")
-    a3c.add_argument("--gae-lambda", type=float, help="GAE lambda (1: n-step returns)")
-    a3c.add_argument(
-        "--normalize-advantages",
-        action=argparse.BooleanOptionalAction,
-        help="normalise each update's advantages",
-    )
-    a3c.add_argument("--ppo-epochs", type=int, help="PPO passes over each rollout")
-    a3c.add_argument("--ppo-minibatches", type=int, help="PPO minibatches per pass")
-    a3c.add_argument("--clip-range", type=float, help="PPO probability-ratio clip")
-    a3c.add_argument(
-        "--ppo-advantages",
-        choices=("minibatch", "running"),
-        help="PPO's advantage normalisation: per minibatch, or a running RMS over rollouts",
-    )
-    a3c.add_argument(
-        "--dagger-beta-frames",
-        type=int,
-        help="imitate: frames over which following the planner falls from always to never",
-    )
-    a3c.add_argument("--dagger-steps", type=int, help="imitate: gradient steps per rollout")
-    a3c.add_argument(
-        "--augment",
-        action=argparse.BooleanOptionalAction,
-        help="imitate: fit each minibatch turned or mirrored at random (RGW's symmetries)",
-    )
-    a3c.add_argument(
-        "--safe-coef",
-        type=float,
-        metavar="C",
-        help="imitate: weight of the loss on actions that give return up (the planner's "
-        "regret > 0) beside the fastest actions' loss (0: none)",
-    )
-    a3c.add_argument(
-        "--critic-warmup",
-        type=int,
-        metavar="FRAMES",
-        help="A3C: first frames of the run in which only the value head learns (0: none)",
-    )
-    a3c.add_argument(
-        "--planner-coef",
-        type=float,
-        metavar="C",
-        help="A3C on RGW: weight of the planner's imitation loss beside A3C's (0: none)",
-    )
-    a3c.add_argument("--entropy", type=float, help="entropy bonus weight")
-    a3c.add_argument("--gamma", type=float, help="discount")
-    a3c.add_argument("--n-steps", type=int, help="rollout length per update (Table 4: 40)")
-    a3c.add_argument("--grad-clip", type=float, help="gradient norm clip")
-    a3c.add_argument("--value-coef", type=float, help="value loss weight")
-    a3c.add_argument("--rms-eps", type=float, help="RMSprop epsilon")
-    a3c.add_argument("--explore", type=float, help="count-based exploration bonus beta (0: none)")
-    a3c.add_argument("--sil", type=float, help="self-imitation loss weight (0: none)")
-    a3c.add_argument(
-        "--sil-episodes", type=int, help="best episodes each worker keeps for self-imitation"
-    )
-    model = parser.add_argument_group("model (defaults: Table 4)")
-    model.add_argument("--heads", type=int, help="attention heads (4)")
-    model.add_argument("--key-size", type=int, help="query/key size (32 RGW, 64 Box-World)")
-    model.add_argument("--relations", type=int, help="PrediNet relations per head (8)")
-    model.add_argument("--value-size", type=int, help="MHDPA value size (64)")
-    model.add_argument(
-        "--conv-channels",
-        type=_channels,
-        metavar="C1,C2,...",
-        help="encoder conv layers' output channels (Table 4: 12,24)",
-    )
-    model.add_argument(
-        "--kernel-size", type=int, help="encoder conv kernel, stride 1, grid shape kept (2)"
-    )
-    model.add_argument(
-        "--local-view",
-        type=int,
-        metavar="K",
-        help="the MLP also sees the K x K cells around the agent, K odd (0: off, Table 4)",
-    )
-    model.add_argument(
-        "--attention-gain", type=float, help="factor on the attention logits (default 8; thesis 1)"
-    )
-    model.add_argument(
-        "--entity-norm",
-        action=argparse.BooleanOptionalAction,
-        help="LayerNorm on the entities (default on; thesis off)",
-    )
-    model.add_argument(
-        "--query",
-        choices=("scene", "learned"),
-        help="PrediNet's queries: from the whole scene (scene, DESIGN and the thesis; default) "
-        "or learned vectors, the same for every scene (learned)",
-    )
-    model.add_argument(
-        "--keys",
-        choices=("entities", "cells"),
-        help="what PrediNet's attention compares its queries with: the encoder's entities "
-        "(default, DESIGN and the thesis) or each cell's own observation (cells: a head "
-        "addresses cells by what they hold); --init-from may switch to cells",
-    )
-    model.add_argument(
-        "--init",
-        choices=("orthogonal", "torch"),
-        help="weight init of the MLP and heads (default orthogonal; thesis torch)",
-    )
-    watch = parser.add_argument_group("watching")
-    watch.add_argument(
-        "--env-option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
+        "--env-option", action="append", default=[], metavar="KEY=VALUE",
         help="keyword argument for the env, e.g. obs_mode=grey (repeatable)",
-    )
-    watch.add_argument(
-        "--eval-interval", type=float, default=2.0, help="seconds between greedy evaluations (2)"
-    )
-    watch.add_argument(
-        "--eval-episodes", type=int, default=8, help="episodes per greedy evaluation (8)"
-    )
-    watch.add_argument(
-        "--checkpoint-interval", type=float, default=60.0, help="seconds between checkpoints (60)"
-    )
-    watch.add_argument(
-        "--snapshot-every",
-        type=float,
-        metavar="MINUTES",
-        help="also keep a copy of the checkpoint every MINUTES in OUT/snapshots/frames-N.pt "
-        "(for curves on held-out levels: bench/curve.py)",
-    )
-    watch.add_argument(
-        "--window",
-        type=int,
-        default=100,
-        help="recent episodes behind mean return and success (100)",
-    )
-    watch.add_argument(
-        "--slim",
-        action=argparse.BooleanOptionalAction,
-        default=None,
-        help="leave the optimizer state out of checkpoints (with --resume: as the run was)",
-    )
-    watch.add_argument("--quiet", action="store_true", help="no progress bar")
+    )  # fmt: skip
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    groups = {key: parser.add_argument_group(title) for key, title in GROUPS.items()}
+    for f in fields(RunOptions):
+        if f.metadata.get("flag"):
+            _add_flag(groups[f.metadata["group"]], RunOptions, f)
+    for title, cls, _ in SETTINGS:
+        group = parser.add_argument_group(title)
+        for f in fields(cls):
+            if f.metadata.get("flag"):
+                _add_flag(group, cls, f)
+
+
+def _parse_value(name: str, f: Field[Any], text: str) -> Any:
+    kind = _kind(f)
+    if kind == "channels":
+        try:
+            return _channels(text)
+        except argparse.ArgumentTypeError as exc:
+            raise ConfigError(f"--set {name}: {exc}") from None
+    if kind == "bool":
+        lowered = text.lower()
+        if lowered not in ("true", "false", "1", "0", "yes", "no"):
+            raise ConfigError(f"--set {name} wants true or false, got {text!r}")
+        return lowered in ("true", "1", "yes")
+    if kind == "str":
+        return text
+    try:
+        value = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        value = None
+    if kind == "float" and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    if type(value).__name__ != kind:
+        raise ConfigError(f"--set {name} wants a number ({kind}), got {text!r}")
+    return value
+
+
+def parse_settings(items: list[str]) -> dict[str, Any]:
+    """``--set`` items -> {name: value}, each read as its field's type."""
+    known = settable()
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or name not in known:
+            raise ConfigError(
+                f"--set wants NAME=VALUE with NAME a setting ({', '.join(sorted(known))}), "
+                f"got {item!r}"
+            )
+        out[name] = _parse_value(name, known[name][1], text)
+    return out
+
+
+def overrides_of(args: argparse.Namespace) -> dict[str, dict[str, Any]]:
+    """The settings given on the command line, by config: {"train": {...}, "model": {...}}."""
+    given = {f.name: getattr(args, f.name) for cls, f in flag_fields() if cls is not RunOptions}
+    given.update(parse_settings(args.settings))
+    model_names = {f.name for f in fields(ModelConfig)}
+    out: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
+    for name, value in given.items():
+        if value is not None:
+            out["model" if name in model_names else "train"][name] = value
+    return out
+
+
+def _as_text(value: Any) -> str:
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
 def command_line(args: argparse.Namespace) -> str:
-    """The command as a user would type it, from the parsed options that were given."""
+    """The command as a user would type it, rebuilt from what was given."""
     parts = ["neurosym", "train"]
-    for flag, dest in (("--env", "env"), ("--module", "module"), ("--out", "out")):
-        if getattr(args, dest) is not None:
-            parts += [flag, str(getattr(args, dest))]
+    for flag in ("env", "module", "out"):
+        if getattr(args, flag) is not None:
+            parts += [f"--{flag}", str(getattr(args, flag))]
     if args.resume:
         parts.append("--resume")
-    if args.init_from is not None:
-        parts += ["--init-from", args.init_from]
-    if args.algo is not None:
-        parts += ["--algo", args.algo]
+    for name in ("init_from", "algo"):
+        if getattr(args, name) is not None:
+            parts += [option_name(name), str(getattr(args, name))]
     if args.preset != "default":
         parts += ["--preset", args.preset]
-    for flag, dest in (
-        ("--frames", "frames"),
-        ("--minutes", "minutes"),
-        ("--target-return", "target_return"),
-        ("--target-success", "target_success"),
-    ):
-        if getattr(args, dest) is not None:
-            parts += [flag, str(getattr(args, dest))]
-    for flag, dest, _ in _OVERRIDES:
-        value = getattr(args, dest)
-        if isinstance(value, bool):
-            parts.append(flag if value else "--no-" + flag[2:])
-        elif isinstance(value, tuple):
-            parts += [flag, ",".join(map(str, value))]
-        elif value is not None:
-            parts += [flag, str(value)]
+    flagged = {f.name for _, f in flag_fields()}
+    for settings in overrides_of(args).values():
+        for name, value in settings.items():
+            if name not in flagged:
+                parts += ["--set", f"{name}={_as_text(value)}"]
+            elif isinstance(value, bool):
+                parts.append(option_name(name) if value else "--no-" + option_name(name)[2:])
+            else:
+                parts += [option_name(name), _as_text(value)]
     for item in args.env_option:
         parts += ["--env-option", item]
-    for flag, dest, default in (
-        ("--eval-interval", "eval_interval", 2.0),
-        ("--eval-episodes", "eval_episodes", 8),
-        ("--checkpoint-interval", "checkpoint_interval", 60.0),
-        ("--snapshot-every", "snapshot_every", None),
-        ("--window", "window", 100),
-    ):
-        if getattr(args, dest) != default:
-            parts += [flag, str(getattr(args, dest))]
-    if args.slim is not None:
-        parts.append("--slim" if args.slim else "--no-slim")
-    if args.tensorboard:
-        parts.append("--tensorboard")
-    if args.device != "cpu":
-        parts += ["--device", args.device]
+    for f in fields(RunOptions):
+        value = getattr(args, f.name, None)
+        if f.metadata.get("flag") and value is not None and value != f.default:
+            if isinstance(value, bool):
+                parts.append(option_name(f.name) if value else "--no-" + option_name(f.name)[2:])
+            else:
+                parts += [option_name(f.name), str(value)]
     command = shlex.join(parts)
     world = os.environ.get("WORLD_SIZE")
     if world and world != "1":  # the checkpoint says the run was distributed
@@ -338,28 +263,17 @@ def command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from neurosym.agent.run.trainer import RunOptions, train
+    from neurosym.agent.run.trainer import train
 
-    overrides: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
-    for _, dest, kind in _OVERRIDES:
-        overrides[kind][dest] = getattr(args, dest)
-    if overrides["train"]["workers"] is None and not args.resume and args.algo in (None, "a3c"):
+    overrides = overrides_of(args)
+    if "workers" not in overrides["train"] and not args.resume and args.algo in (None, "a3c"):
         overrides["train"]["workers"] = os.cpu_count() or 1
-    options = RunOptions(
-        frames=args.frames,
-        minutes=args.minutes,
-        target_return=args.target_return,
-        target_success=args.target_success,
-        eval_interval=args.eval_interval,
-        eval_episodes=args.eval_episodes,
-        checkpoint_interval=args.checkpoint_interval,
-        snapshot_every=args.snapshot_every,
-        window=args.window,
-        slim=args.slim,
-        progress=not args.quiet,
-        tensorboard=args.tensorboard,
-        device=args.device,
-    )
+    given = {
+        f.name: getattr(args, f.name)
+        for f in fields(RunOptions)
+        if f.metadata.get("flag") and getattr(args, f.name) is not None
+    }
+    options = RunOptions(**given, progress=not args.quiet)
     result = train(
         args.env,
         args.module,

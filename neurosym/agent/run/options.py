@@ -2,47 +2,50 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from neurosym.errors import ConfigError
+
+STOP = {"flag": True, "group": "stop"}
+WATCH = {"flag": True, "group": "watch"}
 
 
 @dataclass
 class RunOptions:
-    """How long to train and how to watch it (everything but the model and A3C settings)."""
+    """How long to train and how to watch it (everything but the model and learner settings)."""
 
-    frames: int | None = None
-    """stop once this many frames (env steps, all workers, counting earlier sessions) are done"""
-    minutes: float | None = None
+    frames: int | None = field(default=None, metadata=STOP)
+    """stop at this many training frames (env steps of all learners, counting resumed ones)"""
+    minutes: float | None = field(default=None, metadata=STOP)
     """stop after this many minutes of this session"""
-    target_return: float | None = None
+    target_return: float | None = field(default=None, metadata=STOP)
     """stop when the greedy policy's mean return reaches this"""
-    target_success: float | None = None
+    target_success: float | None = field(default=None, metadata=STOP)
     """stop when the success rate over the last ``window`` training episodes (a full window)
     reaches this: the stop a learning-speed comparison wants"""
-    eval_interval: float = 2.0
+    eval_interval: float = field(default=2.0, metadata=WATCH)
     """seconds between greedy evaluations (more when one takes over 5 % of that)"""
-    device: str = "cpu"
-    """the PPO learner's device: cpu, cuda or auto (cuda when one is visible)"""
-    eval_episodes: int = 8
+    device: str = field(default="cpu", metadata={**WATCH, "choices": ("cpu", "cuda", "auto")})
+    """where the PPO and DAgger learners act and learn: cpu, cuda (the CPU, with a warning, when
+    no GPU is visible) or auto (cuda when one is visible); A3C is CPU-only"""
+    eval_episodes: int = field(default=8, metadata=WATCH)
     """episodes per greedy evaluation (played side by side)"""
-    checkpoint_interval: float = 60.0
+    checkpoint_interval: float = field(default=60.0, metadata=WATCH)
     """seconds between periodic checkpoints"""
-    snapshot_every: float | None = None
-    """minutes between copies of the checkpoint kept in ``out/snapshots/frames-N.pt``: the
-    checkpoint.pt of a run holds only its last weights, a curve on held-out levels needs
-    the earlier ones; None keeps none"""
+    snapshot_every: float | None = field(default=None, metadata={**WATCH, "metavar": "MINUTES"})
+    """minutes between copies of the checkpoint kept in OUT/snapshots/frames-N.pt (for curves
+    on held-out levels: checkpoint.pt holds only the last weights); None keeps none"""
     log_interval: float = 2.0
     """seconds between metrics rows"""
-    window: int = 100
+    window: int = field(default=100, metadata=WATCH)
     """recent episodes behind mean_return and success_rate"""
-    slim: bool | None = None
+    slim: bool | None = field(default=None, metadata=WATCH)
     """leave the optimizer state out of checkpoints; None: as the checkpoint a resumed run
-    continues (slim when it holds no optimizer state), else keep it"""
+    continues, else keep it"""
     progress: bool = True
     """show a rich progress bar on stderr"""
-    tensorboard: bool = False
-    """also write the metrics as TensorBoard event files under ``out/tensorboard``"""
+    tensorboard: bool = field(default=False, metadata=WATCH)
+    """also write the metrics as TensorBoard event files to OUT/tensorboard"""
 
     def __post_init__(self) -> None:
         if self.frames is not None and self.frames < 1:

@@ -62,7 +62,7 @@ class RunPlan:
     @property
     def learners(self) -> int:
         """Learner processes: A3C's W workers, or one synchronous learner."""
-        return self.train_config.workers if self.train_config.algo == "a3c" else 1
+        return self.train_config.a3c.workers if self.train_config.algo == "a3c" else 1
 
     @property
     def optimizer_state(self) -> dict[str, Any] | None:
@@ -205,7 +205,11 @@ def _resumed(
     model_config: ModelConfig = payload["model_config"]
     check_model_fits(ckpt, model_config, module, model_overrides, shape, "env")
     base = payload.get("train_config") or TrainConfig.for_family(family).to_dict()
-    train_config = TrainConfig.from_dict(base).replace(**train_overrides)
+    try:
+        recorded = TrainConfig.from_dict(base)
+    except ConfigError as exc:
+        raise CheckpointError(f"{ckpt}: {exc}") from None
+    train_config = recorded.replace(**train_overrides)
     if algo is not None and algo != train_config.algo:
         raise CheckpointError(
             f"{ckpt} was trained with --algo {train_config.algo}; resume it with that"
@@ -278,17 +282,8 @@ def _new(
 
 
 def _check_learner(plan: RunPlan) -> None:
-    """Settings that do not fit the learner, the env family or a distributed run."""
-    train_config, family = plan.train_config, plan.family
-    if train_config.algo != "a3c" and train_config.sil > 0:  # a new run's or a resume's --sil
-        raise ConfigError(
-            f"--sil is A3C's self-imitation; {train_config.algo} has none (use --sil 0)"
-        )
-    if train_config.planner_coef and family != "rgw":
-        raise ConfigError(
-            f"--planner-coef learns from the RGW planner; {family} has none (use --planner-coef 0)"
-        )
-    if plan.world.distributed and train_config.algo != "ppo":
+    """Refuse a learner that cannot run distributed under torchrun."""
+    if plan.world.distributed and plan.train_config.algo != "ppo":
         raise ConfigError(
             "torchrun trains the synchronous learner: pass --algo ppo "
             "(A3C's workers share one machine's memory)"
