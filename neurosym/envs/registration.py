@@ -140,21 +140,26 @@ def env_family(name_or_id: str) -> str:
     return entry(name_or_id).family
 
 
-def check_options(name_or_id: str, kwargs: dict[str, Any]) -> None:
+def check_options(name_or_id: str, kwargs: dict[str, Any], batched: bool = False) -> None:
     """Refuse, in one line naming the ones it takes, an option the env's class does not take.
 
-    gymnasium would raise a TypeError deep in its factory instead; options the
-    class gathers in ``**kwargs`` (rgw-random's level parameters) it checks itself.
+    ``batched``: the options of the batched class (such as ``copy``), which
+    :func:`make_batched` builds, instead of the single env's. gymnasium would
+    raise a TypeError deep in its factory instead; options the class gathers
+    in ``**kwargs`` (rgw-random's level parameters) it checks itself.
     """
     import importlib
     import inspect
 
     e = entry(name_or_id)
-    module, _, cls = e.entry_point.partition(":")
+    module, _, cls = (e.vector_entry_point if batched else e.entry_point).partition(":")
     params = inspect.signature(getattr(importlib.import_module(module), cls).__init__).parameters
     if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
         return
-    known = [n for n, p in params.items() if n != "self" and p.kind is not p.VAR_POSITIONAL]
+    given_apart = ("self", "num_envs", "seed") if batched else ("self",)  # make_batched's own
+    known = [
+        n for n, p in params.items() if n not in given_apart and p.kind is not p.VAR_POSITIONAL
+    ]
     unknown = sorted(set(kwargs) - set(known))
     if unknown:
         raise ConfigError(
@@ -182,7 +187,7 @@ def make_batched(name: str, n: int, seed: int | None = None, **kwargs: Any) -> A
     e = entry(name)
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ConfigError(f"number of environments must be a positive integer, got {n!r}")
-    check_options(name, kwargs)
+    check_options(name, kwargs, batched=True)
     register_envs()
     return gymnasium.make_vec(
         e.id, num_envs=n, vectorization_mode="vector_entry_point", seed=seed, **kwargs
