@@ -472,3 +472,57 @@ def test_resume_keeps_a_slim_run_slim_unless_told_otherwise(neurosym, tmp_path: 
     payload = torch.load(ckpt, weights_only=True)
     assert payload["optimizer"] is not None
     assert "--no-slim" in payload["command"].split(" && ")[-1]
+
+
+@pytest.mark.expensive
+def test_a_full_disk_leaves_no_run_that_looks_resumable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The checkpoint cannot be written (a full disk): the one-line error, and no run directory
+    holding only metrics.csv, which --resume would take for a run."""
+    from neurosym.agent.run import trainer
+    from neurosym.agent.run.options import RunOptions
+    from neurosym.errors import OutputError
+
+    def full(path: Path, **kwargs: object) -> None:
+        raise OutputError(f"cannot write {path}: No space left on device; it was left as it was")
+
+    monkeypatch.setattr(trainer, "save_checkpoint", full)
+    out = tmp_path / "run"
+    options = RunOptions(frames=100, progress=False, eval_episodes=1, log_interval=0.1,
+                         checkpoint_interval=0.2)  # fmt: skip
+    with pytest.raises(OutputError, match="No space left on device"):
+        trainer.train("rgw2", "predinet", out, train_overrides={"workers": 1, "envs": 2},
+                      options=options, print_fn=lambda text: None)  # fmt: skip
+    assert not out.exists()
+    out.mkdir()
+    with pytest.raises(OutputError):
+        trainer.train("rgw2", "predinet", out, train_overrides={"workers": 1, "envs": 2},
+                      options=options, print_fn=lambda text: None)  # fmt: skip
+    assert out.exists() and list(out.iterdir()) == []  # a directory it did not make stays
+
+
+def test_a_read_only_file_system_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where --out cannot be made or written (a read-only file system), one line says so."""
+    import errno
+
+    from neurosym.agent.run.trainer import make_run_directory
+    from neurosym.errors import ConfigError
+
+    def read_only(self: Path, *args: object, **kwargs: object) -> None:
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(Path, "mkdir", read_only)
+        with pytest.raises(ConfigError) as info:
+            make_run_directory(tmp_path / "run")
+    assert str(info.value) == (
+        f"cannot create the run directory {tmp_path / 'run'}: Read-only file system"
+    )
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(
+        ConfigError, match="^cannot write to the run directory .*: permission denied$"
+    ):
+        make_run_directory(tmp_path)

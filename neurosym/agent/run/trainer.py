@@ -26,9 +26,11 @@ does (:mod:`neurosym.agent.learners.distributed` says how the ranks agree).
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing as _mp
 import os
 import queue as _queue
+import shutil
 import signal
 import sys
 import time
@@ -74,7 +76,7 @@ from neurosym.agent.run.plan import (
     resolve_run,
 )
 from neurosym.atomic import write_bytes_atomic
-from neurosym.errors import CheckpointError, ConfigError
+from neurosym.errors import CheckpointError, ConfigError, OutputError
 
 __all__ = ["LEARNERS", "RunOptions", "TrainResult", "probe_env", "snapshot_path", "train"]
 
@@ -202,12 +204,28 @@ def train(
         env_kwargs=env_kwargs, options=options, resume=resume, command=command, preset=preset,
         algo=algo, init_from=init_from, say=say,
     )  # fmt: skip
+    created = not plan.out.exists()
     make_run_directory(plan.out)
     shared, optimizer = build_learning_state(plan)
     run = _Supervisor(plan, shared, optimizer)
-    learners = start_learners(plan, shared, optimizer)
-    run.supervise(learners)
-    return run.finish(say)
+    try:
+        learners = start_learners(plan, shared, optimizer)
+        run.supervise(learners)
+        return run.finish(say)
+    except OutputError:  # a full disk: leave no new run that looks resumable but is not
+        if not plan.resume and not run.wrote_checkpoint:
+            _remove_unfinished_run(plan.out, created)
+        raise
+
+
+def _remove_unfinished_run(out: Path, created: bool) -> None:
+    """What a new run wrote before its first checkpoint (and ``out`` itself, if it made it)."""
+    (out / METRICS_NAME).unlink(missing_ok=True)
+    shutil.rmtree(out / "tensorboard", ignore_errors=True)
+    _remove_stale_temporaries(out)
+    if created:
+        with contextlib.suppress(OSError):  # only if nothing else is in it
+            out.rmdir()
 
 
 def make_run_directory(out: Path) -> None:
