@@ -19,7 +19,7 @@ of a fresh (or trained) model on a batch of observations:
   each weight by about lr whatever its gradient's size, and the attention
   saturates on fixed cells (``fixed_cell_share`` near 1).
 
-``bench/diagnose.py`` prints both for every env family and module, for the
+``experiments/diagnose.py`` prints both for every env family and module, for the
 model switches and learner settings of a preset, so a change to either is
 judged by these figures before and after.
 """

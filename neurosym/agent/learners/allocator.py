@@ -9,7 +9,7 @@ virtual machines this project runs on, a fault is expensive: measured on the
 2-core development VM, one rgw2 update batch (1,352 observations, PrediNet)
 took 145 ms with 23 k page faults (36 ms of it in the kernel) and 107 ms with
 none once freed memory was kept; MHDPA's 717 ms with 79 k faults, 621 ms
-(``python bench/allocator.py``). Small batches gain little (a bw1 PrediNet
+(``python experiments/allocator.py``). Small batches gain little (a bw1 PrediNet
 batch of 368 faulted little either way). The PyTorch CPU performance guides recommend
 jemalloc or tcmalloc for the same reason; glibc's own ``mallopt`` switches
 give the same effect here with nothing to install.

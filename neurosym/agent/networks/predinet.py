@@ -29,7 +29,7 @@ Choices made here (DESIGN.md leaves them open):
   direction (most of flat(L) is the same in every level: coordinates, walls,
   background), so the queries jump by the same large vector in every scene
   and the attention saturates on fixed cells (largest weight 0.033 -> 0.66
-  after one PPO update, 0.78 after two: ``bench/diagnose.py --ppo-updates 2``;
+  after one PPO update, 0.78 after two: ``experiments/diagnose.py --ppo-updates 2``;
   4 of 8 attentions on one fixed cell in 97-100 % of observations after
   375 k frames of seed 1, which never took off). A learned query moves by
   about lr per step. It cannot make which lock a head attends to depend on

@@ -6,8 +6,8 @@ steps, plus the K last observations and the 40 self-imitation rows. It
 prints one JSON line per case with the milliseconds per forward+backward, the
 minor page faults per iteration and the kernel (system) time per iteration::
 
-    python bench/allocator.py                   # rgw2 K = 32 and bw1 K = 8, PrediNet and MHDPA
-    python bench/allocator.py --cases rgw2:32:predinet --iters 20
+    python experiments/allocator.py                   # rgw2 K = 32 and bw1 K = 8, PrediNet and MHDPA
+    python experiments/allocator.py --cases rgw2:32:predinet --iters 20
 """
 
 from __future__ import annotations

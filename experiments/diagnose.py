@@ -7,9 +7,9 @@ on one rollout's worth of those observations with Monte-Carlo-like returns
 from the env's rewards (random actions). Run before and after changing the
 model or the learner::
 
-    python bench/diagnose.py                        # rgw2 and bw1, both modules, both presets
-    python bench/diagnose.py --envs bw1 --presets thesis
-    python bench/diagnose.py --envs bw1 --modules predinet --presets default \
+    python experiments/diagnose.py                        # rgw2 and bw1, both modules, both presets
+    python experiments/diagnose.py --envs bw1 --presets thesis
+    python experiments/diagnose.py --envs bw1 --modules predinet --presets default \
         --ppo-updates 3 --query learned     # also after each of the first PPO updates
 """
 

@@ -8,7 +8,7 @@ free route avoids, the enemy met unarmed, the decoy's +1 walked past. This
 plays the agent's sampled policy on procedural levels and splits the visited
 states by the planner's per-action regret (:meth:`rgw_solver.Plan.regret`)::
 
-    python bench/regret_profile.py checkpoints/rgw-random-mhdpa.pt --episodes 300
+    python experiments/regret_profile.py checkpoints/rgw-random-mhdpa.pt --episodes 300
 
 Prints one JSON line per checkpoint: the share of ``critical`` states (some
 action loses return), the mean NLL on critical and on other states, the

@@ -16,8 +16,8 @@ probability ``--follow`` (one of its optimal actions, uniformly) and is
 otherwise a uniformly random action, so that they cover the planner's routes
 and the detours a learner makes.
 
-    python bench/imitation_capacity.py                          # the README's table
-    python bench/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
+    python experiments/imitation_capacity.py                          # the README's table
+    python experiments/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
 
 ``cnn`` is a plain CNN reference (not a relational module).
 """

@@ -16,8 +16,8 @@ one JSON line per discount:
 
 Usage::
 
-    python bench/critic_fit.py checkpoints/rgw-random-predinet-deep.pt
-    python bench/critic_fit.py runs/x/checkpoint.pt --gammas 0.99
+    python experiments/critic_fit.py checkpoints/rgw-random-predinet-deep.pt
+    python experiments/critic_fit.py runs/x/checkpoint.pt --gammas 0.99
 """
 
 from __future__ import annotations
