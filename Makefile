@@ -8,7 +8,7 @@ TORCH_SPEC ?= torch==2.13.0
 SWIPL_PATH_FILE := $(VENV)/swipl-path
 export PYTHONHASHSEED := 0
 
-.PHONY: setup test demo bench lint clean
+.PHONY: setup test test-fast demo bench lint clean
 
 setup: $(STAMP)
 
@@ -27,6 +27,9 @@ $(STAMP): pyproject.toml scripts/setup_swipl.sh Makefile
 
 test: setup
 	$(PY) -m pytest -q
+
+test-fast: setup
+	$(PY) -m pytest -q -m "not expensive"
 
 demo: setup
 	$(VENV)/bin/neurosym extract --checkpoint checkpoints/rgw2-predinet.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2
