@@ -1,4 +1,4 @@
-"""Does the network see its input, and where do the gradients go? Measured, not hoped for.
+"""Does the network see its input, and where do the gradients go?
 
 Two questions decide whether A3C can learn at all, and both are cheap to ask
 of a fresh (or trained) model on a batch of observations:

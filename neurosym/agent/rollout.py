@@ -145,10 +145,10 @@ def collect_rollout(
 
     By default no graph is kept and the update runs the model once more over
     the whole rollout: one batched forward and backward instead of T small
-    ones (PrediNet: 35 % faster, its big weight-gradient products want big
-    batches). ``keep_graph`` keeps each step's graph instead and saves that
-    second forward (MHDPA with K = 32: 45 % faster; its cost is per-sample
-    attention, cheapest in small batches).
+    ones (PrediNet's big weight-gradient products want big batches).
+    ``keep_graph`` keeps each step's graph instead and saves that second
+    forward (MHDPA with many envs: its cost is per-sample attention, cheapest
+    in small batches).
     ``bonus(next_obs, valid) -> (K,)`` adds an intrinsic reward to the
     rollout's rewards (the training signal); the finished episodes' returns
     are the environment's own. ``memory`` (an ``sil.EpisodeMemory``) is fed

@@ -24,8 +24,9 @@ value loss is 0.5 A_t^2 with V(o_t) kept in the graph), V after the
 rollout's last step bootstrapping the tail, and rms(A) the worker's running
 root-mean-square of the advantages when ``normalize_advantages`` is on
 (:class:`~neurosym.agent.learners.returns.AdvantageScale` says why not
-the usual per-batch normalisation). With lambda = 1, s = 1 and no normalisation this is Table 4's n-step
-A3C: A_t = G_t - V(o_t) with G_t the bootstrapped n-step return.
+the usual per-batch normalisation). With lambda = 1, s = 1 and no
+normalisation this is Table 4's n-step A3C: A_t = G_t - V(o_t) with G_t the
+bootstrapped n-step return.
 Truncated episodes (time limit) bootstrap from V of their final observation.
 With ``sil > 0`` (:class:`~neurosym.agent.config.A3CConfig`) the self-imitation loss (:mod:`neurosym.agent.learners.sil`)
 on a batch of M remembered transitions is added, scaled to T transitions.

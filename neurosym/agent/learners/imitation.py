@@ -1,8 +1,7 @@
 """Imitation of the env's optimal planner (DAgger): ``neurosym train --algo imitate``.
 
-Why: on rgw-random neither RL learner left uniformly random success (A3C:
-25 M frames in 70 min; PPO: 0.5 M frames in 9 min, both 2-8 % against
-random's 4.6 %). The levels carry an exact planner (:class:`rgw_solver.Plan`,
+Why: on rgw-random neither RL learner gets far beyond uniformly random
+success (docs/results.md). The levels carry an exact planner (:class:`rgw_solver.Plan`,
 the search that gives each level its optimal return), so the network can be
 taught what to do and has to find, from the pixels, what the planner reads
 from the state: where the sword, the enemy, the door and the terminal are and

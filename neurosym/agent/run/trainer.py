@@ -141,9 +141,8 @@ class _StopSignal:
 
     A KeyboardInterrupt raised in the middle of reading a worker's message
     from the queue leaves the rest of that message in the pipe; the next read
-    then takes its bytes for a length header and can wait forever (the likely
-    cause of a Ctrl-C that once never stopped a run under heavy load). A
-    handler that only sets a flag lets every read finish.
+    then takes its bytes for a length header and can wait forever. A handler
+    that only sets a flag lets every read finish.
     """
 
     def __init__(self) -> None:
