@@ -33,6 +33,7 @@ of all ranks form the process group (:mod:`neurosym.agent.learners.distributed`)
 from __future__ import annotations
 
 import os
+from typing import NamedTuple
 
 import torch
 import torch.nn.functional as F
@@ -47,23 +48,21 @@ from neurosym.agent.learners.returns import AdvantageScale, explained_variance, 
 from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 
 
-def ppo_update(
-    model: torch.nn.Module,
-    optimizer: torch.optim.Optimizer,
-    rollout: Rollout,
-    config: TrainConfig,
-    generator: torch.Generator,
-    scale: AdvantageScale | None = None,
-) -> LossStats:
-    """Epochs of clipped-surrogate minibatch steps on one rollout; the mean loss parts.
+class _Batch(NamedTuple):
+    """A rollout's valid transitions, flattened: M of them (``b_*`` as in CleanRL)."""
 
-    ``model`` may be wrapped in DistributedDataParallel; the rollout's CPU
-    tensors are moved to the model's device. ``scale``: the learner's running
-    RMS for ``ppo_advantages == "running"`` (a fresh one if None).
-    """
+    obs: torch.Tensor  # (M, C, H, W)
+    actions: torch.Tensor  # (M,)
+    logp: torch.Tensor  # (M,) the acting policy's log-probability of each action
+    advantages: torch.Tensor  # (M,)
+    returns: torch.Tensor  # (M,) the value's targets
+
+
+def _flatten(
+    core: torch.nn.Module, rollout: Rollout, config: TrainConfig, device: torch.device
+) -> tuple[_Batch, torch.Tensor]:
+    """The rollout's valid transitions with their GAE advantages; also the acting values (M,)."""
     assert rollout.logits is not None and rollout.values is not None, "record the rollout"
-    core = getattr(model, "module", model)
-    device = next(core.parameters()).device
     with torch.no_grad():
         _, last_value = core(rollout.last_obs.to(device))  # (K,)
     values = rollout.values.to(device)  # (T, K)
@@ -84,13 +83,34 @@ def ppo_update(
     b_logp = b_logp.gather(-1, b_actions.unsqueeze(-1)).squeeze(-1)  # (M,)
     b_adv = advantages.flatten()[valid]  # (M,)
     b_values = values.flatten()[valid]  # (M,)
-    b_returns = b_adv + b_values  # (M,)
-    explained = explained_variance(b_values, b_returns)
-    per_minibatch = config.normalize_advantages and config.ppo.ppo_advantages == "minibatch"
+    return _Batch(b_obs, b_actions, b_logp, b_adv, b_adv + b_values), b_values
+
+
+def ppo_update(
+    model: torch.nn.Module,
+    optimizer: torch.optim.Optimizer,
+    rollout: Rollout,
+    config: TrainConfig,
+    generator: torch.Generator,
+    scale: AdvantageScale | None = None,
+) -> LossStats:
+    """Epochs of clipped-surrogate minibatch steps on one rollout; the mean loss parts.
+
+    ``model`` may be wrapped in DistributedDataParallel; the rollout's CPU
+    tensors are moved to the model's device. ``scale``: the learner's running
+    RMS for ``ppo_advantages == "running"`` (a fresh one if None).
+    """
+    core = getattr(model, "module", model)
+    device = next(core.parameters()).device
+    batch, b_values = _flatten(core, rollout, config, device)
+    explained = explained_variance(b_values, batch.returns)
     if config.normalize_advantages and config.ppo.ppo_advantages == "running":
         scale = scale if scale is not None else AdvantageScale()
-        b_adv = scale(b_adv, torch.ones_like(b_adv))  # the returns above keep the raw ones
-    M = b_obs.shape[0]
+        # the returns keep the raw advantages
+        batch = batch._replace(
+            advantages=scale(batch.advantages, torch.ones_like(batch.advantages))
+        )
+    M = batch.obs.shape[0]
     totals = torch.zeros(6)
     steps = 0
     for _ in range(config.ppo.ppo_epochs):
@@ -99,42 +119,47 @@ def ppo_update(
             # an empty minibatch (fewer transitions than minibatches) still takes its step with
             # weight 0, so that every rank of a distributed run makes the same collectives
             weight = 1.0 if mb.numel() else 0.0
-            if not mb.numel():
-                mb = order[:1]
-            logits, value = model(b_obs[mb])  # (m, A), (m,)
-            logp_all = F.log_softmax(logits, dim=-1)
-            logp = logp_all.gather(-1, b_actions[mb].unsqueeze(-1)).squeeze(-1)
-            entropy = -(logp_all.exp() * logp_all).sum(-1).mean()
-            adv = b_adv[mb]
-            if per_minibatch and adv.numel() > 1:
-                adv = (adv - adv.mean()) / (adv.std() + 1e-8)
-            log_ratio = logp - b_logp[mb]
-            ratio = log_ratio.exp()
-            clipped = ratio.clamp(1.0 - config.ppo.clip_range, 1.0 + config.ppo.clip_range)
-            policy_loss = -torch.min(ratio * adv, clipped * adv).mean()
-            value_loss = 0.5 * (value - b_returns[mb]).pow(2).mean()
-            loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy
-            optimizer.zero_grad(set_to_none=True)
-            (loss * weight).backward()
-            norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
-            optimizer.step()
-            with torch.no_grad():
-                # Schulman's low-variance estimator of KL(old || new), as SB3 and CleanRL log it
-                approx_kl = ((ratio - 1.0) - log_ratio).mean()
-                clip_fraction = ((ratio - 1.0).abs() > config.ppo.clip_range).float().mean()
-            totals += torch.stack(
-                [
-                    policy_loss.detach(),
-                    value_loss.detach(),
-                    entropy.detach(),
-                    norm.detach(),
-                    approx_kl,
-                    clip_fraction,
-                ]
-            ).cpu()
+            totals += _minibatch_step(model, optimizer, batch, mb if mb.numel() else order[:1],
+                                      weight, config)  # fmt: skip
             steps += 1
     mean = (totals / max(steps, 1)).tolist()
     return LossStats(*mean, explained_variance=explained)
+
+
+def _minibatch_step(
+    model: torch.nn.Module,
+    optimizer: torch.optim.Optimizer,
+    batch: _Batch,
+    mb: torch.Tensor,
+    weight: float,
+    config: TrainConfig,
+) -> torch.Tensor:
+    """One clipped-surrogate step on minibatch ``mb``; its (6,) loss parts on the CPU."""
+    clip = config.ppo.clip_range
+    logits, value = model(batch.obs[mb])  # (m, A), (m,)
+    logp_all = F.log_softmax(logits, dim=-1)
+    logp = logp_all.gather(-1, batch.actions[mb].unsqueeze(-1)).squeeze(-1)
+    entropy = -(logp_all.exp() * logp_all).sum(-1).mean()
+    adv = batch.advantages[mb]
+    per_minibatch = config.normalize_advantages and config.ppo.ppo_advantages == "minibatch"
+    if per_minibatch and adv.numel() > 1:
+        adv = (adv - adv.mean()) / (adv.std() + 1e-8)
+    log_ratio = logp - batch.logp[mb]
+    ratio = log_ratio.exp()
+    clipped = ratio.clamp(1.0 - clip, 1.0 + clip)
+    policy_loss = -torch.min(ratio * adv, clipped * adv).mean()
+    value_loss = 0.5 * (value - batch.returns[mb]).pow(2).mean()
+    loss = policy_loss + config.value_coef * value_loss - config.entropy * entropy
+    optimizer.zero_grad(set_to_none=True)
+    (loss * weight).backward()
+    norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
+    optimizer.step()
+    with torch.no_grad():
+        # Schulman's low-variance estimator of KL(old || new), as SB3 and CleanRL log it
+        approx_kl = ((ratio - 1.0) - log_ratio).mean()
+        clip_fraction = ((ratio - 1.0).abs() > clip).float().mean()
+    parts = [policy_loss.detach(), value_loss.detach(), entropy.detach(), norm.detach()]
+    return torch.stack([*parts, approx_kl, clip_fraction]).cpu()
 
 
 def ppo_learner(ctx: LearnerContext) -> None:
