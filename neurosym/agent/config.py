@@ -504,8 +504,8 @@ class TrainConfig:
     def build(cls, strict: bool = True, **flat: Any) -> TrainConfig:
         """A config from flat settings: the common fields, then ``algo``'s learner's.
 
-        A setting of another learner is a ConfigError when ``strict`` (a user's
-        flag), else dropped (a preset's table, an old checkpoint's record).
+        A setting of another learner is dropped; when ``strict`` (a user's flag)
+        one that differs from its default is a ConfigError.
         """
         algo = flat.get("algo", "a3c")
         if algo not in LEARNER_CONFIGS:
@@ -518,8 +518,8 @@ class TrainConfig:
             elif name in field_names(cls) and name != "learner":
                 common[name] = value
             elif name in learner_setting_owner():
-                if strict:
-                    owner = learner_setting_owner()[name]
+                owner = learner_setting_owner()[name]
+                if strict and value != field_default(LEARNER_CONFIGS[owner], name):
                     raise ConfigError(
                         f"{option_name(name)} is a setting of --algo {owner}; this run's "
                         f"learner is {algo}"

@@ -224,6 +224,19 @@ def _as_text(value: Any) -> str:
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
+def _run_options(args: argparse.Namespace, group: str) -> list[str]:
+    """The given RunOptions flags of one group that differ from their defaults."""
+    parts: list[str] = []
+    for f in fields(RunOptions):
+        value = getattr(args, f.name, None)
+        if f.metadata.get("group") == group and value is not None and value != f.default:
+            if isinstance(value, bool):
+                parts.append(option_name(f.name) if value else "--no-" + option_name(f.name)[2:])
+            else:
+                parts += [option_name(f.name), str(value)]
+    return parts
+
+
 def command_line(args: argparse.Namespace) -> str:
     """The command as a user would type it, rebuilt from what was given."""
     parts = ["neurosym", "train"]
@@ -237,6 +250,7 @@ def command_line(args: argparse.Namespace) -> str:
             parts += [option_name(name), str(getattr(args, name))]
     if args.preset != "default":
         parts += ["--preset", args.preset]
+    parts += _run_options(args, "stop")
     flagged = {f.name for _, f in flag_fields()}
     for settings in overrides_of(args).values():
         for name, value in settings.items():
@@ -248,13 +262,7 @@ def command_line(args: argparse.Namespace) -> str:
                 parts += [option_name(name), _as_text(value)]
     for item in args.env_option:
         parts += ["--env-option", item]
-    for f in fields(RunOptions):
-        value = getattr(args, f.name, None)
-        if f.metadata.get("flag") and value is not None and value != f.default:
-            if isinstance(value, bool):
-                parts.append(option_name(f.name) if value else "--no-" + option_name(f.name)[2:])
-            else:
-                parts += [option_name(f.name), str(value)]
+    parts += _run_options(args, "watch")
     command = shlex.join(parts)
     world = os.environ.get("WORLD_SIZE")
     if world and world != "1":  # the checkpoint says the run was distributed
