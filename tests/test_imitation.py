@@ -172,7 +172,7 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     assert first.returncode == 0, first.stderr[-2000:]
     payload = read_checkpoint(out / "checkpoint.pt")
     assert payload["train_config"]["algo"] == "imitate"
-    assert payload["train_config"]["learner"]["dagger_steps"] == 2
+    assert payload["train_config"]["dagger_steps"] == 2
     frames = int(payload["frames"])
     assert frames >= 300
     again = neurosym("train", "--out", out, "--resume", "--frames", frames + 200, "--quiet")

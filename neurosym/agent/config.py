@@ -23,12 +23,12 @@ advantages, n-step returns, and the RGB Box-World observation.
 ``preset="default"`` is what learns best here; each departure from Table 4
 says why at its field (docs/results.md has the figures).
 
-Checkpoints store the configs as plain dicts (``to_dict``/``from_dict``). A key
-missing from a stored config predates that setting: ``from_dict`` fills it with
-the value the code had before the setting existed (``_LEGACY``), so older
-checkpoints load and replay as they were made. Older checkpoints store the
-training settings flat (every learner's fields side by side); ``from_dict``
-sorts them into the common and the learner's config. Settings that were
+Checkpoints store the configs as plain flat dicts (``to_dict``/``from_dict``;
+the training settings are the common ones and the learner's side by side). A
+key missing from a stored config predates that setting: ``from_dict`` fills it
+with the value the code had before the setting existed (``_LEGACY``), so older
+checkpoints load and replay as they were made. Older checkpoints store every
+learner's fields; ``from_dict`` keeps those of the run's learner. Settings that were
 retired (``RETIRED``) load when they hold their neutral value; a checkpoint
 that used one is refused in one line naming it.
 """
@@ -564,22 +564,20 @@ class TrainConfig:
         return TrainConfig.build(**{**self.flat(), **given}) if given else self
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain values: the common settings, and the learner's under ``"learner"``."""
-        return asdict(self)
+        """Plain values, flat: the common settings and the learner's side by side (what a
+        checkpoint stores; older neurosym versions read it too)."""
+        return self.flat()
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TrainConfig:
-        """Inverse of :meth:`to_dict`; also reads the flat layout of older checkpoints."""
+        """Inverse of :meth:`to_dict`; also reads older checkpoints' records, which hold every
+        learner's fields (only ``algo``'s are kept) and retired settings (see ``RETIRED``)."""
         if not isinstance(data, dict):
             raise ConfigError(f"TrainConfig must be a dict, got {type(data).__name__}")
         data = _without_retired(cls, data)
-        nested = data.get("learner")
-        flat = {k: v for k, v in data.items() if k != "learner"}
-        if isinstance(nested, dict):
-            flat.update(nested)
-        legacy = {k: v for k, v in _LEGACY["TrainConfig"].items() if k not in flat}
+        legacy = {k: v for k, v in _LEGACY["TrainConfig"].items() if k not in data}
         try:
-            return cls.build(strict=isinstance(nested, dict), **legacy, **flat)
+            return cls.build(strict=False, **legacy, **data)
         except TypeError as exc:
             raise ConfigError(f"bad TrainConfig: {exc}") from None
 
