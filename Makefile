@@ -8,7 +8,7 @@ TORCH_SPEC ?= torch==2.13.0
 SWIPL_PATH_FILE := $(VENV)/swipl-path
 export PYTHONHASHSEED := 0
 
-.PHONY: setup test demo bench lint clean
+.PHONY: setup test test-fast demo bench lint clean
 
 setup: $(STAMP)
 
@@ -28,6 +28,10 @@ $(STAMP): pyproject.toml setup.py scripts/setup_swipl.sh Makefile
 test: setup
 	@bash scripts/setup_browser.sh
 	$(PY) -m pytest -q
+
+test-fast: setup
+	@bash scripts/setup_browser.sh
+	$(PY) -m pytest -q -m "not expensive"
 
 # One story in three steps (under a minute once set up); `neurosym extract --verbose` prints the full tables.
 NS := $(VENV)/bin/neurosym

@@ -69,7 +69,7 @@ def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
     import torch
 
     from neurosym.agent.config import ModelConfig
-    from neurosym.agent.model import ActorCritic
+    from neurosym.agent.networks.model import ActorCritic
     from neurosym.envs import env_family, make
 
     probe = make(env)

@@ -32,9 +32,9 @@ learned PrediNet queries: A3C 4.5-7.1x SB3's PPO in wall time to 90 % (seeds
 0-2), PPO with short rollouts and a running advantage scale 2.7-4.2x (seeds 0-3)::
 
     python bench/peers.py --env bw1 --frames 5000000 --minutes 8 --runs neurosym-a3c \
-        --a3c-args '--query learned'
+        --a3c-args '--set query=learned'
     python bench/peers.py --env bw1 --frames 5000000 --minutes 8 --runs neurosym-ppo \
-        --ppo-args '--n-steps 64 --ppo-epochs 2 --query learned --ppo-advantages running'
+        --ppo-args '--n-steps 64 --ppo-epochs 2 --set query=learned --set ppo_advantages=running'
 """
 
 from __future__ import annotations

@@ -168,8 +168,8 @@ def steady_frames(out: Path) -> tuple[int, float]:
 def bench_distributed(env: str, modules: tuple[str, ...], ranks: list[int], seconds: float) -> None:
     """PPO frames/s under torchrun for each rank count, and the all-reduce volume per update."""
     from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-    from neurosym.agent.model import ActorCritic
-    from neurosym.agent.trainer import probe_env
+    from neurosym.agent.networks.model import ActorCritic
+    from neurosym.agent.run.plan import probe_env
     from neurosym.envs import env_family
 
     kwargs = preset_env_kwargs(env_family(env))
@@ -180,7 +180,7 @@ def bench_distributed(env: str, modules: tuple[str, ...], ranks: list[int], seco
             p.numel()
             for p in ActorCritic(ModelConfig.for_family(family, module, shape, scale)).parameters()
         )
-        reductions = config.ppo_epochs * config.ppo_minibatches  # one gradient all-reduce each
+        reductions = config.ppo.ppo_epochs * config.ppo.ppo_minibatches  # one gradient all-reduce each
         for r in ranks:
             with run_dir(f"distributed-{module}-r{r}") as out:
                 t0 = time.monotonic()
@@ -253,7 +253,8 @@ def random_success(env: str, episodes: int = 1000, seed: int = 0) -> float:
     """Success rate of uniformly random actions: the floor a learned policy must clear."""
     import numpy as np
 
-    from neurosym.agent.rollout import SUCCESS_OUTCOMES, play_episodes
+    from neurosym.agent.evaluation import play_episodes
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES
     from neurosym.envs import make_batched
 
     rng = np.random.default_rng(seed)

@@ -174,7 +174,7 @@ def map_option(
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "train": (
-        "neurosym.agent.cli_train",
+        "neurosym.agent.run.cli_train",
         "Train a PrediNet or MHDPA agent with A3C or PPO (PPO also under torchrun).",
     ),
     "eval": (

@@ -6,9 +6,9 @@ import pytest
 import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.encoder import Encoder, coordinates
-from neurosym.agent.introspection import MHDPAIntrospection, PrediNetIntrospection
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.encoder import Encoder, coordinates
+from neurosym.agent.networks.introspection import MHDPAIntrospection, PrediNetIntrospection
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.errors import ConfigError
 
 RGW = ((9, 10, 10), "rgw", 1.0)
@@ -190,7 +190,7 @@ def _reference_attention(L, w_q, w_k, scale):
 
 
 def test_predinet_attention_backward_matches_autograd() -> None:
-    from neurosym.agent.predinet import PrediNetAttention
+    from neurosym.agent.networks.predinet import PrediNetAttention
 
     g = torch.Generator().manual_seed(0)
     B, N, F, H, D = 3, 7, 5, 2, 4
@@ -243,7 +243,7 @@ def test_recorded_queries_give_the_same_update_and_go_stale_with_the_weights() -
 def test_learned_queries_are_one_vector_for_every_scene() -> None:
     """ModelConfig.query "learned": no query projection, the same Q for every scene, the same
     gradients as plain autograd, and heads that still attend by what is in each scene."""
-    from neurosym.agent.predinet import PrediNetAttention
+    from neurosym.agent.networks.predinet import PrediNetAttention
 
     net = make("predinet", query="learned")
     rel = net.relational
@@ -340,55 +340,3 @@ def test_switching_keys_keeps_every_weight_but_w_k() -> None:
             torch.testing.assert_close(new[name], weight, rtol=0, atol=0)
     same = build_model(payload, "source.pt", keys="entities")  # no switch: a plain load
     torch.testing.assert_close(same.relational.key.weight, source.relational.key.weight)
-
-
-def test_agent_window_is_the_cells_around_the_agent_zero_off_the_grid() -> None:
-    from neurosym.agent.model import agent_window
-
-    x = torch.zeros(2, 2, 4, 5)
-    x[0, 0, 0, 0] = 1  # agent in the top-left corner
-    x[1, 0, 2, 3] = 1  # agent inside
-    x[:, 1] = torch.arange(1.0, 21.0).reshape(4, 5)  # plane 1 numbers the cells 1..20
-    window = agent_window(x, plane=0, size=3).reshape(2, 3, 3, 2)
-    assert window[0, :, :, 1].tolist() == [[0, 0, 0], [0, 1, 2], [0, 6, 7]]
-    assert window[1, :, :, 1].tolist() == [[8, 9, 10], [13, 14, 15], [18, 19, 20]]
-    assert window[:, 1, 1, 0].tolist() == [1, 1]  # the agent at the centre
-    assert window[:, :, :, 0].sum().item() == 2
-
-
-@pytest.mark.parametrize("module", ["predinet", "mhdpa"])
-def test_local_view_feeds_the_mlp_what_is_next_to_the_agent(module: str) -> None:
-    from neurosym.agent.model import agent_window
-
-    net = make(module, local_view=3)
-    assert net.config.agent_plane == 0 and net.config.local_size == 9 * 9
-    assert net.body[0].in_features == net.config.output_size + 81
-    obs = obs_batch(3, RGW[0])
-    obs[:, 0] = 0
-    obs[:, 0, 5, 5] = 1  # the agent
-    x = obs.float()
-    with torch.no_grad():
-        relations, _ = net.relational(net.encoder(x), False)
-        hidden = net.body(torch.cat([relations, agent_window(x, 0, 3)], dim=1))
-        torch.testing.assert_close(net(obs)[0], net.policy(hidden))
-    far, near = obs.clone(), obs.clone()
-    far[:, 1:, 0, 0] = 1 - far[:, 1:, 0, 0]  # a cell outside the window
-    near[:, 1:, 4, 6] = 1 - near[:, 1:, 4, 6]  # a cell diagonally next to the agent
-    assert torch.equal(agent_window(far.float(), 0, 3), agent_window(x, 0, 3))
-    assert not torch.equal(agent_window(near.float(), 0, 3), agent_window(x, 0, 3))
-
-
-def test_local_view_is_a_recorded_switch_and_bad_values_are_one_line() -> None:
-    data = ModelConfig.for_family("rgw", "predinet", RGW[0]).to_dict()
-    del data["local_view"], data["agent_plane"]  # a checkpoint from before the switch
-    old = ModelConfig.from_dict(data)
-    assert (old.local_view, old.agent_plane, old.local_size) == (0, -1, 0)
-    bw = ModelConfig.for_family("boxworld", "predinet", (26, 14, 14), local_view=5)
-    assert (bw.agent_plane, bw.local_size) == (1, 26 * 25)
-    assert ModelConfig.from_dict(bw.to_dict()) == bw
-    with pytest.raises(ConfigError, match="local_view must be 0 \\(off\\) or an odd window size"):
-        ModelConfig.for_family("rgw", "predinet", RGW[0], local_view=4)
-    with pytest.raises(ConfigError, match="one-hot observation; this env's observation is grey"):
-        ModelConfig.for_family("boxworld", "predinet", BW[0], BW[2], local_view=3)
-    with pytest.raises(ConfigError, match="local_view needs the agent's plane, one of 0..8"):
-        ModelConfig(module="predinet", obs_shape=RGW[0], local_view=3)

@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from neurosym.agent.allocator import keep_freed_memory
+from neurosym.agent.learners.allocator import keep_freed_memory
 
 GLIBC = platform.system() == "Linux" and platform.libc_ver()[0] == "glibc"
 
@@ -18,9 +18,9 @@ GLIBC = platform.system() == "Linux" and platform.libc_ver()[0] == "glibc"
 CHILD = r"""
 import resource, sys
 import torch
-from neurosym.agent.allocator import keep_freed_memory
+from neurosym.agent.learners.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
 
 torch.set_num_threads(1)
@@ -78,12 +78,12 @@ def test_learner_processes_keep_freed_memory(monkeypatch: pytest.MonkeyPatch) ->
     """Every learner (A3C worker, PPO, imitation) runs inside learner_process, which sets it."""
     import queue
 
-    from neurosym.agent import a3c
+    from neurosym.agent.learners import process
 
     calls: list[bool] = []
-    monkeypatch.setattr(a3c, "keep_freed_memory", lambda: calls.append(True) or True)
-    monkeypatch.setattr(a3c.signal, "signal", lambda *args: None)
-    monkeypatch.setattr("neurosym.agent.distributed.die_with_parent", lambda: None)
-    with a3c.learner_process(queue.Queue(), 0):
+    monkeypatch.setattr(process, "keep_freed_memory", lambda: calls.append(True) or True)
+    monkeypatch.setattr(process.signal, "signal", lambda *args: None)
+    monkeypatch.setattr("neurosym.agent.learners.distributed.die_with_parent", lambda: None)
+    with process.learner_process(queue.Queue(), 0):
         pass
     assert calls == [True]

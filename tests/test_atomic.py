@@ -28,10 +28,10 @@ import pandas as pd
 from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
 from neurosym.export.prolog_writer import write_prolog
 from neurosym.export.recording import Recording
-from neurosym.agent.trainer import _write_rows
+from neurosym.agent.run.metrics import write_rows as _write_rows
 from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 
 out = Path(sys.argv[1])
 write_bytes_atomic(out / "bytes.bin", b"x")
@@ -81,7 +81,7 @@ from pathlib import Path
 import numpy as np, pandas as pd
 from neurosym.errors import NeurosymError
 from neurosym.export.prolog_writer import write_prolog
-from neurosym.agent.trainer import _write_rows
+from neurosym.agent.run.metrics import write_rows as _write_rows
 
 out = Path(sys.argv[1])
 what = sys.argv[2]
@@ -93,7 +93,7 @@ try:
     else:
         from neurosym.agent.checkpoint import save_checkpoint
         from neurosym.agent.config import ModelConfig
-        from neurosym.agent.model import ActorCritic
+        from neurosym.agent.networks.model import ActorCritic
 
         config = ModelConfig.for_family("rgw", "predinet", (10, 10, 10), 1.0)
         save_checkpoint(out / "checkpoint.pt", model=ActorCritic(config), config=config, env_name="rgw2")
@@ -158,7 +158,7 @@ def test_a_folder_that_cannot_be_made_is_one_line(tmp_path: Path) -> None:
 
     from neurosym.agent.checkpoint import save_checkpoint
     from neurosym.agent.config import ModelConfig
-    from neurosym.agent.model import ActorCritic
+    from neurosym.agent.networks.model import ActorCritic
     from neurosym.errors import OutputError
     from neurosym.export.prolog_writer import write_prolog
     from neurosym.export.recording import Recording

@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.augment import TRANSFORMS, action_permutation, augment_batch, transform_grid
+from neurosym.agent.learners.augment import (
+    TRANSFORMS,
+    action_permutation,
+    augment_batch,
+    transform_grid,
+)
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Plan
 

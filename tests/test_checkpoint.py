@@ -12,8 +12,8 @@ import torch
 
 from neurosym.agent.checkpoint import FORMAT, load_agent, read_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.introspection import PrediNetIntrospection
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.introspection import PrediNetIntrospection
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.errors import CheckpointError
 
 CONFIG = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
@@ -89,7 +89,7 @@ def test_overwrite_is_atomic_replacement(tmp_path: Path) -> None:
 
 
 def test_optimizer_state_round_trips_or_is_left_out(tmp_path: Path) -> None:
-    from neurosym.agent.a3c import SharedRMSprop
+    from neurosym.agent.learners.optimizers import SharedRMSprop
 
     model = ActorCritic(CONFIG)
     opt = SharedRMSprop(model.parameters(), lr=1e-3, alpha=0.99, eps=0.1)

@@ -89,6 +89,7 @@ def test_all_shipped_agents_are_there() -> None:
     assert set(SHIPPED) == EXPECTED, SHIPPED
 
 
+@pytest.mark.expensive
 @pytest.mark.parametrize("name", BOXWORLD + RANDOM)
 def test_shipped_agent_solves_unseen_levels(name: str) -> None:
     from neurosym.agent.cli_eval import evaluate
@@ -151,6 +152,7 @@ def test_the_rgw_random_mhdpa_plays_rgw2_zero_shot_sampled() -> None:
     assert report["success_rate"] >= 0.9 and report["mean_return"] >= 10.0, report
 
 
+@pytest.mark.expensive
 def test_the_cell_keys_predinet_plays_rgw2_and_relates_objects(tmp_path: Path) -> None:
     """The general agent whose heads address cells by what they hold (--keys cells), never
     trained on rgw2: greedily sword, teleport, enemy, terminal at the optimal 10.7 (round the

@@ -15,7 +15,7 @@ import torch
 
 from neurosym.agent.checkpoint import compact_checkpoint, load_agent, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.errors import CheckpointError, ConfigError
 
 CONFIG = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))

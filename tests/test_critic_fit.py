@@ -1,4 +1,4 @@
-"""bench/critic_fit.py: Monte-Carlo returns stop at each episode's end; unfinished tails are left out."""
+"""experiments/critic_fit.py: Monte-Carlo returns stop at each episode's end; unfinished tails are left out."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 _spec = importlib.util.spec_from_file_location(
-    "critic_fit", Path(__file__).resolve().parents[1] / "bench" / "critic_fit.py"
+    "critic_fit", Path(__file__).resolve().parents[1] / "experiments" / "critic_fit.py"
 )
 critic_fit = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(critic_fit)

@@ -14,7 +14,7 @@ from neurosym.agent.diagnostics import (
     random_observations,
     signal_after_ppo_updates,
 )
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +84,7 @@ def test_one_ppo_update_saturates_scene_queries_not_learned_ones(bw1_obs) -> Non
         after[query] = signal_after_ppo_updates(
             model, "bw1", probe, 1, **preset_env_kwargs("boxworld")
         )[0]
-    # bench/diagnose.py --ppo-updates 2 (16 envs x 32 steps): scene 0.033 -> 0.66 -> 0.78
+    # experiments/diagnose.py --ppo-updates 2 (16 envs x 32 steps): scene 0.033 -> 0.66 -> 0.78
     # (entropy 95 % -> 19 % -> 12 % of uniform's); learned 0.079 -> 0.076 -> 0.076
     assert after["scene"]["attention_max"] > 0.5
     assert after["learned"]["attention_max"] < 0.1

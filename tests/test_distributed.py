@@ -24,8 +24,8 @@ from pathlib import Path
 import pytest
 import torch
 
-from neurosym.agent import distributed
 from neurosym.agent.checkpoint import load_agent, read_checkpoint
+from neurosym.agent.learners import distributed
 from neurosym.errors import ConfigError
 
 REPO = Path(__file__).resolve().parents[1]
@@ -109,8 +109,8 @@ def _ddp_update(rank: int, world: int, port: int, data: str, out: str) -> None:
     import torch.distributed as dist
     from torch.nn.parallel import DistributedDataParallel
 
-    from neurosym.agent.a3c import shared_optimizer
-    from neurosym.agent.ppo import ppo_update
+    from neurosym.agent.learners.optimizers import shared_optimizer
+    from neurosym.agent.learners.ppo import ppo_update
     from neurosym.agent.rollout import Rollout
 
     torch.set_num_threads(1)
@@ -141,10 +141,10 @@ def test_two_rank_update_equals_one_rank_update_on_the_same_batch(tmp_path: Path
     import copy
     import multiprocessing
 
-    from neurosym.agent.a3c import shared_optimizer
     from neurosym.agent.config import ModelConfig, TrainConfig
-    from neurosym.agent.model import ActorCritic
-    from neurosym.agent.ppo import ppo_update
+    from neurosym.agent.learners.optimizers import shared_optimizer
+    from neurosym.agent.learners.ppo import ppo_update
+    from neurosym.agent.networks.model import ActorCritic
     from neurosym.agent.rollout import RolloutState, collect_rollout
     from neurosym.envs import make_batched
 
@@ -304,7 +304,7 @@ def test_a_killed_rank_stops_the_run_with_a_checkpoint(tmp_path: Path) -> None:
 
 
 def test_a3c_under_torchrun_is_refused_with_one_line(tmp_path: Path) -> None:
-    from neurosym.agent.trainer import train
+    from neurosym.agent.run.trainer import train
 
     os.environ.update(RANK="0", WORLD_SIZE="2", LOCAL_RANK="0", LOCAL_WORLD_SIZE="2")
     try:

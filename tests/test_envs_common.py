@@ -52,6 +52,17 @@ def test_unknown_options_are_refused_with_the_known_ones() -> None:
     make("rgw2", classic=True).close()  # known options still pass
 
 
+@pytest.mark.parametrize("name", ["rgw2", "rgw-random", "bw1"])
+def test_the_batched_env_takes_its_own_options(name: str) -> None:
+    """copy=False is the batched env's option (no copy of the observation per step)."""
+    venv = make_batched(name, 2, seed=0, copy=False)
+    obs, _ = venv.reset(seed=0)
+    assert obs.shape[0] == 2
+    venv.close()
+    with pytest.raises(ConfigError, match=r"^unknown .*'copy'"):
+        make(name, copy=False)
+
+
 @pytest.mark.parametrize("name", NAMES)
 def test_gymnasium_check_env(name: str) -> None:
     for render_mode in ("rgb_array", "ansi"):

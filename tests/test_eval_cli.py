@@ -14,7 +14,7 @@ import torch
 from neurosym.agent.checkpoint import load_agent, save_checkpoint
 from neurosym.agent.cli_eval import evaluate
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 
 RGW1_MAP = Path(__file__).resolve().parents[1] / "neurosym" / "envs" / "maps" / "rgw1.txt"
 

@@ -12,7 +12,7 @@ import torch
 
 from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make
 from neurosym.export.recording import Recording
 

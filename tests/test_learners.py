@@ -7,18 +7,16 @@ import math
 import pytest
 import torch
 
-from neurosym.agent.a3c import (
+from neurosym.agent.config import ModelConfig, PPOConfig, TrainConfig, preset_env_kwargs
+from neurosym.agent.learners.a3c import a3c_loss
+from neurosym.agent.learners.optimizers import SharedAdam, SharedRMSprop, shared_optimizer
+from neurosym.agent.learners.ppo import ppo_update
+from neurosym.agent.learners.returns import (
     AdvantageScale,
-    SharedAdam,
-    SharedRMSprop,
-    a3c_loss,
+    explained_variance,
     gae_advantages,
     n_step_returns,
-    shared_optimizer,
 )
-from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
-from neurosym.agent.diagnostics import explained_variance
-from neurosym.agent.ppo import ppo_update
 from neurosym.agent.rollout import Rollout
 from neurosym.errors import ConfigError
 
@@ -32,7 +30,7 @@ def test_thesis_preset_is_table_4() -> None:
         0.99,
         400.0,
     )
-    assert (bw.entropy, bw.n_steps, bw.envs, bw.explore, bw.sil) == (0.01, 40, 1, 0.0, 0.0)
+    assert (bw.entropy, bw.n_steps, bw.envs, bw.explore, bw.a3c.sil) == (0.01, 40, 1, 0.0, 0.0)
     assert (bw.reward_scale, bw.normalize_advantages, bw.gae_lambda) == (1.0, False, 1.0)
     rgw = TrainConfig.for_family("rgw", preset="thesis")
     assert (rgw.lr, rgw.entropy) == (2e-3, 0.02)
@@ -45,14 +43,16 @@ def test_thesis_preset_is_table_4() -> None:
 
 def test_default_preset_departures_and_algo() -> None:
     bw = TrainConfig.for_family("boxworld")
-    assert (bw.optimizer, bw.normalize_advantages, bw.reward_scale, bw.sil) == (
+    assert (bw.optimizer, bw.normalize_advantages, bw.reward_scale, bw.a3c.sil) == (
         "adam",
         True,
         0.1,
         1.0,
     )
     ppo = TrainConfig.for_family("boxworld", algo="ppo")
-    assert (ppo.algo, ppo.workers, ppo.sil, ppo.explore) == ("ppo", 1, 0.0, 0.0)
+    assert (ppo.algo, ppo.learner, ppo.explore) == ("ppo", PPOConfig(), 0.0)
+    with pytest.raises(ConfigError, match="this run's learner is ppo, which has no A3CConfig"):
+        ppo.a3c  # noqa: B018 - the property raises
     assert TrainConfig.for_family("rgw", lr=5e-4).lr == 5e-4
     with pytest.raises(ConfigError, match="unknown preset 'fast'"):
         TrainConfig.for_family("rgw", preset="fast")
@@ -176,7 +176,7 @@ def _bandit_rollout(model: Lookup, T: int = 8, K: int = 4) -> Rollout:
 
 def _ppo_prob_of_paying_action(clip_range: float) -> tuple[float, int]:
     model = Lookup()
-    config = TrainConfig(
+    config = TrainConfig.build(
         algo="ppo", lr=0.05, entropy=0.0, ppo_epochs=10, ppo_minibatches=2, clip_range=clip_range
     )
     opt = torch.optim.SGD(model.parameters(), lr=config.lr)
@@ -198,7 +198,7 @@ def test_ppo_update_prefers_the_paying_action_within_the_clip() -> None:
 def test_ppo_update_reports_how_far_the_policy_moved() -> None:
     def stats_for(clip_range: float, epochs: int):
         model = Lookup()
-        config = TrainConfig(
+        config = TrainConfig.build(
             algo="ppo", lr=0.05, entropy=0.0, ppo_epochs=epochs, ppo_minibatches=2,
             clip_range=clip_range,
         )  # fmt: skip
@@ -223,7 +223,7 @@ def test_ppo_running_advantages_keep_a_rewardless_rollout_small() -> None:
 
     def paying_prob_after(mode: str, scale: AdvantageScale | None, reward: float) -> float:
         model = Lookup()
-        config = TrainConfig(
+        config = TrainConfig.build(
             algo="ppo", lr=0.05, entropy=0.0, ppo_epochs=4, ppo_minibatches=2,
             ppo_advantages=mode,
         )  # fmt: skip

@@ -1,4 +1,4 @@
-"""bench/map_copies.py: a map's eight symmetric copies, each with the map's optimal return."""
+"""experiments/map_copies.py: a map's eight symmetric copies, each with the map's optimal return."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 from neurosym.envs.rgw_maps import load_map
 
 REPO = Path(__file__).resolve().parents[1]
-_spec = importlib.util.spec_from_file_location("map_copies", REPO / "bench" / "map_copies.py")
+_spec = importlib.util.spec_from_file_location("map_copies", REPO / "experiments" / "map_copies.py")
 map_copies = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(map_copies)
 

@@ -11,7 +11,7 @@ import torch
 
 from neurosym.agent.checkpoint import Agent
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import ACTION_NAMES, env_family, make
 from neurosym.errors import CheckpointError, ConfigError
 from neurosym.export.recorder import record

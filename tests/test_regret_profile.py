@@ -1,4 +1,4 @@
-"""bench/regret_profile.py: the shipped MHDPA's mass on return-losing actions, on a few levels."""
+"""experiments/regret_profile.py: the shipped MHDPA's mass on return-losing actions, on a few levels."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location(
-    "regret_profile", ROOT / "bench" / "regret_profile.py"
+    "regret_profile", ROOT / "experiments" / "regret_profile.py"
 )
 regret_profile = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(regret_profile)

@@ -6,12 +6,15 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.a3c import SharedRMSprop, a3c_loss, apply_update, n_step_returns
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.exploration import CountBonus
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.rollout import EpisodeTracker, Rollout, play_episodes, select_actions
-from neurosym.agent.sil import EpisodeMemory, SILBatch
+from neurosym.agent.evaluation import play_episodes
+from neurosym.agent.learners.a3c import a3c_loss, apply_update
+from neurosym.agent.learners.exploration import CountBonus
+from neurosym.agent.learners.optimizers import SharedRMSprop
+from neurosym.agent.learners.returns import n_step_returns
+from neurosym.agent.learners.sil import EpisodeMemory, SILBatch
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.rollout import EpisodeTracker, Rollout, select_actions
 
 
 class Lookup(torch.nn.Module):
@@ -86,7 +89,7 @@ def test_loss_ignores_invalid_steps() -> None:
 
 def test_self_imitation_only_learns_from_better_than_expected() -> None:
     torch.manual_seed(0)
-    cfg = TrainConfig(entropy=0.0, sil=1.0)
+    cfg = TrainConfig.build(entropy=0.0, sil=1.0)
     ro = rollout_of(
         ids=[[1]],
         rewards=[[0.0]],
@@ -337,47 +340,8 @@ def test_recorded_queries_give_the_recomputed_loss() -> None:
     reused.backward()
 
 
-def test_critic_warmup_update_moves_the_value_head_alone() -> None:
-    """critic_only + only_prefix: the value loss, and only value.* weights (and their Adam state) move."""
-    from neurosym.agent.a3c import SharedAdam
-
-    torch.manual_seed(0)
-    config = ModelConfig.for_family("rgw", "predinet", (9, 10, 10))
-    shared, local = ActorCritic(config), ActorCritic(config)
-    shared.share_memory()
-    opt = SharedAdam(shared.parameters(), lr=1e-3, eps=1e-5)
-    obs = torch.randint(0, 2, (1, 2, 9, 10, 10), dtype=torch.uint8)
-    ro = Rollout(
-        obs=obs,
-        last_obs=obs[0],
-        actions=torch.full((1, 2), 2),
-        rewards=torch.full((1, 2), 5.0),
-        terminated=torch.ones(1, 2, dtype=torch.bool),
-        truncated=torch.zeros(1, 2, dtype=torch.bool),
-        valid=torch.ones(1, 2, dtype=torch.bool),
-    )
-    cfg = TrainConfig(entropy=0.01, value_coef=0.5)
-    full, stats = a3c_loss(local, ro, cfg)
-    value_only, same = a3c_loss(local, ro, cfg, critic_only=True)
-    assert same == stats  # the parts are reported either way
-    assert value_only.item() == pytest.approx(0.5 * stats.value_loss)
-    assert full.item() != pytest.approx(value_only.item())
-    before = {k: v.clone() for k, v in shared.state_dict().items()}
-    v_before = shared(obs[0])[1].mean().item()
-    for _ in range(5):
-        local.load_state_dict(shared.state_dict())
-        loss, _ = a3c_loss(local, ro, cfg, critic_only=True)
-        apply_update(local, shared, opt, loss, clip=400.0, only_prefix="value.")
-    after = shared.state_dict()
-    moved = {k for k in before if not torch.equal(before[k], after[k])}
-    assert moved == {"value.weight", "value.bias"}
-    assert shared(obs[0])[1].mean().item() > v_before  # towards the return of 5
-    untouched = [p for n, p in shared.named_parameters() if not n.startswith("value.")]
-    assert all(float(opt.state[p]["exp_avg"].abs().max()) == 0 for p in untouched)
-
-
 def test_optimal_set_nll_is_minus_log_of_the_sets_probability() -> None:
-    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.agent.learners.planner_loss import optimal_set_nll
 
     logits = torch.tensor([[1.0, 2.0, 3.0, 4.0], [0.0, 0.0, 0.0, 0.0], [5.0, -1.0, 0.0, 2.0]])
     optimal = torch.tensor(
@@ -388,65 +352,20 @@ def test_optimal_set_nll_is_minus_log_of_the_sets_probability() -> None:
     torch.testing.assert_close(optimal_set_nll(logits, optimal), torch.tensor(expected).float())
 
 
-def test_planner_coef_adds_the_masked_planner_loss() -> None:
-    from neurosym.agent.planner_loss import optimal_set_nll
-
-    torch.manual_seed(0)
-    model = Lookup()
-    ro = rollout_of(
-        ids=[[1, 2], [3, 4], [5, 6]],
-        rewards=[[0.0, 1.0], [0.0, 0.0], [1.0, 0.0]],
-        terminated=[[False, True], [False, False], [True, False]],
-        truncated=[[False, False], [False, False], [False, False]],
-        valid=[[True, True], [True, False], [True, True]],  # env 1's step 1 is an autoreset
-        last_ids=[7, 8],
-    )
-    optimal = torch.zeros(3, 2, 4, dtype=torch.bool)
-    optimal[..., 1] = True
-    optimal[0, 0, 2] = True
-    base, stats = a3c_loss(model, ro, TrainConfig())
-    with pytest.raises(ValueError, match="planner's labels"):
-        a3c_loss(model, ro, TrainConfig(planner_coef=0.5))
-    ro = ro._replace(optimal=optimal)
-    with_planner, same = a3c_loss(model, ro, TrainConfig(planner_coef=0.5))
-    assert same == stats
-    logits = model.logits[ro.obs.view(3, 2).long()]
-    nll = optimal_set_nll(logits, optimal) * ro.valid
-    torch.testing.assert_close(with_planner, base + 0.5 * nll.sum() / 2)
-    warm, _ = a3c_loss(model, ro, TrainConfig(planner_coef=0.5), critic_only=True)
-    assert warm.item() == pytest.approx(0.5 * stats.value_loss)  # the warm-up has no planner term
-
-
-def test_rollout_keeps_the_planners_optimal_actions() -> None:
-    from neurosym.agent.a3c import planner_labels
-    from neurosym.agent.rollout import RolloutState, collect_rollout
-    from neurosym.envs import make_batched
-    from neurosym.envs.rgw_solver import Planner
-
-    torch.manual_seed(0)
-    model = ActorCritic(ModelConfig.for_family("rgw", "predinet", (9, 10, 10)))
-    venv = make_batched("rgw-random", 3, seed=5)
-    state = RolloutState(venv, seed=5)
-    asked = Planner().action_sets(venv)[0]
-    ro, _ = collect_rollout(
-        model, state, 6, torch.Generator().manual_seed(0), labels=planner_labels()
-    )
-    assert ro.optimal.shape == (6, 3, 4) and ro.optimal.dtype == torch.bool
-    assert np.array_equal(ro.optimal[0].numpy(), asked)  # asked before the step, in that state
-    assert bool(ro.optimal[ro.valid].any(-1).all())  # every real state has an optimal action
-    loss, _ = a3c_loss(model, ro, TrainConfig(planner_coef=1.0))
-    loss.backward()
-
-
 def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it() -> None:
     """A3C reports no PPO parts (blank), and one PPO update without an explained variance
     (its returns did not vary) does not blank the row's mean of the others."""
-    from neurosym.agent.trainer import _Stats
+    from neurosym.agent.learners.messages import LossStats, Update
+    from neurosym.agent.rollout import Finished
+    from neurosym.agent.run.metrics import RunningStats as _Stats
+
+    def update(*losses: float) -> Update:
+        return Update(0, 8, Finished.empty(), LossStats(*losses))
 
     nan = float("nan")
     stats = _Stats(0, 0, window=10)
-    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, 1e-3, 0.1, nan))
-    stats.add(8, [], [], [], (3.0, 4.0, 1.1, 0.7, 3e-3, 0.3, 0.6))
+    stats.add(update(1.0, 2.0, 1.3, 0.5, 1e-3, 0.1, nan))
+    stats.add(update(3.0, 4.0, 1.1, 0.7, 3e-3, 0.3, 0.6))
     row = stats.row(1.0, 8.0, None, None)
     assert (row["policy_loss"], row["entropy"], row["grad_norm"]) == ("2", "1.2", "0.6")
     assert (row["approx_kl"], row["clip_fraction"], row["explained_variance"]) == (
@@ -454,7 +373,7 @@ def test_metrics_row_averages_each_loss_part_over_the_updates_that_measured_it()
         "0.2",
         "0.6",
     )
-    stats.add(8, [], [], [], (1.0, 2.0, 1.3, 0.5, nan, nan, nan))  # an A3C worker's report
+    stats.add(update(1.0, 2.0, 1.3, 0.5))  # an A3C worker's report
     row = stats.row(2.0, 8.0, None, None)
     assert row["policy_loss"] == "1" and row["approx_kl"] == row["explained_variance"] == ""
     assert stats.row(3.0, 8.0, None, None)["policy_loss"] == ""  # no update since the last row
@@ -465,7 +384,7 @@ def test_frame_rate_spans_updates_not_one_log_row() -> None:
 
     Logged every 2 s over the row's own interval, the rate read 4,000 on one
     row in four and 0 on the others (PPO's metrics.csv before the window)."""
-    from neurosym.agent.trainer import FrameRate
+    from neurosym.agent.run.metrics import FrameRate
 
     rate = FrameRate(0.0, 0, window=30.0)
     frames, rates = 0, []

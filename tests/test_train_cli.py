@@ -183,61 +183,6 @@ def test_train_init_from_starts_from_another_checkpoint(neurosym, tmp_path: Path
 
 
 @pytest.mark.expensive
-def test_train_critic_warmup_moves_the_value_head_alone(neurosym, tmp_path: Path) -> None:
-    # the whole run inside the warm-up, at a learning rate that moves every weight it touches
-    out = tmp_path / "run"
-    proc = neurosym(
-        "train", "--env", "bw1", "--init-from", str(BW1), "--out", str(out), "--workers", "2",
-        "--frames", "2000", "--lr", "1e-3", "--critic-warmup", "1000000", "--slim", *TINY,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    agent = load_agent(out / "checkpoint.pt")
-    assert agent.meta["train_config"]["critic_warmup"] == 1_000_000
-    assert "--critic-warmup 1000000" in agent.meta["command"]
-    before, after = load_agent(BW1).model.state_dict(), agent.model.state_dict()
-    moved = {k for k in before if not torch.equal(before[k], after[k])}
-    assert moved == {"value.weight", "value.bias"}
-
-
-@pytest.mark.expensive
-def test_train_planner_coef_keeps_the_policy_on_the_planners_actions(
-    neurosym, tmp_path: Path
-) -> None:
-    """The same A3C fine-tune of a DAgger agent (the cell-keyed one: DAgger alone, no A3C yet),
-    with the README's fine-tuning settings but a 10x learning rate, without and with the planner's
-    loss beside it: A3C alone throws the planner's actions away within a few updates; with the
-    planner's loss the policy keeps them (nll on the start states of levels neither run played)."""
-    from neurosym.agent.planner_loss import optimal_set_nll
-    from neurosym.envs import make_batched
-    from neurosym.envs.rgw_solver import Planner
-
-    source = ROOT / "checkpoints" / "rgw-random-predinet-cellkeys.pt"
-    nll = {}
-    venv = make_batched("rgw-random", 64, seed=3_000_000_000)
-    obs, _ = venv.reset(seed=3_000_000_000)
-    optimal = torch.from_numpy(Planner().action_sets(venv)[0])
-    for coef in ("0", "5"):
-        out = tmp_path / f"run-{coef}"
-        proc = neurosym(
-            "train", "--env", "rgw-random", "--init-from", str(source), "--out", str(out),
-            "--workers", "1", "--frames", "8000", "--lr", "1e-3", "--entropy", "0", "--value-coef", "0",
-            "--optimizer", "adam", "--sil", "0", "--explore", "0", "--reward-scale", "0.1",
-            "--normalize-advantages", "--grad-clip", "0.5",
-            "--planner-coef", coef, "--slim", *TINY,
-        )  # fmt: skip
-        assert proc.returncode == 0, proc.stderr
-        agent = load_agent(out / "checkpoint.pt")
-        assert agent.meta["train_config"]["planner_coef"] == float(coef)
-        assert f"--planner-coef {coef}" in agent.meta["command"]
-        with torch.no_grad():
-            logits = agent.model(torch.from_numpy(obs))[0]
-        nll[coef] = optimal_set_nll(logits, optimal).mean().item()
-    # one worker, so that A3C alone drifts the same way every run (with two, Hogwild's timing
-    # decided how far it drifted)
-    assert nll["5"] < 0.4 and nll["5"] < nll["0"] / 3, nll
-
-
-@pytest.mark.expensive
 def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
@@ -295,7 +240,7 @@ def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path:
     wrong = neurosym("train", "--out", str(out), "--resume", "--algo", "a3c", "--quiet")
     assert wrong.returncode == 1 and "trained with --algo ppo" in wrong.stderr
     sil = neurosym("train", "--out", str(out), "--resume", "--sil", "1", "--quiet")
-    assert sil.returncode == 1 and "ppo has none" in sil.stderr
+    assert sil.returncode == 1 and "--sil is a setting of --algo a3c" in sil.stderr
     again = neurosym(
         "train", "--out", str(out), "--resume", "--frames", str(agent.meta["frames"] + 256),
         "--quiet", "--eval-interval", "0.5", "--eval-episodes", "2",
@@ -332,17 +277,17 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
 
 @pytest.mark.expensive
 def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: Path) -> None:
-    """--query learned trains (A3C's recorded-query path included), is kept in the checkpoint
+    """--set query=learned trains (A3C's recorded-query path included), is kept in the checkpoint
     and its command, and the saved agent loads with one query vector and no projection."""
     out = tmp_path / "run"
     proc = neurosym(
-        "train", "--env", "bw1", "--module", "predinet", "--query", "learned", "--out", str(out),
+        "train", "--env", "bw1", "--module", "predinet", "--set", "query=learned", "--out", str(out),
         "--workers", "1", "--envs", "4", "--frames", "400", "--quiet",
         "--eval-interval", "0.5", "--eval-episodes", "2",
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     agent = load_agent(out / "checkpoint.pt")
-    assert agent.config.query == "learned" and "--query learned" in agent.meta["command"]
+    assert agent.config.query == "learned" and "--set query=learned" in agent.meta["command"]
     params = dict(agent.model.relational.named_parameters())
     assert "queries" in params and "query1.weight" not in params
     assert agent.meta["frames"] >= 400
@@ -381,7 +326,7 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
     [
         (("--env", "rgw9", "--module", "predinet"), "rgw9"),
         (
-            ("--env", "bw1", "--module", "mhdpa", "--query", "learned"),
+            ("--env", "bw1", "--module", "mhdpa", "--set", "query=learned"),
             "query 'learned' is PrediNet's; mhdpa's queries come from each entity",
         ),
         (("--module", "predinet"), "--env is needed unless --resume"),
@@ -395,7 +340,22 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
         ),
         (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
         (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
-        (("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"), "ppo has none"),
+        (
+            ("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"),
+            "--sil is a setting of --algo a3c; this run's learner is ppo",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--seed", str(2**64)),
+            "--seed must be an integer from 0 to 2**64 - 1, got 18446744073709551616",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--set", "critic_warmup=5"),
+            "--set wants NAME=VALUE with NAME a setting (adam_eps, attention_gain,",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--set", "gae_lambda=high"),
+            "--set gae_lambda wants a number (float), got 'high'",
+        ),
         (
             ("--env", "bw1", "--module", "mhdpa", "--preset", "thesis", "--algo", "ppo"),
             "--preset thesis is A3C",
@@ -430,37 +390,8 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
             "keys 'cells' is PrediNet's; mhdpa's keys come from each entity",
         ),
         (
-            ("--env", "bw1", "--module", "predinet", "--critic-warmup", "-5"),
-            "critic_warmup must be >= 0 frames, got -5",
-        ),
-        (
-            ("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--critic-warmup", "100"),
-            "--critic-warmup is an A3C setting; --algo ppo does not use it",
-        ),
-        (
-            ("--env", "bw1", "--module", "predinet", "--planner-coef", "1"),
-            "--planner-coef learns from the RGW planner; boxworld has none",
-        ),
-        (
-            (
-                "--env",
-                "rgw-random",
-                "--module",
-                "predinet",
-                "--algo",
-                "imitate",
-                "--planner-coef",
-                "1",
-            ),
-            "--planner-coef is an A3C setting; --algo imitate does not use it",
-        ),
-        (
-            ("--env", "rgw2", "--module", "predinet", "--planner-coef", "-1"),
-            "planner_coef must be >= 0, got -1.0",
-        ),
-        (
             ("--env", "rgw2", "--module", "predinet", "--safe-coef", "2"),
-            "--safe-coef weighs DAgger's labels; it needs --algo imitate, not a3c",
+            "--safe-coef is a setting of --algo imitate; this run's learner is a3c",
         ),
         (
             ("--env", "rgw2", "--module", "predinet", "--env-option", "max_steps"),
@@ -474,7 +405,7 @@ def test_train_bad_input_is_one_line(
     proc = neurosym("train", "--out", str(tmp_path / "run"), "--quiet", *args)
     assert proc.returncode == 1, proc.stderr
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
-    assert not (tmp_path / "run" / "checkpoint.pt").exists()
+    assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.parametrize("value", ["12,x", "0,24", ""])
@@ -494,9 +425,9 @@ def test_train_bad_conv_channels(neurosym, tmp_path: Path, value: str) -> None:
 def test_resume_without_checkpoint(neurosym, tmp_path: Path) -> None:
     proc = neurosym("train", "--out", str(tmp_path / "nothing"), "--resume", "--quiet")
     assert proc.returncode == 1
-    assert (
-        proc.stderr.strip()
-        == f"neurosym train: error: checkpoint not found: {tmp_path / 'nothing' / 'checkpoint.pt'}"
+    assert proc.stderr.strip() == (
+        f"neurosym train: error: cannot resume: {tmp_path / 'nothing'} does not exist "
+        "(start the run without --resume)"
     )
 
 
@@ -543,3 +474,57 @@ def test_resume_keeps_a_slim_run_slim_unless_told_otherwise(neurosym, tmp_path: 
     payload = torch.load(ckpt, weights_only=True)
     assert payload["optimizer"] is not None
     assert "--no-slim" in payload["command"].split(" && ")[-1]
+
+
+@pytest.mark.expensive
+def test_a_full_disk_leaves_no_run_that_looks_resumable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The checkpoint cannot be written (a full disk): the one-line error, and no run directory
+    holding only metrics.csv, which --resume would take for a run."""
+    from neurosym.agent.run import trainer
+    from neurosym.agent.run.options import RunOptions
+    from neurosym.errors import OutputError
+
+    def full(path: Path, **kwargs: object) -> None:
+        raise OutputError(f"cannot write {path}: No space left on device; it was left as it was")
+
+    monkeypatch.setattr(trainer, "save_checkpoint", full)
+    out = tmp_path / "run"
+    options = RunOptions(frames=100, progress=False, eval_episodes=1, log_interval=0.1,
+                         checkpoint_interval=0.2)  # fmt: skip
+    with pytest.raises(OutputError, match="No space left on device"):
+        trainer.train("rgw2", "predinet", out, train_overrides={"workers": 1, "envs": 2},
+                      options=options, print_fn=lambda text: None)  # fmt: skip
+    assert not out.exists()
+    out.mkdir()
+    with pytest.raises(OutputError):
+        trainer.train("rgw2", "predinet", out, train_overrides={"workers": 1, "envs": 2},
+                      options=options, print_fn=lambda text: None)  # fmt: skip
+    assert out.exists() and list(out.iterdir()) == []  # a directory it did not make stays
+
+
+def test_a_read_only_file_system_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where --out cannot be made or written (a read-only file system), one line says so."""
+    import errno
+
+    from neurosym.agent.run.trainer import make_run_directory
+    from neurosym.errors import ConfigError
+
+    def read_only(self: Path, *args: object, **kwargs: object) -> None:
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(Path, "mkdir", read_only)
+        with pytest.raises(ConfigError) as info:
+            make_run_directory(tmp_path / "run")
+    assert str(info.value) == (
+        f"cannot create the run directory {tmp_path / 'run'}: Read-only file system"
+    )
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(
+        ConfigError, match="^cannot write to the run directory .*: permission denied$"
+    ):
+        make_run_directory(tmp_path)

@@ -20,7 +20,7 @@ from PIL import Image
 
 from neurosym.agent.checkpoint import load_agent, save_checkpoint
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.cli import main
 from neurosym.envs import env_family, make
 from neurosym.export.recorder import record

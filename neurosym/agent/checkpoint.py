@@ -52,8 +52,8 @@ import numpy as np
 import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.introspection import Introspection
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.introspection import Introspection
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import select_actions
 from neurosym.atomic import make_folder, write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError

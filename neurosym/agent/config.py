@@ -1,37 +1,45 @@
 """Model and training settings, with the thesis's Table 4 as defaults per env family.
 
+Three kinds of settings, each a frozen dataclass whose fields carry a one-line
+docstring (the ``neurosym train`` help is generated from them,
+:mod:`neurosym.agent.run.cli_train`):
+
+* :class:`ModelConfig`: the network's sizes and switches.
+* :class:`TrainConfig`: what every learner shares (optimiser, discount, rollout
+  length, seed, ...) and, in ``learner``, the chosen learner's own settings:
+  :class:`A3CConfig`, :class:`PPOConfig` or :class:`ImitationConfig`.
+
 Table 4 (thesis section 5.1) fixes one set of sizes for both relational modules;
 where it differs between Box-World (BW) and Relational-Grid-World (RGW) the
 family decides: query/key size 64 BW / 32 RGW, learning rate 2e-4 BW / 2e-3 RGW,
-entropy 0.01 BW / 0.02 RGW. Two notes on the table:
+entropy 0.01 BW / 0.02 RGW. PrediNet relations: the table says 8 and the text
+of 5.1 says 4; we follow the table. The discount gamma is not in the thesis;
+we use 0.99.
 
-* PrediNet relations: the table says 8, the text of 5.1 says 4 was chosen;
-  we follow the table (``relations=8``), ``--relations 4`` gives the text's value.
-* The discount gamma is not in the thesis; we use 0.99.
+Presets. ``preset="thesis"`` is Table 4 exactly: RMSprop (lr as above, epsilon
+0.1, decay 0.99), gradient clip 400, classic A3C (one env per worker), the
+network as first built (no entity normalisation), raw rewards, unnormalised
+advantages, n-step returns, and the RGB Box-World observation.
+``preset="default"`` is what learns best here; each departure from Table 4
+says why at its field (docs/results.md has the figures).
 
-Presets. ``preset="thesis"`` (``neurosym train --preset thesis``) is Table 4
-exactly: RMSprop (lr as above, epsilon 0.1, decay 0.99), gradient clip 400,
-classic A3C (one env per worker), the network as first built (no entity
-normalisation), raw rewards, unnormalised advantages, n-step returns, and the
-RGB Box-World observation. ``preset="default"`` is what learns best here,
-measured with ``bench/diagnose.py`` (the fresh network's input signal and
-gradient split) and ``bench/train.py``; each departure from Table 4 says why
-at its field. In short: the thesis network is blind at initialisation (policy
-logits varied by 6e-9 across bw1 observations, PrediNet attention exactly
-uniform), its per-weight gradients (1e-8 to 4e-7) sit far below RMSprop's
-epsilon, and the critic's gradient on the shared layers was 100-200x the
-actor's; the default preset fixes each of these.
-
-Both configs are plain frozen dataclasses that round-trip through
-``to_dict``/``from_dict`` (plain ints, floats, strings and lists only), which is
-how checkpoints store them. A key missing from a stored config predates that
-setting: ``from_dict`` fills it with the value the code had before the setting
-existed (``_LEGACY``), so older checkpoints load and replay as they were made.
+Checkpoints store the configs as plain flat dicts (``to_dict``/``from_dict``;
+the training settings are the common ones and the learner's side by side). A
+key missing from a stored config predates that setting: ``from_dict`` fills it
+with the value the code had before the setting existed (``_LEGACY``), so older
+checkpoints load and replay as they were made. Older checkpoints store every
+learner's fields; ``from_dict`` keeps those of the run's learner. Settings that were
+retired (``RETIRED``) load when they hold their neutral value; a checkpoint
+that used one is refused in one line naming it.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields, replace
+import ast
+import inspect
+import textwrap
+from dataclasses import MISSING, asdict, dataclass, field, fields
+from functools import cache
 from typing import Any
 
 from neurosym.errors import ConfigError
@@ -45,6 +53,15 @@ PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
 QUERIES = ("scene", "learned")
 KEYS = ("entities", "cells")
+
+FLAG = {"flag": True}
+"""field metadata: the setting is a ``neurosym train`` flag of its own (others: ``--set``)"""
+
+
+def flag(**cli: Any) -> dict[str, Any]:
+    """Field metadata for a setting with a flag: ``choices``, ``metavar``, ``parse`` ("channels")."""
+    return {"flag": True, **cli}
+
 
 # Table 4 values that differ by env family.
 _MODEL_FAMILY: dict[str, dict[str, Any]] = {
@@ -66,12 +83,11 @@ _THESIS_COMMON: dict[str, Any] = {
     "normalize_advantages": False,
     "gae_lambda": 1.0,
 }
-# What learns best here (preset "default"); each value's reason is at its field.
+# What learns best here (preset "default"), flat: each learner takes its own fields.
 _DEFAULT_TRAIN: dict[str, dict[str, Any]] = {
-    # RGW keeps the learner its shipped agents were measured with (rgw2 solved in 54-245 s):
-    # RMSprop with epsilon 1e-5 (Table 4's 0.1 stalls), n-step returns, and two exploration
-    # aids, since the +10 terminal sits behind a teleport reached across a mountain (random
-    # actions reach it in ~0.2 %). The Box-World learner below is not yet measured on RGW.
+    # RGW keeps the learner its shipped agents were trained with: RMSprop with epsilon 1e-5
+    # (Table 4's 0.1 stalls), n-step returns, and two exploration aids, since the +10
+    # terminal sits behind a teleport reached across a mountain.
     "rgw": {
         "optimizer": "rmsprop",
         "lr": 2e-3,
@@ -85,44 +101,39 @@ _DEFAULT_TRAIN: dict[str, dict[str, Any]] = {
         "gae_lambda": 1.0,
     },
     # Adam, GAE, running-RMS advantages, rewards x 0.1: the +11 gem otherwise makes the
-    # critic's loss (and its pull on the shared layers) a hundred times the actor's.
-    # Self-imitation 1.0: without it A3C on bw1 stayed at 17-29 % success after 1.8 M
-    # frames; with it 75 % at 1.4 M and 93-100 % at 2.3-2.5 M (PrediNet, 2 workers)
+    # critic's loss (and its pull on the shared layers) far larger than the actor's;
+    # self-imitation, without which A3C on bw1 stays far from solving it.
     "boxworld": {"lr": 5e-4, "entropy": 0.01, "reward_scale": 0.1, "sil": 1.0},
 }
+# PPO: no exploration aids, the plain comparison point.
 _PPO_TRAIN: dict[str, Any] = {
     "envs": 64,
     "n_steps": 128,
-    "workers": 1,
     "lr": 5e-4,
     "optimizer": "adam",
     "grad_clip": 0.5,
     "normalize_advantages": True,
     "gae_lambda": 0.95,
+    "explore": 0.0,
 }
-# DAgger from the RGW planner (neurosym/agent/imitation.py): one process, 64 envs x 32 steps
-# of labelled states, 8 Adam steps of 512 from the latest 204,800 (measured on rgw-random,
-# PrediNet: 4 steps of single-action labels reached 58 % action agreement and 4 % greedy
-# success on unseen levels in 8 min; 8 steps on the optimal-action sets 73 % and 21 % in 6).
+# DAgger from the RGW planner: one process, 64 envs x 32 steps of labelled states.
 _IMITATE_TRAIN: dict[str, Any] = {
     "envs": 64,
     "n_steps": 32,
-    "workers": 1,
     "lr": 5e-4,
     "optimizer": "adam",
     "grad_clip": 0.5,
     "reward_scale": 0.1,
     "explore": 0.0,
-    "sil": 0.0,
 }
 _SEEING_MODEL: dict[str, Any] = {"entity_norm": True, "attention_gain": 8.0, "init": "orthogonal"}
 _THESIS_MODEL: dict[str, Any] = {"entity_norm": False, "attention_gain": 1.0, "init": "torch"}
 _DEFAULT_MODEL: dict[str, dict[str, Any]] = {
-    # RGW: the network the shipped agents were measured with (see _DEFAULT_TRAIN)
+    # RGW: the network the shipped agents were trained with (see _DEFAULT_TRAIN)
     "rgw": _THESIS_MODEL,
     # Box-World: sizes of Table 4 but key size 32 (as RGW): queries come from the flattened
-    # entities (196 x 26 inputs), so key size 64 makes that one layer 2.6 M of the 2.7 M
-    # weights and about 60 % of a forward-backward; 32 halves both
+    # entities, so key size 64 makes that one layer nearly all of the weights and most of
+    # a forward-backward; 32 halves both
     "boxworld": {**_SEEING_MODEL, "key_size": 32},
 }
 _LEGACY: dict[str, dict[str, Any]] = {
@@ -137,17 +148,14 @@ _LEGACY: dict[str, dict[str, Any]] = {
         "preset": "legacy",
     },
 }
-
-
-def _agent_plane(family: str) -> int:
-    """The one-hot plane that marks the agent, as the family's env lays out its observation."""
-    if family == "rgw":
-        from neurosym.envs.rgw_rules import AGENT  # plane e holds entity e
-
-        return AGENT
-    from neurosym.envs.boxworld_entities import TYPE_PLANES
-
-    return TYPE_PLANES.index("agent")
+RETIRED: dict[str, dict[str, tuple[str, Any]]] = {
+    # setting -> (its flag, its neutral value): old checkpoints record them; none used them
+    "ModelConfig": {"local_view": ("--local-view", 0), "agent_plane": ("--local-view", -1)},
+    "TrainConfig": {
+        "critic_warmup": ("--critic-warmup", 0),
+        "planner_coef": ("--planner-coef", 0.0),
+    },
+}
 
 
 def _check_family(family: str) -> None:
@@ -158,6 +166,20 @@ def _check_family(family: str) -> None:
 def _check_preset(preset: str) -> None:
     if preset not in PRESETS:
         raise ConfigError(f"unknown preset {preset!r}; expected one of {', '.join(PRESETS)}")
+
+
+def _check_choice(config: Any, name: str, allowed: tuple[str, ...]) -> None:
+    value = getattr(config, name)
+    if value not in allowed:
+        raise ConfigError(f"unknown {name} {value!r}; expected one of {', '.join(allowed)}")
+
+
+def _check_positive(config: Any, *names: str, integer: bool = False) -> None:
+    for name in names:
+        value = getattr(config, name)
+        if not (int(value) >= 1 if integer else float(value) > 0):
+            kind = "a positive integer" if integer else "positive"
+            raise ConfigError(f"{name} must be {kind}, got {value}")
 
 
 def preset_env_kwargs(family: str, preset: str = "default") -> dict[str, Any]:
@@ -179,11 +201,13 @@ class ModelConfig:
     """observation shape (C, H, W); the model has H * W entities"""
     obs_scale: float = 1.0
     """factor turning raw observation values into [0, 1] (1 for onehot, 1/255 for grey/RGB)"""
-    conv_channels: tuple[int, ...] = (12, 24)
-    """output channels of the conv layers (Table 4: 12 and 24)"""
-    kernel_size: int = 2
-    """conv kernel size, stride 1, padded so the feature map keeps the grid shape"""
-    heads: int = 4
+    conv_channels: tuple[int, ...] = field(
+        default=(12, 24), metadata=flag(parse="channels", metavar="C1,C2,...")
+    )
+    """output channels of the encoder's conv layers (Table 4: 12,24)"""
+    kernel_size: int = field(default=2, metadata=FLAG)
+    """encoder conv kernel, stride 1, padded so the feature map keeps the grid shape (Table 4: 2)"""
+    heads: int = field(default=4, metadata=FLAG)
     """attention heads (Table 4: 4)"""
     key_size: int = 32
     """query and key size per head (Table 4: 32 RGW, 64 BW)"""
@@ -198,64 +222,33 @@ class ModelConfig:
     n_actions: int = 4
     """policy outputs (up, right, down, left)"""
     entity_norm: bool = True
-    """LayerNorm over each entity's conv features (not its coordinates) before the relational
-    module. Without it (Table 4's network) the entities are small and alike at initialisation:
-    PrediNet's attention is exactly uniform and the logits barely vary across observations
-    (bench/diagnose.py)."""
+    """LayerNorm over each entity's conv features before the relational module (thesis: off).
+    Without it the fresh network's entities are small and alike: PrediNet's attention is
+    uniform and the logits barely vary across observations."""
     attention_gain: float = 8.0
-    """factor on the attention logits (softmax(gain * Q K^T / sqrt(d))). At 1 (Table 4's network)
-    the fresh attention is uniform to within 1.3x on bw1 (max weight 0.0063 against 1/196), so
-    every head attends to the mean entity and PrediNet's D is 0; at 8 the largest weight is
-    5x uniform (entropy 96 % of uniform's), so heads start out looking at something"""
+    """factor on the attention logits, softmax(gain * Q K^T / sqrt(d)) (thesis: 1). At 1 the
+    fresh attention is close to uniform, so every head attends to the mean entity; at 8 the
+    heads start out looking at something."""
     query: str = "scene"
     """PrediNet's queries: "scene" (Q = flat(L) W_Q, DESIGN.md and the thesis) or "learned" (a
     learned Q1, Q2 per head, the same for every scene: attention by what and where an entity
-    is, not by the rest of the scene; see neurosym/agent/predinet.py for the measurements).
-    "learned" also drops the query projection, two thirds of a bw1 forward's arithmetic (PPO
-    64 x 2 on bw1: 2.3-3.2 k frames/s against 1.5-2.0 k). Measured on bw1 (PPO 64 steps x 2
-    passes, frames to 90 % training success, seeds 0/1/2): scene 657 k / none / none in 8
-    minutes; learned none (seed 0 collapsed to 0.2 % success) / 1,216 k / 461 k; learned with
-    ppo_advantages "running" 652 k / 787 k / 542 k (seed 3: 624 k). A3C (the defaults): scene
-    1,167 k / none / none in 10 minutes, learned 531 k / 837 k / 705 k (135-205 s). Not yet
-    measured on bw2/bw3, whose chains may need a query that depends on the held key, so
-    "scene" stays the default."""
-    keys: str = "entities"
-    """what PrediNet's attention compares its queries with: "entities" (K = L W_K, DESIGN.md and
-    the thesis) or "cells" (K = c W_K, c a cell's own observation vector, e.g. RGW's one-hot
-    planes, without coordinates): a head addresses cells by what they hold and reads the
-    encoder's entity there (E = a L, as before). Why it exists: with an encoder whose view is
-    wider than the map (the deep rgw-random PrediNet, six 3x3 layers) every entity carries the
-    whole route, and the heads attended background cells (no head on two different objects on
-    more than 7 % of states); with cell keys a head can only single out a cell by its content,
-    so its two arguments are what it chose to compare. The entity it reads still sees the
-    encoder's window, so a relation names which cells were compared, not that nothing else
-    entered D. Cells that hold the same thing get the same weight: a head on a kind with several
-    cells (rgw's two teleport ends, walls) reads their mean, and the recorded argument (the
-    attention's argmax) is the first of them in row-major order. ``--init-from`` may switch an
-    agent to "cells": W_K starts afresh, every other weight is copied."""
+    is, not by the rest of the scene). "learned" also drops the query projection, most of a
+    Box-World forward's arithmetic."""
+    keys: str = field(default="entities", metadata=flag(choices=KEYS))
+    """what PrediNet's attention compares its queries with: the encoder's entities (DESIGN.md,
+    the thesis) or each cell's own observation (cells). With cell keys a head singles out a cell
+    by what it holds, so its two arguments are what it chose to compare, even when the
+    encoder's view is wider than the map. The entity it reads still sees the encoder's window.
+    Cells that hold the same thing get the same weight (a head on several cells of a kind
+    reads their mean; the recorded argument is the first in row-major order).
+    ``--init-from`` may switch an agent to cells: W_K starts afresh, every other weight is
+    copied."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
-    (PyTorch's default, Table 4's network). torch's default shrinks a signal's spread by about
-    0.4 per layer, so after the five layers behind the relational module the value varied by
-    2.5e-7 across bw1 observations; orthogonal init with the entity norm and attention gain
-    gives 3.7e-3 (bench/diagnose.py). The policy head starts at gain 0.01 either way (a near
-    uniform first policy)."""
-
-    local_view: int = 0
-    """0 (Table 4's network, the default): the actor-critic MLP sees only the relational
-    module's output. K (odd): it also sees the one-hot K x K window of cells centred on the
-    agent (zeros off the grid), flattened. With single-cell entities (kernel_size 1) a head
-    must attend a cell to know what is on it, and the cells agent of issue 11 fell into a pit
-    in 37 % of unseen levels (`neurosym eval --checkpoint
-    checkpoints/rgw-random-predinet-cells.pt --episodes 100 --seed 3000000000 --sample`): a
-    3 x 3 window shows what one step can reach, so the heads are left with what lies beyond.
-    Measured (README "Measured", 2026-11-27): with it pits all but vanish and the cells agent
-    learns 2-3x faster per frame, its heads still on objects, but it flattens near 70 %
-    sampled success on timeouts (routes around walls beyond the window); 5 x 5 alike"""
-    agent_plane: int = -1
-    """the observation plane marking the agent, which ``local_view`` centres on (RGW 0,
-    Box-World's one-hot 1; -1 when local_view is 0)"""
+    (PyTorch's default, Table 4's network), which shrinks a signal's spread layer by layer
+    until the fresh value barely varies across observations. The policy head starts at gain
+    0.01 either way (a near uniform first policy)."""
 
     def __post_init__(self) -> None:
         if self.module not in MODULES:
@@ -300,25 +293,11 @@ class ModelConfig:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
         if not self.attention_gain > 0:
             raise ConfigError(f"attention_gain must be positive, got {self.attention_gain}")
-        if self.local_view < 0 or (self.local_view and self.local_view % 2 == 0):
-            raise ConfigError(
-                f"local_view must be 0 (off) or an odd window size such as 3, got {self.local_view}"
-            )
-        if self.local_view and not 0 <= self.agent_plane < self.obs_shape[0]:
-            raise ConfigError(
-                f"local_view needs the agent's plane, one of 0..{self.obs_shape[0] - 1}, "
-                f"got {self.agent_plane}"
-            )
 
     @property
     def n_entities(self) -> int:
         """Entities the relational module sees: one per grid cell."""
         return self.obs_shape[1] * self.obs_shape[2]
-
-    @property
-    def local_size(self) -> int:
-        """Features of the window around the agent the MLP sees besides the relations (0: none)."""
-        return self.obs_shape[0] * self.local_view**2
 
     @property
     def entity_size(self) -> int:
@@ -344,13 +323,6 @@ class ModelConfig:
             **switches,
             **{k: v for k, v in overrides.items() if v is not None},
         }
-        if values.get("local_view"):
-            if obs_scale != 1.0:
-                raise ConfigError(
-                    "--local-view reads the agent's plane of a one-hot observation; this env's "
-                    "observation is grey or RGB (use obs_mode=onehot)"
-                )
-            values["agent_plane"] = _agent_plane(family)
         return cls(module=module, obs_shape=obs_shape, obs_scale=obs_scale, **values)
 
     def to_dict(self) -> dict[str, Any]:
@@ -364,170 +336,202 @@ class ModelConfig:
 
 
 @dataclass(frozen=True)
+class A3CConfig:
+    """A3C's own settings (``--algo a3c``): asynchronous workers, self-imitation."""
+
+    workers: int = field(default=2, metadata=FLAG)
+    """worker processes W (neurosym train's default: one per CPU core)"""
+    sil: float = field(default=0.0, metadata=FLAG)
+    """weight of the self-imitation loss on the best episodes so far (0: none)"""
+    sil_episodes: int = 32
+    """best episodes each worker keeps for self-imitation"""
+
+    def __post_init__(self) -> None:
+        _check_positive(self, "workers", "sil_episodes", integer=True)
+        if self.sil < 0:
+            raise ConfigError(f"sil must be >= 0, got {self.sil}")
+
+
+@dataclass(frozen=True)
+class PPOConfig:
+    """PPO's own settings (``--algo ppo``): clipped-surrogate epochs over each rollout."""
+
+    ppo_epochs: int = field(default=4, metadata=FLAG)
+    """passes over each rollout"""
+    ppo_minibatches: int = field(default=4, metadata=FLAG)
+    """minibatches per pass"""
+    clip_range: float = 0.2
+    """probability-ratio clip"""
+    ppo_advantages: str = "minibatch"
+    """with normalize_advantages: "minibatch" centres and scales each minibatch's advantages
+    (SB3, CleanRL); "running" divides each rollout's by a running RMS of the advantages seen so
+    far (A3C's), so that a rollout without reward keeps its small advantages small"""
+
+    def __post_init__(self) -> None:
+        _check_positive(self, "ppo_epochs", "ppo_minibatches", integer=True)
+        _check_positive(self, "clip_range")
+        _check_choice(self, "ppo_advantages", PPO_ADVANTAGES)
+
+
+@dataclass(frozen=True)
+class ImitationConfig:
+    """DAgger's own settings (``--algo imitate``): imitation of the RGW planner."""
+
+    dagger_beta_frames: int = 200_000
+    """frames over which the chance of following the planner falls from 1 to 0"""
+    dagger_buffer: int = 204_800
+    """labelled states kept (the latest)"""
+    dagger_batch: int = 512
+    """states per gradient step"""
+    dagger_steps: int = field(default=8, metadata=FLAG)
+    """gradient steps per rollout of envs x n_steps labelled states"""
+    safe_coef: float = field(default=0.0, metadata=flag(metavar="C"))
+    """weight of a second set loss on every action that gives no return up (the planner's
+    regret 0) beside the fastest actions' loss (0: none). It weighs only the states where an
+    episode can miss its optimum, which the fastest-route loss weighs like any other."""
+    augment: bool = field(default=False, metadata=FLAG)
+    """fit each minibatch turned by a random quarter turn or mirrored (RGW's rules and its
+    planner are symmetric), so that the network does not memorise its labelled states"""
+
+    def __post_init__(self) -> None:
+        _check_positive(self, "dagger_buffer", "dagger_batch", "dagger_steps", integer=True)
+        for name in ("dagger_beta_frames", "safe_coef"):
+            if getattr(self, name) < 0:
+                raise ConfigError(f"{name} must be >= 0, got {getattr(self, name)}")
+
+
+LearnerConfig = A3CConfig | PPOConfig | ImitationConfig
+LEARNER_CONFIGS: dict[str, type] = {"a3c": A3CConfig, "ppo": PPOConfig, "imitate": ImitationConfig}
+"""each ``--algo``'s own settings"""
+SEED_LIMIT = 2**64
+"""seeds are integers in [0, 2**64): what torch and numpy accept"""
+
+
+@dataclass(frozen=True)
 class TrainConfig:
-    """Learner settings (A3C or PPO). ``for_family`` gives a preset's values per env family."""
+    """What every learner shares, and the chosen learner's own settings in ``learner``.
+
+    ``for_family`` gives a preset's values per env family; ``build`` and
+    ``replace`` take flat settings (common and the learner's side by side).
+    """
 
     algo: str = "a3c"
     """learner: "a3c" (asynchronous workers, the mission's algorithm), "ppo" (synchronous) or
-    "imitate" (DAgger from the RGW planner, neurosym/agent/imitation.py)"""
+    "imitate" (DAgger from the RGW planner)"""
     preset: str = "default"
     """the preset these settings started from ("default", "thesis"), recorded for the reader"""
     optimizer: str = "adam"
-    """"adam" (shared statistics) or "rmsprop" (Table 4). Adam's per-weight step is about lr
-    whatever the gradient's size; RMSprop with Table 4's epsilon 0.1 divided gradients of
-    1e-8..4e-7 (encoder, queries, keys at initialisation) by ~0.3 and left those layers still"""
-    lr: float = 1e-3
+    """"adam" (its per-weight step is about lr whatever the gradient's size) or "rmsprop"
+    (Table 4; with its epsilon 0.1 the tiny gradients of a fresh encoder barely move it)"""
+    lr: float = field(default=1e-3, metadata=FLAG)
     """learning rate (Table 4, RMSprop: 2e-3 RGW, 2e-4 BW)"""
-    entropy: float = 0.02
+    entropy: float = field(default=0.02, metadata=FLAG)
     """entropy bonus weight (Table 4: 0.02 RGW, 0.01 BW)"""
-    gamma: float = 0.99
+    gamma: float = field(default=0.99, metadata=FLAG)
     """discount (not in the thesis)"""
-    n_steps: int = 40
+    n_steps: int = field(default=40, metadata=FLAG)
     """rollout length per update (Table 4 "buffer": 40)"""
     value_coef: float = 0.5
     """weight of the value loss"""
     explore: float = 0.0
-    """count-based exploration bonus beta (intrinsic reward beta / sqrt(visits)); 0 = none"""
+    """count-based exploration bonus beta (intrinsic reward beta / sqrt(visits)); 0: none"""
     explore_half_life: float = 2000.0
-    """half-life of the visit counts, in worker steps (K frames each)"""
-    sil: float = 0.0
-    """weight of the self-imitation loss on the best episodes so far; 0 = none"""
-    sil_episodes: int = 32
-    """best episodes each worker keeps for self-imitation"""
+    """half-life of the visit counts, in learner steps (K frames each)"""
     rms_eps: float = 1e-5
-    """RMSprop epsilon (Table 4: 0.1, which stalls learning here; see the module docstring)"""
+    """RMSprop epsilon (Table 4: 0.1, which stalls learning here)"""
     adam_eps: float = 1e-5
     """Adam epsilon"""
     reward_scale: float = 1.0
     """factor on the env's rewards in the training signal (reported returns stay the env's)"""
     normalize_advantages: bool = True
-    """scale each update's advantages to zero mean and unit variance: the actor's gradient then
-    no longer grows with the rewards' size, and the critic stops drowning it on the shared
-    layers (measured 100-200x on a bw1 rollout with one +11 gem)"""
+    """scale each update's advantages, so that the actor's gradient does not grow with the
+    rewards' size and the critic does not drown it on the shared layers"""
     gae_lambda: float = 0.95
-    """GAE lambda for the advantages (1.0 = the n-step returns of Table 4's A3C)"""
-    ppo_epochs: int = 4
-    """PPO: passes over each rollout"""
-    ppo_minibatches: int = 4
-    """PPO: minibatches per pass"""
-    clip_range: float = 0.2
-    """PPO: probability-ratio clip"""
-    ppo_advantages: str = "minibatch"
-    """PPO, with ``normalize_advantages``: "minibatch" centres and scales each minibatch's
-    advantages (SB3, CleanRL); "running" divides each rollout's by a running RMS of the
-    advantages seen so far (A3C's :class:`~neurosym.agent.a3c.AdvantageScale`), so that a
-    rollout without reward keeps its small advantages small instead of scaled to unit size.
-    Measured on bw1 (PrediNet, 64 steps x 2 passes, README "Measured"): per minibatch with
-    ``--attention-gain 32`` the policy collapsed below random (0.4 % success); "running" did not
-    collapse, but took off later on seed 0 (75 % after 897 k frames against 90 % at 657 k) and
-    not at all on seed 1, so the default stays "minibatch". With learned PrediNet queries
-    (ModelConfig.query) it is what kept seed 0 from the same collapse (0.2 % after 1.29 M
-    frames per minibatch; 90 % at 652 k with "running"), and that pair is the fastest PPO on
-    bw1 measured here (README "Measured"; not the default, since bw2/bw3 are unmeasured)
-    """
+    """GAE lambda for the advantages (1: the n-step returns of Table 4's A3C)"""
     rms_alpha: float = 0.99
     """RMSprop decay (Table 4: 0.99), no momentum"""
     grad_clip: float = 0.5
-    """global gradient-norm clip (Table 4: 400, which never bites; 0.5 as in common A2C/PPO code
-    keeps one rollout with a rare large reward from throwing the shared weights far)"""
-    workers: int = 2
-    """worker processes W"""
-    envs: int = 8
-    """environments per worker K (1 = classic A3C with one env)"""
-    seed: int = 0
-    """base seed; worker w uses seed + 1000 * w"""
-    critic_warmup: int = 0
-    """A3C: frames (all workers) at the start of a run in which only the value head learns (its
-    loss alone; every other weight and the policy stay as they are). For fine-tuning a policy
-    whose critic never learned (``--init-from`` an imitation agent: the deep rgw-random DAgger
-    agent's values explain 1-4 % of its returns' variance, bench/critic_fit.py), whose first
-    advantages are noise"""
-    planner_coef: float = 0.0
-    """A3C on RGW: weight of the planner's imitation loss (``-log`` of the probability the policy
-    gives the env planner's optimal actions, on every state the rollout visits) beside the
-    actor-critic loss; 0 = none. Kickstarting (Schmitt et al. 2018) with the exact planner as
-    teacher: A3C fine-tuning of a DAgger agent finished more levels but lost the undiscounted
-    optimum (decoy enemy's +1 left, shortcuts), which the planner's labels keep asking for"""
-    dagger_beta_frames: int = 200_000
-    """imitate: frames over which the chance of following the planner falls from 1 to 0"""
-    dagger_buffer: int = 204_800
-    """imitate: labelled states kept (the latest)"""
-    dagger_batch: int = 512
-    """imitate: states per gradient step"""
-    dagger_steps: int = 8
-    """imitate: gradient steps per rollout of envs x n_steps states"""
-    safe_coef: float = 0.0
-    """imitate: weight of a second set loss beside the planner's fastest actions, whose set is
-    every action that gives no return up (:meth:`rgw_solver.Plan.regret` 0); 0 = none. It is 0
-    wherever no action loses return, so its weight falls only on the states where an episode
-    can miss its optimum (a mountain a free route avoids, the enemy met unarmed). On the
-    shipped MHDPA's sampled play a quarter of the states are such states, and its set loss
-    there (0.21) was twice the rest's (0.11): ``bench/regret_profile.py``"""
-    augment: bool = False
-    """imitate: fit each minibatch turned by a random quarter turn or mirrored
-    (neurosym/agent/augment.py; RGW's rules and its planner are symmetric). Without it the
-    Table 4 PrediNet memorised its labelled states (95 % optimal on them after 15 k
-    minibatches) and stayed at 83 % on levels it never saw"""
+    """global gradient-norm clip (Table 4: 400, which never bites; 0.5, as common A2C/PPO code
+    has it, keeps one rollout with a rare large reward from throwing the weights far)"""
+    envs: int = field(default=8, metadata=FLAG)
+    """environments per learner K (1: classic A3C with one env per worker)"""
+    seed: int = field(default=0, metadata=FLAG)
+    """base seed of the run's envs, sampling and initial weights"""
+    learner: LearnerConfig | None = None
+    """the settings of ``algo``'s learner (None: its defaults)"""
 
     def __post_init__(self) -> None:
-        if self.augment and self.algo != "imitate":
-            raise ConfigError(
-                f"--augment turns the planner's labelled states; it needs --algo imitate, "
-                f"not {self.algo}"
-            )
-        for name, allowed in (
-            ("algo", ALGOS),
-            ("optimizer", OPTIMIZERS),
-            ("ppo_advantages", PPO_ADVANTAGES),
-        ):
-            if getattr(self, name) not in allowed:
-                raise ConfigError(
-                    f"unknown {name} {getattr(self, name)!r}; expected one of {', '.join(allowed)}"
-                )
-        for name in (
-            "lr",
-            "gamma",
-            "rms_eps",
-            "adam_eps",
-            "rms_alpha",
-            "grad_clip",
-            "explore_half_life",
-            "reward_scale",
-            "clip_range",
-        ):
-            if not float(getattr(self, name)) > 0:
-                raise ConfigError(f"{name} must be positive, got {getattr(self, name)}")
+        for name, allowed in (("algo", ALGOS), ("optimizer", OPTIMIZERS)):
+            _check_choice(self, name, allowed)
+        own = LEARNER_CONFIGS[self.algo]
+        if self.learner is None:
+            object.__setattr__(self, "learner", own())
+        elif not isinstance(self.learner, own):
+            raise ConfigError(f"--algo {self.algo} needs {own.__name__}, got {self.learner!r}")
+        _check_positive(self, "lr", "gamma", "rms_eps", "adam_eps", "rms_alpha", "grad_clip",
+                        "explore_half_life", "reward_scale")  # fmt: skip
+        _check_positive(self, "n_steps", "envs", integer=True)
         if not 0 < self.gamma <= 1 or not 0 < self.rms_alpha < 1:
             raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
         if not 0 <= self.gae_lambda <= 1:
             raise ConfigError(f"gae_lambda must be in [0, 1], got {self.gae_lambda}")
-        if self.critic_warmup < 0:
-            raise ConfigError(f"critic_warmup must be >= 0 frames, got {self.critic_warmup}")
-        if self.critic_warmup and self.algo != "a3c":
-            raise ConfigError(
-                f"--critic-warmup is an A3C setting; --algo {self.algo} does not use it"
-            )
-        if self.planner_coef < 0:
-            raise ConfigError(f"planner_coef must be >= 0, got {self.planner_coef}")
-        if self.planner_coef and self.algo != "a3c":
-            raise ConfigError(
-                f"--planner-coef is an A3C setting; --algo {self.algo} does not use it"
-                + (" (DAgger learns from the planner alone)" if self.algo == "imitate" else "")
-            )
-        if self.safe_coef < 0:
-            raise ConfigError(f"safe_coef must be >= 0, got {self.safe_coef}")
-        if self.safe_coef and self.algo != "imitate":
-            raise ConfigError(
-                f"--safe-coef weighs DAgger's labels; it needs --algo imitate, not {self.algo}"
-            )
-        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0 or self.sil < 0:
-            raise ConfigError("entropy, value_coef, explore and sil must be >= 0")
-        if self.dagger_beta_frames < 0:
-            raise ConfigError(f"dagger_beta_frames must be >= 0, got {self.dagger_beta_frames}")
-        for name in ("n_steps", "workers", "envs", "sil_episodes", "ppo_epochs", "ppo_minibatches",
-                     "dagger_buffer", "dagger_batch", "dagger_steps"):  # fmt: skip
-            if int(getattr(self, name)) < 1:
-                raise ConfigError(f"{name} must be a positive integer, got {getattr(self, name)}")
+        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0:
+            raise ConfigError("entropy, value_coef and explore must be >= 0")
+        if not isinstance(self.seed, int) or not 0 <= self.seed < SEED_LIMIT:
+            raise ConfigError(f"--seed must be an integer from 0 to 2**64 - 1, got {self.seed}")
+
+    @property
+    def a3c(self) -> A3CConfig:
+        """A3C's settings (an error in another learner's run)."""
+        return self._learner(A3CConfig)
+
+    @property
+    def ppo(self) -> PPOConfig:
+        """PPO's settings (an error in another learner's run)."""
+        return self._learner(PPOConfig)
+
+    @property
+    def imitate(self) -> ImitationConfig:
+        """DAgger's settings (an error in another learner's run)."""
+        return self._learner(ImitationConfig)
+
+    def _learner(self, kind: type) -> Any:
+        if not isinstance(self.learner, kind):
+            raise ConfigError(f"this run's learner is {self.algo}, which has no {kind.__name__}")
+        return self.learner
+
+    @classmethod
+    def build(cls, strict: bool = True, **flat: Any) -> TrainConfig:
+        """A config from flat settings: the common fields, then ``algo``'s learner's.
+
+        A setting of another learner is dropped; when ``strict`` (a user's flag)
+        one that differs from its default is a ConfigError.
+        """
+        algo = flat.get("algo", "a3c")
+        if algo not in LEARNER_CONFIGS:
+            raise ConfigError(f"unknown algo {algo!r}; expected one of {', '.join(ALGOS)}")
+        common, own = {}, {}
+        mine = field_names(LEARNER_CONFIGS[algo])
+        for name, value in flat.items():
+            if name in mine:
+                own[name] = value
+            elif name in field_names(cls) and name != "learner":
+                common[name] = value
+            elif name in learner_setting_owner():
+                owner = learner_setting_owner()[name]
+                if strict and value != field_default(LEARNER_CONFIGS[owner], name):
+                    raise ConfigError(
+                        f"{option_name(name)} is a setting of --algo {owner}; this run's "
+                        f"learner is {algo}"
+                    )
+            else:
+                raise ConfigError(f"unknown TrainConfig keys: {name}")
+        return cls(**common, learner=LEARNER_CONFIGS[algo](**own))
+
+    def flat(self) -> dict[str, Any]:
+        """The common settings and the learner's, side by side."""
+        common = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "learner"}
+        return {**common, **asdict(self.learner)}  # type: ignore[call-overload]
 
     @classmethod
     def for_family(
@@ -548,33 +552,96 @@ class TrainConfig:
             base = {**_THESIS_COMMON, **_THESIS_TRAIN[family]}
         else:
             base = dict(_DEFAULT_TRAIN[family])
-            if algo == "ppo":  # no exploration aids: PPO is the plain comparison point
-                base = {**base, "explore": 0.0, "sil": 0.0, **_PPO_TRAIN}
+            if algo == "ppo":
+                base = {**base, **_PPO_TRAIN}
             elif algo == "imitate":
                 base = {**base, **_IMITATE_TRAIN}
-        values = {
-            **base,
-            "preset": preset,
-            "algo": algo,
-            **{k: v for k, v in overrides.items() if v is not None},
-        }
-        return cls(**values)
+        return cls.build(strict=False, **base, preset=preset, algo=algo).replace(**overrides)
 
     def replace(self, **changes: Any) -> TrainConfig:
-        """A copy with the changes that are not None."""
-        return replace(self, **{k: v for k, v in changes.items() if v is not None})
+        """A copy with the changes that are not None (flat names, as :meth:`build`)."""
+        given = {k: v for k, v in changes.items() if v is not None}
+        return TrainConfig.build(**{**self.flat(), **given}) if given else self
 
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        """Plain values, flat: the common settings and the learner's side by side (what a
+        checkpoint stores; older neurosym versions read it too)."""
+        return self.flat()
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TrainConfig:
-        return _from_dict(cls, data)
+        """Inverse of :meth:`to_dict`; also reads older checkpoints' records, which hold every
+        learner's fields (only ``algo``'s are kept) and retired settings (see ``RETIRED``)."""
+        if not isinstance(data, dict):
+            raise ConfigError(f"TrainConfig must be a dict, got {type(data).__name__}")
+        data = _without_retired(cls, data)
+        legacy = {k: v for k, v in _LEGACY["TrainConfig"].items() if k not in data}
+        try:
+            return cls.build(strict=False, **legacy, **data)
+        except TypeError as exc:
+            raise ConfigError(f"bad TrainConfig: {exc}") from None
+
+
+def field_names(cls: type) -> frozenset[str]:
+    return frozenset(f.name for f in fields(cls))
+
+
+@cache
+def learner_setting_owner() -> dict[str, str]:
+    """Every learner setting's name -> the ``--algo`` it belongs to."""
+    return {name: algo for algo, kind in LEARNER_CONFIGS.items() for name in field_names(kind)}
+
+
+def option_name(name: str) -> str:
+    """The flag of a setting (``ppo_epochs`` -> ``--ppo-epochs``)."""
+    return "--" + name.replace("_", "-")
+
+
+@cache
+def field_docs(cls: type) -> dict[str, str]:
+    """Each field's docstring (the string literal after it in the class body), whitespace joined."""
+    tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
+    body = tree.body[0].body  # type: ignore[attr-defined]
+    docs: dict[str, str] = {}
+    for node, after in zip(body, body[1:], strict=False):
+        if (
+            isinstance(node, ast.AnnAssign)
+            and isinstance(node.target, ast.Name)
+            and isinstance(after, ast.Expr)
+            and isinstance(after.value, ast.Constant)
+            and isinstance(after.value.value, str)
+        ):
+            docs[node.target.id] = " ".join(after.value.value.split())
+    return docs
+
+
+def field_default(cls: type, name: str) -> Any:
+    """The default of one of ``cls``'s fields (MISSING when it has none)."""
+    for f in fields(cls):
+        if f.name == name:
+            if f.default_factory is not MISSING:  # type: ignore[misc]
+                return f.default_factory()  # type: ignore[misc]
+            return f.default
+    raise KeyError(name)
+
+
+def _without_retired(cls: type, data: dict[str, Any]) -> dict[str, Any]:
+    """``data`` without the retired settings it records at their neutral value; one it used
+    is refused (the model or learner it describes no longer exists)."""
+    retired = RETIRED.get(cls.__name__, {})
+    for name, (option, neutral) in retired.items():
+        if name in data and data[name] != neutral:
+            raise ConfigError(
+                f"it was trained with {option} {data[name]}, an option this version no longer "
+                "has (neurosym before its removal plays it)"
+            )
+    return {k: v for k, v in data.items() if k not in retired}
 
 
 def _from_dict(cls: Any, data: dict[str, Any]) -> Any:
     if not isinstance(data, dict):
         raise ConfigError(f"{cls.__name__} must be a dict, got {type(data).__name__}")
+    data = _without_retired(cls, data)
     names = {f.name for f in fields(cls)}
     unknown = sorted(set(data) - names)
     if unknown:

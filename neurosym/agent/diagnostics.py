@@ -1,4 +1,4 @@
-"""Does the network see its input, and where do the gradients go? Measured, not hoped for.
+"""Does the network see its input, and where do the gradients go?
 
 Two questions decide whether A3C can learn at all, and both are cheap to ask
 of a fresh (or trained) model on a batch of observations:
@@ -19,7 +19,7 @@ of a fresh (or trained) model on a batch of observations:
   each weight by about lr whatever its gradient's size, and the attention
   saturates on fixed cells (``fixed_cell_share`` near 1).
 
-``bench/diagnose.py`` prints both for every env family and module, for the
+``experiments/diagnose.py`` prints both for every env family and module, for the
 model switches and learner settings of a preset, so a change to either is
 judged by these figures before and after.
 """
@@ -33,7 +33,12 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.config import TrainConfig
+from neurosym.agent.learners.optimizers import shared_optimizer
+from neurosym.agent.learners.ppo import ppo_update
+from neurosym.agent.learners.returns import AdvantageScale
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.rollout import RolloutState, collect_rollout
 
 
 def random_observations(env: str, n: int, seed: int = 0, **env_kwargs: Any) -> np.ndarray:
@@ -135,20 +140,6 @@ def gradient_report(
     return report
 
 
-def explained_variance(predicted: torch.Tensor, target: torch.Tensor) -> float:
-    """How much of ``target``'s variance ``predicted`` explains (SB3's figure for a critic):
-    1 - Var(target - predicted) / Var(target); NaN when the targets do not vary.
-
-    Used by PPO's metrics and ``bench/critic_fit.py``.
-    """
-    if target.numel() < 2:
-        return float("nan")
-    var = target.var()
-    if var <= 0:
-        return float("nan")
-    return float(1.0 - (target - predicted).var() / var)
-
-
 def signal_after_ppo_updates(
     model: ActorCritic,
     env: str,
@@ -162,10 +153,6 @@ def signal_after_ppo_updates(
     """:func:`input_signal` on ``probe`` after each of ``updates`` PPO updates of ``model`` (in
     place) on its own rollouts, with the family's PPO settings but ``envs`` x ``n_steps``
     rollouts and 2 passes (8 Adam steps per update)."""
-    from neurosym.agent.a3c import AdvantageScale, shared_optimizer
-    from neurosym.agent.config import TrainConfig
-    from neurosym.agent.ppo import ppo_update
-    from neurosym.agent.rollout import RolloutState, collect_rollout
     from neurosym.envs import env_family, make_batched
 
     train = TrainConfig.for_family(

@@ -1,7 +1,7 @@
 """Evaluation episodes scored against their levels: optimal return, sword first, no detour.
 
 :func:`play_scored` plays whole episodes (episode k from ``reset(seed=seed + k)``,
-in waves of at most ``batch`` sub-envs, as :func:`neurosym.agent.rollout.play_episodes`)
+in waves of at most ``batch`` sub-envs; :func:`play_episodes` is the same without scores)
 and keeps, per episode, what the level was and what the agent did about it.
 On Relational-Grid-World envs every level reports its optimal return and its
 kinds (``info["optimal_return"]``, ``info["guarded"]``, rgw_solver), so
@@ -33,6 +33,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
+from neurosym.agent.rollout import Finished, outcome_of
 
 TOLERANCE = 1e-6
 """returns this close to the optimal return count as optimal (float sums of -0.1 steps)"""
@@ -71,8 +73,6 @@ def play_scored(
     skips the level-aware scoring (its no-sword search costs time at every
     reset): returns, lengths and outcomes only, as the trainer's evaluation wants.
     """
-    from neurosym.agent.rollout import outcome_of
-
     out = ScoredEpisodes()
     venvs: dict[int, Any] = {}
     for first in range(0, episodes, batch):
@@ -124,6 +124,26 @@ def play_scored(
             out.sword_first += [False] * n
             out.no_sword_best += [float("nan")] * n
     return out
+
+
+def play_episodes(
+    act: Callable[[np.ndarray], np.ndarray],
+    make_venv: Callable[[int], Any],
+    episodes: int,
+    seed: int,
+    batch: int = 64,
+    max_steps: int = 100_000,
+) -> Finished:
+    """Play ``episodes`` whole episodes in waves of at most ``batch`` sub-envs.
+
+    Episode k is played from ``reset(seed=seed + k)``. ``act`` maps a batch of
+    observations to actions; ``make_venv(n)`` builds a batched env of n.
+    Results are in episode order: :func:`play_scored` without its level scores.
+    """
+    done = play_scored(
+        lambda obs, _venv: act(obs), make_venv, episodes, seed, batch, max_steps, levels=False
+    )
+    return Finished(done.returns, done.lengths, done.outcomes)
 
 
 def _mark_events(

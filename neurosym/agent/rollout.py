@@ -6,7 +6,6 @@
   episode ends is not a real transition; ``valid`` says which are).
 * :func:`collect_rollout`: n steps of K envs acted without a graph; the A3C
   update runs the model once over the stacked rollout.
-* :func:`play_episodes`: play N whole episodes, one per sub-env, for evaluation.
 """
 
 from __future__ import annotations
@@ -116,8 +115,6 @@ class Rollout(NamedTuple):
     when only recorded (PPO's behaviour policy); None when neither (the update recomputes)"""
     values: torch.Tensor | None = None
     """(T, K) the acting values, likewise"""
-    optimal: torch.Tensor | None = None
-    """(T, K, A) bool: the planner's optimal actions in each observation, when ``labels`` was given"""
     queries: Any | None = None
     """what the model kept of its acting forwards (``ActorCritic.recording``: PrediNet's
     queries), for an update that runs the model over ``obs`` again with the same weights"""
@@ -143,16 +140,15 @@ def collect_rollout(
     keep_graph: bool = False,
     record: bool = False,
     device: torch.device | None = None,
-    labels: Callable[[Any], np.ndarray] | None = None,
 ) -> tuple[Rollout, Finished]:
     """Act ``n_steps`` steps in every sub-env with sampled actions.
 
     By default no graph is kept and the update runs the model once more over
     the whole rollout: one batched forward and backward instead of T small
-    ones (PrediNet: 35 % faster, its big weight-gradient products want big
-    batches). ``keep_graph`` keeps each step's graph instead and saves that
-    second forward (MHDPA with K = 32: 45 % faster; its cost is per-sample
-    attention, cheapest in small batches).
+    ones (PrediNet's big weight-gradient products want big batches).
+    ``keep_graph`` keeps each step's graph instead and saves that second
+    forward (MHDPA with many envs: its cost is per-sample attention, cheapest
+    in small batches).
     ``bonus(next_obs, valid) -> (K,)`` adds an intrinsic reward to the
     rollout's rewards (the training signal); the finished episodes' returns
     are the environment's own. ``memory`` (an ``sil.EpisodeMemory``) is fed
@@ -161,21 +157,16 @@ def collect_rollout(
     ``device``: where the model lives (observations go there, actions are
     drawn on the CPU so that the generator's stream is the same on any device);
     the recorded logits and values stay there, the rest of the rollout is on the CPU.
-    ``labels(venv) -> (K, A) bool``: the optimal actions in the current state
-    of every sub-env (a planner's), asked before each step and kept in the
-    rollout's ``optimal``.
     """
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
-    logits_t, values_t, optimal_t = [], [], []
+    logits_t, values_t = [], []
     finished = Finished.empty()
     # no graph kept and nothing recorded: the update will run the model over these
     # observations again, and may take back what the model remembers of acting
     reuse = not keep_graph and not record and hasattr(model, "recording")
     with model.recording() if reuse else contextlib.nullcontext() as queries:
         for _ in range(n_steps):
-            if labels is not None:
-                optimal_t.append(labels(venv))
             with torch.set_grad_enabled(keep_graph):
                 obs_in = torch.from_numpy(state.obs)
                 logits, value = model(
@@ -210,30 +201,6 @@ def collect_rollout(
         valid=torch.from_numpy(np.stack(valids)),
         logits=torch.stack(logits_t) if logits_t else None,
         values=torch.stack(values_t) if values_t else None,
-        optimal=torch.from_numpy(np.stack(optimal_t)) if optimal_t else None,
         queries=queries,
     )
     return rollout, finished
-
-
-def play_episodes(
-    act: Callable[[np.ndarray], np.ndarray],
-    make_venv: Callable[[int], Any],
-    episodes: int,
-    seed: int,
-    batch: int = 64,
-    max_steps: int = 100_000,
-) -> Finished:
-    """Play ``episodes`` whole episodes in waves of at most ``batch`` sub-envs.
-
-    Episode k is played from ``reset(seed=seed + k)``. ``act`` maps a batch of
-    observations to actions; ``make_venv(n)`` builds a batched env of n.
-    Results are in episode order. The loop is
-    :func:`neurosym.agent.evaluation.play_scored`'s, without its level scores.
-    """
-    from neurosym.agent.evaluation import play_scored
-
-    done = play_scored(
-        lambda obs, _venv: act(obs), make_venv, episodes, seed, batch, max_steps, levels=False
-    )
-    return Finished(done.returns, done.lengths, done.outcomes)

@@ -161,14 +161,29 @@ def _option_types(entry_point: str, level_options: str) -> dict[str, OptionType]
     return option_types_of(entry_point, level_options)
 
 
-def check_options(name_or_id: str, kwargs: dict[str, Any]) -> None:
+def _batched_only(e: Any) -> list[str]:
+    """Options of the batched class that the single env does not take (such as ``copy``)."""
+    import inspect
+
+    params = inspect.signature(load(e.vector_entry_point).__init__).parameters
+    apart = ("self", "num_envs", "seed")  # make_batched's own arguments
+    single = option_types(e.short)
+    return [
+        n
+        for n, p in params.items()
+        if n not in apart and n not in single and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+    ]
+
+
+def check_options(name_or_id: str, kwargs: dict[str, Any], batched: bool = False) -> None:
     """Refuse, in one line, an option the env's class does not take or a value of the wrong type.
 
     gymnasium would raise a TypeError deep in its factory instead (or, for a
     render mode the env lacks, warn first); options the class gathers in
     ``**kwargs`` it checks itself (rgw-random names its level parameters). Values
     are checked against the option's annotation: ``classic="false"`` is refused,
-    not played as a true value.
+    not played as a true value. ``batched``: the batched class's own options
+    (such as ``copy``, which :func:`make_batched` passes on) are accepted too.
     """
     import inspect
 
@@ -176,11 +191,13 @@ def check_options(name_or_id: str, kwargs: dict[str, Any]) -> None:
     cls = load(e.entry_point)
     params = inspect.signature(cls.__init__).parameters
     types = option_types(name_or_id)
+    extra = _batched_only(e) if batched else []
     if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
-        unknown = sorted(set(kwargs) - set(types))
+        unknown = sorted(set(kwargs) - set(types) - set(extra))
         if unknown:
             raise ConfigError(
-                f"unknown option {unknown[0]!r} for {e.short}; expected one of {', '.join(types)}"
+                f"unknown option {unknown[0]!r} for {e.short}; "
+                f"expected one of {', '.join([*types, *extra])}"
             )
     for key, value in kwargs.items():
         option = types.get(key)
@@ -216,7 +233,7 @@ def make_batched(name: str, n: int, seed: int | None = None, **kwargs: Any) -> A
     e = entry(name)
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ConfigError(f"number of environments must be a positive integer, got {n!r}")
-    check_options(name, kwargs)
+    check_options(name, kwargs, batched=True)
     register_envs()
     return gymnasium.make_vec(
         e.id, num_envs=n, vectorization_mode="vector_entry_point", seed=seed, **kwargs

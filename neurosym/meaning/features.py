@@ -119,7 +119,7 @@ def mhdpa_head_outputs(module: nn.Module, x: torch.Tensor) -> torch.Tensor:
     """(B, H, N, F) each head's output A^h x W_V^h W_O^h, as MHDPA sums them into the residual.
 
     Recomputed from the module's input x with its own folded weights (see
-    neurosym/agent/mhdpa.py); tests check that the heads' sum plus the
+    neurosym/agent/networks/mhdpa.py); tests check that the heads' sum plus the
     projection's bias is exactly what enters ``norm1``, minus x.
     """
     B, N, F = x.shape

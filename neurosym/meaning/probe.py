@@ -391,7 +391,7 @@ def untrained_like(config: Any, seed: int) -> Any:
     """A freshly initialised network of the same shape (seeded), in eval mode."""
     import torch
 
-    from neurosym.agent.model import ActorCritic
+    from neurosym.agent.networks.model import ActorCritic
 
     with torch.random.fork_rng():
         torch.manual_seed(seed)

@@ -153,7 +153,6 @@ def load_agent_or_note(path: str | None) -> tuple[Any | None, str | None]:
 def load_extract(path: Path, threshold: str | None = None) -> tuple[Recording, Any, Path | None]:
     """(recording, facts, kb.pl or None) of an extract folder; facts at the extract's threshold."""
     from neurosym.export.facts import DEFAULT_THRESHOLD, extract_facts
-
     from neurosym.publish import published
 
     rec_dir, folder = recording_folder(path)

@@ -10,7 +10,7 @@ random actions as the floor, into ``--out``::
 
     neurosym train --env boxworld --init-from checkpoints/bw3-predinet.pt \\
         --out runs/bw-hard --minutes 120 --snapshot-every 10
-    python bench/curve.py runs/bw-hard --out docs/images/boxworld-curve.png
+    python experiments/curve.py runs/bw-hard --out docs/images/boxworld-curve.png
 
 Minutes are this run's own (a curriculum's earlier stages are in the
 checkpoint's ``init_wall_s``).
@@ -20,11 +20,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 UNSEEN = 3_000_000_000
 

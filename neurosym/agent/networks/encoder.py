@@ -11,7 +11,7 @@ appended last, so an entity has ``channels[-1] + 2`` features (26 by default).
 conv features (not its coordinates). Table 4's network has none, and on
 Box-World's RGB input its entities start small and alike, so that the
 relational module's attention starts uniform and the policy blind
-(bench/diagnose.py measures both).
+(experiments/diagnose.py measures both).
 """
 
 from __future__ import annotations

@@ -1,9 +1,7 @@
 """The actor-critic network: encoder -> PrediNet | MHDPA -> MLP -> policy logits and value.
 
 Table 4: the relational module's 26-wide output goes through 26 -> 256 -> 128
--> 64 (ReLU) and then two linear heads, 4 policy logits and 1 value. With
-``config.local_view`` K the MLP's input also holds the one-hot K x K cells
-around the agent (:func:`agent_window`; a recorded switch, off by default). The
+-> 64 (ReLU) and then two linear heads, 4 policy logits and 1 value. The
 policy head starts with small weights (std 0.01 orthogonal) so the initial
 policy is close to uniform, which is what exploration on RGW needs. With
 ``config.init == "orthogonal"`` the MLP (gain sqrt 2), the value head and
@@ -17,14 +15,13 @@ import contextlib
 import math
 
 import torch
-import torch.nn.functional as F
 from torch import nn
 
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.encoder import Encoder
-from neurosym.agent.introspection import Introspection
-from neurosym.agent.mhdpa import MHDPA
-from neurosym.agent.predinet import PrediNet, QueryRecord
+from neurosym.agent.networks.encoder import Encoder
+from neurosym.agent.networks.introspection import Introspection
+from neurosym.agent.networks.mhdpa import MHDPA
+from neurosym.agent.networks.predinet import PrediNet, QueryRecord
 from neurosym.errors import ConfigError
 
 
@@ -53,21 +50,6 @@ def build_relational(config: ModelConfig) -> nn.Module:
     )
 
 
-def agent_window(x: torch.Tensor, plane: int, size: int) -> torch.Tensor:
-    """(B, C, H, W) -> (B, size * size * C): the cells centred on the agent (the largest value of
-    ``plane``), row-major, zeros off the grid; one gather, no loop over the batch."""
-    B, C, H, W = x.shape
-    radius = size // 2
-    where = x[:, plane].reshape(B, H * W).argmax(dim=1)  # (B,) agent's cell, row-major
-    offsets = torch.arange(size, device=x.device)
-    rows = (where // W)[:, None] + offsets  # (B, size) rows in the padded grid
-    cols = (where % W)[:, None] + offsets  # (B, size)
-    padded = F.pad(x, (radius, radius, radius, radius)).permute(0, 2, 3, 1)  # (B, H+2r, W+2r, C)
-    batch = torch.arange(B, device=x.device)[:, None, None]
-    window = padded[batch, rows[:, :, None], cols[:, None, :]]  # (B, size, size, C)
-    return window.reshape(B, size * size * C)
-
-
 class ActorCritic(nn.Module):
     """``forward(obs, introspect=False)`` per docs/interfaces.md."""
 
@@ -80,7 +62,7 @@ class ActorCritic(nn.Module):
         )
         self.relational = build_relational(config)
         layers: list[nn.Module] = []
-        width = config.output_size + config.local_size
+        width = config.output_size
         for size in config.hidden_sizes:
             layers += [nn.Linear(width, size), nn.ReLU()]
             width = size
@@ -134,9 +116,6 @@ class ActorCritic(nn.Module):
             features, intro = self.relational(entities, introspect, queries)  # (B, output_size)
         else:
             features, intro = self.relational(entities, introspect)  # (B, output_size)
-        if self.config.local_view:
-            near = agent_window(x, self.config.agent_plane, self.config.local_view)
-            features = torch.cat([features, near], dim=1)  # (B, output_size + local_size)
         h = self.body(features)  # (B, hidden[-1])
         logits = self.policy(h)  # (B, n_actions)
         value = self.value(h).squeeze(-1)  # (B,)

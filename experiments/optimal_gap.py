@@ -14,7 +14,7 @@ seeds from ``--seed``) goes in one class:
 
 and each class is split by level kind (guarded or decoy)::
 
-    python bench/optimal_gap.py checkpoints/rgw-random-predinet-cellkeys.pt runs/x/checkpoint.pt
+    python experiments/optimal_gap.py checkpoints/rgw-random-predinet-cellkeys.pt runs/x/checkpoint.pt
 
 Prints one JSON line per checkpoint and mode (sampled, greedy).
 """

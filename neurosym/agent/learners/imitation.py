@@ -1,8 +1,7 @@
 """Imitation of the env's optimal planner (DAgger): ``neurosym train --algo imitate``.
 
-Why: on rgw-random neither RL learner left uniformly random success (A3C:
-25 M frames in 70 min; PPO: 0.5 M frames in 9 min, both 2-8 % against
-random's 4.6 %). The levels carry an exact planner (:class:`rgw_solver.Plan`,
+Why: on rgw-random neither RL learner gets far beyond uniformly random
+success (docs/results.md). The levels carry an exact planner (:class:`rgw_solver.Plan`,
 the search that gives each level its optimal return), so the network can be
 taught what to do and has to find, from the pixels, what the planner reads
 from the state: where the sword, the enemy, the door and the terminal are and
@@ -22,25 +21,25 @@ miss its optimum, which the fastest-route loss weighs like any other. The
 critic is fitted to the planner's best return still to earn (times
 ``reward_scale``), so that a later RL run can start from it.
 
-Same signature and messages as :func:`neurosym.agent.ppo.ppo_learner`; one
-process, RGW only (Box-World has no planner here), no torchrun.
+Started and reporting as every learner (:mod:`neurosym.agent.learners.process`);
+one process, RGW only (Box-World has no planner here), no torchrun.
 """
 
 from __future__ import annotations
 
 import os
-from typing import Any
 
 import numpy as np
 import torch
 
-from neurosym.agent import distributed
-from neurosym.agent.a3c import LossStats, learner_process, report_update
-from neurosym.agent.augment import augment_batch
-from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.planner_loss import optimal_set_nll
-from neurosym.agent.ppo import copy_into_shared, private_copy
+from neurosym.agent.config import TrainConfig
+from neurosym.agent.learners import distributed
+from neurosym.agent.learners.augment import augment_batch
+from neurosym.agent.learners.messages import LossStats, Stopped
+from neurosym.agent.learners.optimizers import copy_into_shared, private_copy
+from neurosym.agent.learners.planner_loss import optimal_set_nll
+from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
 
@@ -113,16 +112,16 @@ def imitation_update(
 ) -> LossStats:
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
-    for _ in range(config.dagger_steps):
-        obs, optimal, values, safe = buffer.sample(config.dagger_batch, rng)
-        if config.augment:  # the level turned or mirrored; the return still to earn is the same
+    for _ in range(config.imitate.dagger_steps):
+        obs, optimal, values, safe = buffer.sample(config.imitate.dagger_batch, rng)
+        if config.imitate.augment:  # the level turned or mirrored; the return still to earn is the same
             obs, sets = augment_batch(obs, torch.stack((optimal, safe), dim=-1), generator)
             optimal, safe = sets.unbind(-1)
         obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
         logits, value = model(obs)
         policy_loss = imitation_loss(logits, optimal)
-        if config.safe_coef:
-            policy_loss = policy_loss + config.safe_coef * imitation_loss(logits, safe.to(device))
+        if config.imitate.safe_coef:
+            policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(logits, safe.to(device))
         value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
         loss = policy_loss + config.value_coef * value_loss
         optimizer.zero_grad(set_to_none=True)
@@ -133,50 +132,38 @@ def imitation_update(
             logp = torch.log_softmax(logits, dim=-1)
             entropy = -(logp.exp() * logp).sum(-1).mean()
         totals += [policy_loss.item(), value_loss.item(), entropy.item(), float(norm)]
-    return LossStats(*(totals / config.dagger_steps))
+    return LossStats(*(totals / config.imitate.dagger_steps).tolist())
 
 
-def imitation_learner(
-    rank: int,
-    shared: ActorCritic,
-    optimizer: torch.optim.Optimizer,
-    model_config: ModelConfig,
-    train_config: TrainConfig,
-    env_name: str,
-    env_kwargs: dict[str, Any],
-    env_seed: int,
-    stop: Any,
-    queue: Any,
-    device: str = "cpu",
-    frames0: int = 0,
-) -> None:
-    """The DAgger learner process: labelled rollouts and updates until ``stop`` is set.
+def imitation_learner(ctx: LearnerContext) -> None:
+    """The DAgger learner process: labelled rollouts and updates until ``ctx.stop`` is set.
 
-    ``frames0``: frames trained before (a resumed run), so that beta goes on from there.
+    Beta goes on from ``ctx.frames0``, the frames trained before a resume.
     """
     torch.set_num_threads(max(1, len(os.sched_getaffinity(0))))
-    with learner_process(queue, rank):
+    with learner_process(ctx.queue, ctx.rank):
         from neurosym.envs import make_batched
         from neurosym.envs.rgw_solver import Planner
 
-        dev = distributed.learner_device(device, distributed.World())
-        torch.manual_seed(env_seed)
-        generator = torch.Generator().manual_seed(env_seed)
-        rng = np.random.default_rng(env_seed)
-        local, local_opt = private_copy(shared, optimizer, train_config, dev)
-        venv = make_batched(env_name, train_config.envs, seed=env_seed, **env_kwargs)
-        obs, _ = venv.reset(seed=env_seed)
+        config = ctx.train_config
+        dev = distributed.learner_device(ctx.device, distributed.World())
+        torch.manual_seed(ctx.env_seed)
+        generator = torch.Generator().manual_seed(ctx.env_seed)
+        rng = np.random.default_rng(ctx.env_seed)
+        local, local_opt = private_copy(ctx.shared, ctx.optimizer, config, dev)
+        venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
+        obs, _ = venv.reset(seed=ctx.env_seed)
         planner = Planner()
         tracker = EpisodeTracker(venv.num_envs)
-        buffer = LabelBuffer(train_config.dagger_buffer, obs.shape[1:], obs.dtype)
-        safe_loss = train_config.safe_coef > 0  # regrets only where the loss reads them
-        frames = frames0
+        buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype)
+        safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
+        frames = ctx.frames0
         parent = os.getppid()
-        while not stop.is_set() and os.getppid() == parent:
+        while not ctx.stop.is_set() and os.getppid() == parent:
             finished = Finished.empty()
-            beta = expert_share(frames, train_config.dagger_beta_frames)
+            beta = expert_share(frames, config.imitate.dagger_beta_frames)
             steps = 0
-            for _ in range(train_config.n_steps):
+            for _ in range(config.n_steps):
                 optimal, values, regret = planner.labels(venv, regret=safe_loss)
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
@@ -192,8 +179,8 @@ def imitation_learner(
                 valid, done = tracker.step(venv, reward, terminated, truncated, info)
                 finished.extend(done)
                 steps += int(valid.sum())
-            stats = imitation_update(local, local_opt, buffer, train_config, rng, dev, generator)
-            copy_into_shared(local, local_opt, shared, optimizer)
+            stats = imitation_update(local, local_opt, buffer, config, rng, dev, generator)
+            copy_into_shared(local, local_opt, ctx.shared, ctx.optimizer)
             frames += steps
-            report_update(queue, rank, steps, finished, stats)
-        queue.put(("stopped", rank, []))  # one process: no ranks to compare
+            report_update(ctx, steps, finished, stats)
+        ctx.queue.put(Stopped(ctx.rank))  # one process: no ranks to compare

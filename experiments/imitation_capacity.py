@@ -16,8 +16,8 @@ probability ``--follow`` (one of its optimal actions, uniformly) and is
 otherwise a uniformly random action, so that they cover the planner's routes
 and the detours a learner makes.
 
-    python bench/imitation_capacity.py                          # the table in docs/results.md
-    python bench/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
+    python experiments/imitation_capacity.py                          # the table in docs/results.md
+    python experiments/imitation_capacity.py --variants predinet:heads=8 mhdpa cnn
 
 ``cnn`` is a plain CNN reference (not a relational module).
 """
@@ -32,10 +32,10 @@ from typing import Any
 import numpy as np
 import torch
 
-from neurosym.agent.augment import augment_batch
 from neurosym.agent.config import ModelConfig
-from neurosym.agent.imitation import imitation_loss, planner_choice
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.learners.augment import augment_batch
+from neurosym.agent.learners.imitation import imitation_loss, planner_choice
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
 from neurosym.envs.rgw_solver import Planner
 

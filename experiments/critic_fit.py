@@ -16,8 +16,8 @@ one JSON line per discount:
 
 Usage::
 
-    python bench/critic_fit.py checkpoints/rgw-random-predinet-cellkeys.pt
-    python bench/critic_fit.py runs/x/checkpoint.pt --gammas 0.99
+    python experiments/critic_fit.py checkpoints/rgw-random-predinet-cellkeys.pt
+    python experiments/critic_fit.py runs/x/checkpoint.pt --gammas 0.99
 """
 
 from __future__ import annotations
@@ -77,7 +77,8 @@ def main(argv: list[str] | None = None) -> int:
     from sklearn.model_selection import cross_val_score
 
     from neurosym.agent.checkpoint import load_agent
-    from neurosym.agent.diagnostics import explained_variance, gradient_report
+    from neurosym.agent.diagnostics import gradient_report
+    from neurosym.agent.learners.returns import explained_variance
 
     agent = load_agent(args.checkpoint)
     model = agent.model

@@ -10,7 +10,7 @@ two numbers when each state's two arguments are drawn uniformly from the grid
 states and object positions as a recording::
 
     neurosym extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --sample --out kb_out/rgw2-general
-    python bench/heads_chance.py kb_out/rgw2-general/recording
+    python experiments/heads_chance.py kb_out/rgw2-general/recording
 
 Prints one JSON line per recording: the mean over ``--draws`` random heads.
 """

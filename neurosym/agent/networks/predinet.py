@@ -25,13 +25,10 @@ Choices made here (DESIGN.md leaves them open):
   the default): each head's Q1, Q2 are learned vectors, the same for every
   scene, so a head selects by what an entity is and where it stands, not by
   the rest of the scene. Why it exists: with scene queries, Adam's first
-  update on bw1 moves every one of W_Q's 5,096 inputs by about lr in the same
-  direction (most of flat(L) is the same in every level: coordinates, walls,
+  updates move every one of W_Q's inputs by about lr in the same direction
+  (most of flat(L) is the same in every level: coordinates, walls,
   background), so the queries jump by the same large vector in every scene
-  and the attention saturates on fixed cells (largest weight 0.033 -> 0.66
-  after one PPO update, 0.78 after two: ``bench/diagnose.py --ppo-updates 2``;
-  4 of 8 attentions on one fixed cell in 97-100 % of observations after
-  375 k frames of seed 1, which never took off). A learned query moves by
+  and the attention can saturate on fixed cells. A learned query moves by
   about lr per step. It cannot make which lock a head attends to depend on
   the colour of the held key, which bw2/bw3's chains may need.
 * ``keys="cells"`` (ModelConfig.keys; "entities", K = L W_K, is the default):
@@ -53,12 +50,7 @@ How it is computed (same function, same parameters, cheaper on a CPU):
   attentions share one softmax and one batched product with L (small
   batched products are slow per call). W_Q1 and W_Q2 are concatenated for
   one product with flat(L): its backward is then one contiguous product
-  instead of two over strided halves (PrediNet's forward and backward over
-  1,352 rgw2 observations 74 -> 69 ms on one core; same numbers bit for bit).
-With the encoder's channels-last convolutions these made a forward and
-backward over a 1352-observation update batch 25-35 % faster on one core, and
-training on rgw2 with W = 2, K = 32 went from 8.0 k to 10.7 k frames/s
-(bench/train.py's fps part).
+  instead of two over strided halves (the same numbers bit for bit).
 * The attention has a hand-written backward (:class:`PrediNetAttention`):
   L's three gradients are one batched product and one ``addmm`` instead of
   two small products, a strided add and a plain one.
@@ -79,7 +71,7 @@ from typing import NamedTuple
 import torch
 from torch import nn
 
-from neurosym.agent.introspection import PrediNetIntrospection
+from neurosym.agent.networks.introspection import PrediNetIntrospection
 
 
 class QueryRecord(NamedTuple):

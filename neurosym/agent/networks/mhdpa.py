@@ -31,7 +31,7 @@ import torch
 import torch.nn.functional as F_
 from torch import nn
 
-from neurosym.agent.introspection import MHDPAIntrospection
+from neurosym.agent.networks.introspection import MHDPAIntrospection
 
 
 class MHDPA(nn.Module):

@@ -3,8 +3,8 @@
 Why a set: equally short routes are all optimal, and a planner's tie-break
 between them is arbitrary; ``-log sum_{a optimal} p(a)`` asks the policy to put
 its probability on the set and leaves the split inside it free. Used by DAgger
-(:mod:`neurosym.agent.imitation`) and by A3C's ``planner_coef`` term
-(:func:`neurosym.agent.a3c.a3c_loss`).
+(:mod:`neurosym.agent.learners.imitation`) and by A3C's ``planner_coef`` term
+(:func:`neurosym.agent.learners.a3c.a3c_loss`).
 """
 
 from __future__ import annotations

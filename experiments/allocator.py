@@ -1,4 +1,4 @@
-"""What keeping freed memory (neurosym.agent.allocator) saves in an update's forward and backward.
+"""What keeping freed memory (neurosym.agent.learners.allocator) saves in an update's forward and backward.
 
 Each measurement runs in a fresh process (the malloc settings are process-wide
 and stay), one torch thread, on the batch one A3C update sees: K envs x 40
@@ -6,8 +6,8 @@ steps, plus the K last observations and the 40 self-imitation rows. It
 prints one JSON line per case with the milliseconds per forward+backward, the
 minor page faults per iteration and the kernel (system) time per iteration::
 
-    python bench/allocator.py                   # rgw2 K = 32 and bw1 K = 8, PrediNet and MHDPA
-    python bench/allocator.py --cases rgw2:32:predinet --iters 20
+    python experiments/allocator.py                   # rgw2 K = 32 and bw1 K = 8, PrediNet and MHDPA
+    python experiments/allocator.py --cases rgw2:32:predinet --iters 20
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ import sys
 CHILD = r"""
 import json, resource, sys, time
 import torch
-from neurosym.agent.allocator import keep_freed_memory
+from neurosym.agent.learners.allocator import keep_freed_memory
 from neurosym.agent.config import ModelConfig, preset_env_kwargs
-from neurosym.agent.model import ActorCritic
-from neurosym.agent.trainer import probe_env
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.run.plan import probe_env
 from neurosym.envs import env_family, make_batched
 
 env, k, module, keep, iters = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1", int(sys.argv[5])

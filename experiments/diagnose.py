@@ -7,9 +7,9 @@ on one rollout's worth of those observations with Monte-Carlo-like returns
 from the env's rewards (random actions). Run before and after changing the
 model or the learner::
 
-    python bench/diagnose.py                        # rgw2 and bw1, both modules, both presets
-    python bench/diagnose.py --envs bw1 --presets thesis
-    python bench/diagnose.py --envs bw1 --modules predinet --presets default \
+    python experiments/diagnose.py                        # rgw2 and bw1, both modules, both presets
+    python experiments/diagnose.py --envs bw1 --presets thesis
+    python experiments/diagnose.py --envs bw1 --modules predinet --presets default \
         --ppo-updates 3 --query learned     # also after each of the first PPO updates
 """
 
@@ -23,7 +23,7 @@ import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.diagnostics import gradient_report, input_signal, signal_after_ppo_updates
-from neurosym.agent.model import ActorCritic
+from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import env_family, make_batched
 
 

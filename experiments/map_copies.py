@@ -7,7 +7,7 @@ with and without a mirror) have the same optimal return, so counting the
 copies played at the optimum says more than the one map does. Copy 0 is the
 map itself; copies 1-3 are it turned, 4-7 the mirrored map turned::
 
-    python bench/map_copies.py checkpoints/rgw-random-predinet-cellkeys.pt --map rgw2
+    python experiments/map_copies.py checkpoints/rgw-random-predinet-cellkeys.pt --map rgw2
 
 Prints one JSON line per checkpoint: each copy's greedy return and optimal
 return, and the counts at the optimum, finished short of it, and unfinished.

@@ -8,7 +8,7 @@ free route avoids, the enemy met unarmed, the decoy's +1 walked past. This
 plays the agent's sampled policy on procedural levels and splits the visited
 states by the planner's per-action regret (:meth:`rgw_solver.Plan.regret`)::
 
-    python bench/regret_profile.py checkpoints/rgw-random-mhdpa.pt --episodes 300
+    python experiments/regret_profile.py checkpoints/rgw-random-mhdpa.pt --episodes 300
 
 Prints one JSON line per checkpoint: the share of ``critical`` states (some
 action loses return), the mean NLL on critical and on other states, the
@@ -31,7 +31,7 @@ def profile(path: str, env: str, episodes: int, seed: int) -> dict[str, object]:
     import torch
 
     from neurosym.agent.checkpoint import load_agent
-    from neurosym.agent.planner_loss import optimal_set_nll
+    from neurosym.agent.learners.planner_loss import optimal_set_nll
     from neurosym.envs import make_batched
     from neurosym.envs.rgw_solver import Planner
 

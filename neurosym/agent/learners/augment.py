@@ -4,9 +4,9 @@ Why: an RGW level turned a quarter or mirrored is another level of the same
 generator, with the same rules, whose optimal actions are the originals'
 turned the same way (moves are the four unit steps; walls, teleports,
 mountains, pits, sword and enemy do not care about direction). Imitating
-the planner on rgw-random, the Table 4 PrediNet fits 95 % of 200 k labelled
-states and still picks an optimal action in only 83 % of states of levels it
-never saw (``bench/imitation_capacity.py``): it memorises levels instead of
+the planner on rgw-random, the Table 4 PrediNet fits nearly all of its
+labelled states and picks optimal actions far less often on levels it never
+saw (``experiments/imitation_capacity.py``): it memorises levels instead of
 learning the rule. Each of the eight turned or mirrored copies of a state is
 a state it has not seen, for free.
 

@@ -1,0 +1,1 @@
+"""The agent network: encoder -> relational module (PrediNet or MHDPA) -> actor-critic MLP."""

@@ -1,0 +1,1 @@
+"""The training run: configuration, the ``neurosym train`` command and the trainer."""

@@ -1,0 +1,300 @@
+"""``neurosym train``: train a PrediNet or MHDPA agent with A3C, PPO or DAgger.
+
+A thin wrapper over :func:`neurosym.agent.run.trainer.train`. The settings'
+flags are generated from the config dataclasses (:mod:`neurosym.agent.config`,
+:class:`~neurosym.agent.run.options.RunOptions`): a field whose metadata says
+``flag`` gets ``--its-name`` with its docstring as help; every other field is
+set with ``--set NAME=VALUE``. Unset options take the preset's defaults for
+the env family (``--preset thesis`` is Table 4 exactly); with ``--resume``
+they take the checkpoint's settings. The command line, rebuilt from what was
+given, is stored in the checkpoint. Under ``torchrun`` (``--algo ppo``) every
+rank runs this command and rank 0 writes
+(:mod:`neurosym.agent.learners.distributed`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import os
+import shlex
+from dataclasses import Field, fields
+from typing import Any
+
+from neurosym.agent.config import (
+    A3CConfig,
+    ImitationConfig,
+    ModelConfig,
+    PPOConfig,
+    TrainConfig,
+    field_docs,
+    option_name,
+)
+from neurosym.agent.run.options import RunOptions
+from neurosym.cli import parse_env_options
+from neurosym.errors import ConfigError
+
+SETTINGS: tuple[tuple[str, type, str], ...] = (
+    (
+        "settings every learner shares (default: the preset's for the env family)",
+        TrainConfig,
+        "train",
+    ),
+    ("--algo a3c", A3CConfig, "train"),
+    ("--algo ppo", PPOConfig, "train"),
+    ("--algo imitate (DAgger from the env's optimal planner; RGW only)", ImitationConfig, "train"),
+    ("model (default: Table 4 and the preset's switches)", ModelConfig, "model"),
+)
+"""(argument group title, config class, train | model) of the settings' flags, in help order"""
+FIXED = {"algo", "preset", "learner", "module", "obs_shape", "obs_scale"}
+"""config fields that are not settings of a run (own flags, derived, or nested)"""
+GROUPS = {
+    "stop": "stopping (any that is reached; none: run until Ctrl-C)",
+    "watch": "watching",
+}
+
+
+def _help(cls: type, f: Field[Any]) -> str:
+    """The field's docstring up to its first top-level '. ', '; ' or ': ', plus the default."""
+    text, depth = field_docs(cls).get(f.name, ""), 0
+    for i, char in enumerate(text):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if depth == 0 and char in ".;:" and text[i + 1 : i + 2] in (" ", ""):
+            text = text[:i]
+            break
+    text = text.replace("``", "")
+    if cls is RunOptions and f.default is not None and not isinstance(f.default, bool):
+        text += f" (default {f.default})"  # the settings' defaults are the preset's
+    return text.replace("%", "%%")
+
+
+def _channels(text: str) -> tuple[int, ...]:
+    """'16,16,24' -> (16, 16, 24): the encoder's conv layers, one positive width each."""
+    try:
+        widths = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        widths = ()
+    if not widths or min(widths) < 1:
+        raise argparse.ArgumentTypeError(
+            f"want comma-separated positive channel counts such as 12,24, got {text!r}"
+        )
+    return widths
+
+
+def _kind(f: Field[Any]) -> str:
+    """bool, channels, int, float or str: how a field's value is read from text."""
+    declared = str(f.type)
+    for kind in ("bool", "tuple", "int", "float"):
+        if kind in declared:
+            return "channels" if kind == "tuple" else kind
+    return "str"
+
+
+def _add_flag(group: Any, cls: type, f: Field[Any]) -> None:
+    meta, kind = f.metadata, _kind(f)
+    extra: dict[str, Any] = {}
+    if kind == "bool":
+        extra["action"] = argparse.BooleanOptionalAction
+    else:
+        extra["type"] = {"channels": _channels, "int": int, "float": float, "str": str}[kind]
+    for key in ("choices", "metavar"):
+        if key in meta:
+            extra[key] = meta[key]
+    group.add_argument(option_name(f.name), dest=f.name, default=None, help=_help(cls, f), **extra)
+
+
+def flag_fields() -> list[tuple[type, Field[Any]]]:
+    """Every config field with a flag of its own."""
+    classes = [cls for _, cls, _ in SETTINGS] + [RunOptions]
+    return [(cls, f) for cls in classes for f in fields(cls) if f.metadata.get("flag")]
+
+
+def settable() -> dict[str, tuple[type, Field[Any]]]:
+    """Every setting ``--set`` takes: name -> (its config class, its field)."""
+    out: dict[str, tuple[type, Field[Any]]] = {}
+    for _, cls, _ in SETTINGS:
+        for f in fields(cls):
+            if f.name not in FIXED:
+                out[f.name] = (cls, f)
+    return out
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--env", help="environment short name or id, e.g. rgw2 (required unless --resume)"
+    )
+    parser.add_argument(
+        "--module", choices=("predinet", "mhdpa"),
+        help="relational module (required unless --resume or --init-from)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--out", required=True, help="run directory: checkpoint.pt and metrics.csv go here"
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="continue the run in --out from its checkpoint"
+    )
+    parser.add_argument(
+        "--init-from", metavar="CHECKPOINT",
+        help="start a new run from this checkpoint's weights and model (a curriculum: e.g. a bw1 "
+        "agent on bw2); any env of its family with its observation shape; frames count afresh",
+    )  # fmt: skip
+    parser.add_argument(
+        "--algo", choices=("a3c", "ppo", "imitate"),
+        help="learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or "
+        "imitate (DAgger from the env's optimal planner; RGW only)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--preset", choices=("default", "thesis"), default="default",
+        help="settings to start from: default (what learns best here) or thesis (Table 4 exactly)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE", dest="settings",
+        help="any other setting of neurosym/agent/config.py, e.g. --set attention_gain=32 "
+        "(repeatable)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--env-option", action="append", default=[], metavar="KEY=VALUE",
+        help="keyword argument for the env, e.g. obs_mode=grey (repeatable)",
+    )  # fmt: skip
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    groups = {key: parser.add_argument_group(title) for key, title in GROUPS.items()}
+    for f in fields(RunOptions):
+        if f.metadata.get("flag"):
+            _add_flag(groups[f.metadata["group"]], RunOptions, f)
+    for title, cls, _ in SETTINGS:
+        group = parser.add_argument_group(title)
+        for f in fields(cls):
+            if f.metadata.get("flag"):
+                _add_flag(group, cls, f)
+
+
+def _parse_value(name: str, f: Field[Any], text: str) -> Any:
+    kind = _kind(f)
+    if kind == "channels":
+        try:
+            return _channels(text)
+        except argparse.ArgumentTypeError as exc:
+            raise ConfigError(f"--set {name}: {exc}") from None
+    if kind == "bool":
+        lowered = text.lower()
+        if lowered not in ("true", "false", "1", "0", "yes", "no"):
+            raise ConfigError(f"--set {name} wants true or false, got {text!r}")
+        return lowered in ("true", "1", "yes")
+    if kind == "str":
+        return text
+    try:
+        value = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        value = None
+    if kind == "float" and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    if type(value).__name__ != kind:
+        raise ConfigError(f"--set {name} wants a number ({kind}), got {text!r}")
+    return value
+
+
+def parse_settings(items: list[str]) -> dict[str, Any]:
+    """``--set`` items -> {name: value}, each read as its field's type."""
+    known = settable()
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or name not in known:
+            raise ConfigError(
+                f"--set wants NAME=VALUE with NAME a setting ({', '.join(sorted(known))}), "
+                f"got {item!r}"
+            )
+        out[name] = _parse_value(name, known[name][1], text)
+    return out
+
+
+def overrides_of(args: argparse.Namespace) -> dict[str, dict[str, Any]]:
+    """The settings given on the command line, by config: {"train": {...}, "model": {...}}."""
+    given = {f.name: getattr(args, f.name) for cls, f in flag_fields() if cls is not RunOptions}
+    given.update(parse_settings(args.settings))
+    model_names = {f.name for f in fields(ModelConfig)}
+    out: dict[str, dict[str, Any]] = {"train": {}, "model": {}}
+    for name, value in given.items():
+        if value is not None:
+            out["model" if name in model_names else "train"][name] = value
+    return out
+
+
+def _as_text(value: Any) -> str:
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
+def _run_options(args: argparse.Namespace, group: str) -> list[str]:
+    """The given RunOptions flags of one group that differ from their defaults."""
+    parts: list[str] = []
+    for f in fields(RunOptions):
+        value = getattr(args, f.name, None)
+        if f.metadata.get("group") == group and value is not None and value != f.default:
+            if isinstance(value, bool):
+                parts.append(option_name(f.name) if value else "--no-" + option_name(f.name)[2:])
+            else:
+                parts += [option_name(f.name), str(value)]
+    return parts
+
+
+def command_line(args: argparse.Namespace) -> str:
+    """The command as a user would type it, rebuilt from what was given."""
+    parts = ["neurosym", "train"]
+    for flag in ("env", "module", "out"):
+        if getattr(args, flag) is not None:
+            parts += [f"--{flag}", str(getattr(args, flag))]
+    if args.resume:
+        parts.append("--resume")
+    for name in ("init_from", "algo"):
+        if getattr(args, name) is not None:
+            parts += [option_name(name), str(getattr(args, name))]
+    if args.preset != "default":
+        parts += ["--preset", args.preset]
+    parts += _run_options(args, "stop")
+    flagged = {f.name for _, f in flag_fields()}
+    for settings in overrides_of(args).values():
+        for name, value in settings.items():
+            if name not in flagged:
+                parts += ["--set", f"{name}={_as_text(value)}"]
+            elif isinstance(value, bool):
+                parts.append(option_name(name) if value else "--no-" + option_name(name)[2:])
+            else:
+                parts += [option_name(name), _as_text(value)]
+    for item in args.env_option:
+        parts += ["--env-option", item]
+    parts += _run_options(args, "watch")
+    command = shlex.join(parts)
+    world = os.environ.get("WORLD_SIZE")
+    if world and world != "1":  # the checkpoint says the run was distributed
+        command = f"torchrun (WORLD_SIZE={world}) -m {command}"
+    return command
+
+
+def run(args: argparse.Namespace) -> int:
+    from neurosym.agent.run.trainer import train
+
+    overrides = overrides_of(args)
+    if "workers" not in overrides["train"] and not args.resume and args.algo in (None, "a3c"):
+        overrides["train"]["workers"] = os.cpu_count() or 1
+    given = {
+        f.name: getattr(args, f.name)
+        for f in fields(RunOptions)
+        if f.metadata.get("flag") and getattr(args, f.name) is not None
+    }
+    options = RunOptions(**given, progress=not args.quiet)
+    result = train(
+        args.env,
+        args.module,
+        args.out,
+        train_overrides=overrides["train"],
+        model_overrides=overrides["model"],
+        env_kwargs=parse_env_options(args.env_option) if args.env_option else None,
+        options=options,
+        resume=args.resume,
+        init_from=args.init_from,
+        command=command_line(args),
+        print_fn=print,
+        preset=args.preset,
+        algo=args.algo,
+    )
+    return 130 if result.stop_reason == "interrupted" else 0
