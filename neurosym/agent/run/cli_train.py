@@ -119,6 +119,15 @@ def settable() -> dict[str, tuple[type, Field[Any]]]:
     return out
 
 
+def set_names_help() -> str:
+    """The settings ``--set NAME=VALUE`` takes, a line each with what it does (the help's epilog)."""
+    lines = ["settings without a flag of their own (--set NAME=VALUE):"]
+    for name, (cls, f) in sorted(settable().items()):
+        if not f.metadata.get("flag"):
+            lines.append(f"  {name:<22} {_help(cls, f).replace('%%', '%')}")
+    return "\n".join(lines)
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--env", help="environment short name or id, e.g. rgw2 (required unless --resume)"
@@ -157,6 +166,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="keyword argument for the env, e.g. obs_mode=grey (repeatable)",
     )  # fmt: skip
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.epilog = set_names_help()
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
     groups = {key: parser.add_argument_group(title) for key, title in GROUPS.items()}
     for f in fields(RunOptions):
         if f.metadata.get("flag"):
