@@ -265,7 +265,7 @@ def read_checkpoint(
 
 
 SIZE_FIELDS = ("conv_channels", "hidden_sizes", "kernel_size", "heads", "key_size",
-               "output_size", "n_actions", "local_view")  # fmt: skip
+               "output_size", "n_actions")  # fmt: skip
 """ModelConfig fields that size a layer: none can exceed every dimension of the weights"""
 
 MODULE_SIZE_FIELDS = {"predinet": ("relations",), "mhdpa": ("value_size",)}
