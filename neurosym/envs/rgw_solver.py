@@ -23,7 +23,7 @@ Two questions about a level, asked of many levels at once with array operations:
 
 :class:`Plan` keeps every layer of the search and acts optimally from any
 state; :class:`Planner` wraps it as a policy for a batched env, the scripted
-agent whose evaluation must show ``optimal_rate`` 1.0 (tests/test_evaluation.py).
+agent whose evaluation must show ``optimal_rate`` 1.0 (tests/agent/test_evaluation.py).
 """
 
 from __future__ import annotations

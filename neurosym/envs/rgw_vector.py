@@ -1,7 +1,7 @@
 """Batched Relational-Grid-World: n episodes stepped with array operations.
 
 Runs the same :class:`~neurosym.envs.rgw_rules.RGWBatch` as the single env, so
-the two agree step for step (tests/test_rgw_vector.py runs them in lockstep).
+the two agree step for step (tests/envs/test_rgw_vector.py runs them in lockstep).
 Autoreset follows gymnasium's next-step mode: the step after an episode ends
 ignores that sub-env's action and returns the first observation of its next
 episode with reward 0.

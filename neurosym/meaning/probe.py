@@ -191,7 +191,7 @@ def logistic_fit(
     shared, Y (M, n) bool. A probe run fits thousands of tiny probes; one
     sklearn call each costs 5 ms on a quiet core and 50 ms on a busy one
     (2-3 minutes per checkpoint here), while here every Newton step of all of
-    them is a few matrix products. ``tests/test_meaning_probe.py`` checks the
+    them is a few matrix products. ``tests/meaning/test_meaning_probe.py`` checks the
     fits against scikit-learn's, and ``solver="sklearn"`` uses it directly.
     """
     n, d = X.shape

@@ -4,7 +4,7 @@ Every table the player draws from (``positions``, ``holding``, ``events``,
 ``attends``, ``relations``, ``attention``) is embedded as it was recorded,
 one column list per schema column without ``episode``, floats at full
 precision: the page shows the recording's own values, and
-``tests/test_webreport_data.py`` checks that the embedded columns put back
+``tests/webreport/test_webreport_data.py`` checks that the embedded columns put back
 together equal the recording's tables. The map's terrain (walls, mountains,
 pits: cells the recording does not list) comes from the environment's layout
 after ``reset(seed)``, as :func:`neurosym.viz.recorded.trace_from_recording`

@@ -14,7 +14,7 @@ from neurosym.agent.evaluation import ScoredEpisodes, level_scores
 from neurosym.envs.rgw_solver import Planner
 from neurosym.errors import CheckpointError
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 RGW2_PREDINET = ROOT / "checkpoints" / "rgw2-predinet.pt"
 
 

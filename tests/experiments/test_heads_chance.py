@@ -6,7 +6,7 @@ import importlib.util
 from pathlib import Path
 
 _spec = importlib.util.spec_from_file_location(
-    "heads_chance", Path(__file__).resolve().parents[1] / "experiments" / "heads_chance.py"
+    "heads_chance", Path(__file__).resolve().parents[2] / "experiments" / "heads_chance.py"
 )
 heads_chance = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(heads_chance)

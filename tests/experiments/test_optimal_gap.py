@@ -9,7 +9,7 @@ from pathlib import Path
 from neurosym.agent.evaluation import ScoredEpisodes
 
 _spec = importlib.util.spec_from_file_location(
-    "optimal_gap", Path(__file__).resolve().parents[1] / "experiments" / "optimal_gap.py"
+    "optimal_gap", Path(__file__).resolve().parents[2] / "experiments" / "optimal_gap.py"
 )
 optimal_gap = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(optimal_gap)

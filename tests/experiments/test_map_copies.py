@@ -10,7 +10,7 @@ import pytest
 
 from neurosym.envs.rgw_maps import load_map
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location("map_copies", REPO / "experiments" / "map_copies.py")
 map_copies = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(map_copies)

@@ -16,7 +16,7 @@ from neurosym.agent.cli_eval import evaluate
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.networks.model import ActorCritic
 
-RGW1_MAP = Path(__file__).resolve().parents[1] / "neurosym" / "envs" / "maps" / "rgw1.txt"
+RGW1_MAP = Path(__file__).resolve().parents[2] / "neurosym" / "envs" / "maps" / "rgw1.txt"
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ import argparse
 import ast
 from pathlib import Path
 
-AGENT = Path(__file__).resolve().parents[1] / "neurosym" / "agent"
+AGENT = Path(__file__).resolve().parents[2] / "neurosym" / "agent"
 
 
 def _module_name(path: Path) -> str:

@@ -22,7 +22,7 @@ from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.prolog.signature import signature_path
 from neurosym.terms import atom_text
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _touch(marker: Path) -> str:

@@ -17,7 +17,7 @@ from neurosym.envs import ACTION_NAMES, ENVS, Action, canonical_name, env_family
 from neurosym.errors import ConfigError
 
 NAMES = list(ENVS)
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def test_names_ids_and_families() -> None:

@@ -25,7 +25,7 @@ from neurosym.cli import main
 from neurosym.envs import env_family, make
 from neurosym.export.recorder import record
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DPI = "40"
 MAX_STEPS = 30
 

@@ -17,7 +17,7 @@ import torch
 
 from neurosym.agent.checkpoint import load_agent
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONHASHSEED": "0"}
 
 

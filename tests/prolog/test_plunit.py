@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-RULES = Path(__file__).resolve().parents[1] / "rules"
+RULES = Path(__file__).resolve().parents[2] / "rules"
 PLT_FILES = sorted(RULES.glob("*.plt"))
 
 

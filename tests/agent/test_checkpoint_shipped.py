@@ -2,7 +2,7 @@
 env's own events; Box-World and rgw-random agents solve levels they never trained on (reset seeds
 >= 2**31); the cell-keyed rgw-random PrediNet has a head that relates two different objects on
 rgw-random and plays rgw2 by the optimal route, relating the agent to the sword and the enemy,
-with a sword-enemy link in Prolog. (Each agent's card: tests/test_zoo.py.)"""
+with a sword-enemy link in Prolog. (Each agent's card: tests/agent/test_zoo.py.)"""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import torch
 
 from neurosym.agent.checkpoint import load_agent
 
-CHECKPOINTS = Path(__file__).resolve().parents[1] / "checkpoints"
+CHECKPOINTS = Path(__file__).resolve().parents[2] / "checkpoints"
 # rgw2: the lower part is reachable only through the teleport; rgw1 (no mountains, no pits)
 # also opens the way down the right edge, so the teleport is optional there.
 ROUTES = {

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 _spec = importlib.util.spec_from_file_location(
-    "critic_fit", Path(__file__).resolve().parents[1] / "experiments" / "critic_fit.py"
+    "critic_fit", Path(__file__).resolve().parents[2] / "experiments" / "critic_fit.py"
 )
 critic_fit = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(critic_fit)

@@ -168,7 +168,7 @@ def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
     import os
     import sys
 
-    repo = Path(__file__).resolve().parents[1]
+    repo = Path(__file__).resolve().parents[2]
     env = {
         **os.environ,
         "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")])),

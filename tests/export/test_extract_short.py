@@ -11,7 +11,7 @@ from neurosym.export.cli_extract import write_outputs
 from neurosym.export.facts import extract_facts
 from neurosym.export.report import print_report
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def report(tmp_path: Path, capsys: pytest.CaptureFixture[str], verbose: bool) -> str:

@@ -28,7 +28,7 @@ from neurosym.agent.checkpoint import load_agent, read_checkpoint
 from neurosym.agent.learners import distributed
 from neurosym.errors import ConfigError
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 TORCHRUN = [sys.executable, "-m", "torch.distributed.run"]
 TINY = ["--env", "rgw2", "--module", "predinet", "--algo", "ppo", "--envs", "4", "--n-steps", "16",
         "--ppo-minibatches", "2", "--ppo-epochs", "1", "--quiet", "--eval-episodes", "2"]  # fmt: skip

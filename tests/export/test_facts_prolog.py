@@ -19,7 +19,7 @@ from neurosym.export.facts import FactSet, extract_facts
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.terms import Term
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 RULES = REPO / "rules"
 ENEMY = ("defeated(enemy)", "hurt_by(enemy)")
 

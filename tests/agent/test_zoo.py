@@ -13,7 +13,7 @@ import torch
 from neurosym.agent.checkpoint import load_agent
 from neurosym.errors import CheckpointError, ConfigError
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 CHECKPOINTS = REPO / "checkpoints"
 
 

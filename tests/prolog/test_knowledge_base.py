@@ -344,7 +344,7 @@ def test_janus_gets_the_venv_home_despite_an_old_swipl_on_path(tmp_path: Path, s
     env = {**os.environ, "PATH": f"{old.parent}{os.pathsep}{os.environ['PATH']}"}
     env.pop("NEUROSYM_SWIPL", None)
     env.pop("SWI_HOME_DIR", None)
-    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1])
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[2])
     proc = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
     )
