@@ -1,6 +1,6 @@
 """Checkpoints: save atomically, read safely, and load a trained :class:`Agent`.
 
-A checkpoint is a dict of tensors and plain values (DESIGN.md "Checkpoint"):
+A checkpoint is a dict of tensors and plain values (docs/design.md "Checkpoints"):
 
 =================== ==========================================================
 ``format``          ``"neurosym-checkpoint"``
@@ -30,7 +30,7 @@ observation shape, another model config) is one line of
 :class:`~neurosym.errors.CheckpointError`.
 
 A checkpoint runs on any environment of its family whose observations have
-its shape (DESIGN.md): an agent trained on rgw-random plays rgw1, rgw2 or a
+its shape (docs/design.md): an agent trained on rgw-random plays rgw1, rgw2 or a
 user's map, and the other way round. :func:`env_for` decides which env and
 which options: on its own env, the options it was trained with; on another,
 that env's own options, except those that shape the observation

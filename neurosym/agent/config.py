@@ -230,12 +230,12 @@ class ModelConfig:
     fresh attention is close to uniform, so every head attends to the mean entity; at 8 the
     heads start out looking at something."""
     query: str = "scene"
-    """PrediNet's queries: "scene" (Q = flat(L) W_Q, DESIGN.md and the thesis) or "learned" (a
+    """PrediNet's queries: "scene" (Q = flat(L) W_Q, docs/design.md and the thesis) or "learned" (a
     learned Q1, Q2 per head, the same for every scene: attention by what and where an entity
     is, not by the rest of the scene). "learned" also drops the query projection, most of a
     Box-World forward's arithmetic."""
     keys: str = field(default="entities", metadata=flag(choices=KEYS))
-    """what PrediNet's attention compares its queries with: the encoder's entities (DESIGN.md,
+    """what PrediNet's attention compares its queries with: the encoder's entities (docs/design.md,
     the thesis) or each cell's own observation (cells). With cell keys a head singles out a cell
     by what it holds, so its two arguments are what it chose to compare, even when the
     encoder's view is wider than the map. The entity it reads still sees the encoder's window.

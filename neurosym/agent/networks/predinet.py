@@ -1,4 +1,4 @@
-"""PrediNet (Shanahan et al. 2020) as DESIGN.md describes it.
+"""PrediNet (Shanahan et al. 2020) as docs/design.md describes it.
 
 With L the (B, N, F) entities (F = features + 2 coordinates):
 
@@ -10,7 +10,7 @@ With L the (B, N, F) entities (F = features + 2 coordinates):
   same thing in every head;
 * R^h = [D^h, pos(E1), pos(E2)].
 
-Choices made here (DESIGN.md leaves them open):
+Choices made here (docs/design.md leaves them open):
 
 * The 1/sqrt(d) in the softmax is the usual attention temperature, times
   ``attention_gain`` (ModelConfig; 1 in Table 4's network). It is the same
