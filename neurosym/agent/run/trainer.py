@@ -541,8 +541,10 @@ class _Supervisor:
             outcome.stop_reason = "peer"
         elif not learners.any_alive():
             outcome.failure, outcome.stop_reason = "all workers exited unexpectedly", "error"
-        if outcome.stop_reason:
+        if outcome.stop_reason in ("interrupted", "error", "peer"):
             return True
+        # a stop decided in the last turn (frames, minutes, success) still gets its last
+        # evaluation chance and the final metrics row and progress figures
         self.evaluate_if_due(time.monotonic())
         self.log_if_due(time.monotonic(), progress, task, total)
         if outcome.stop_reason:
