@@ -1,7 +1,8 @@
 """Evaluation episodes scored against their levels: optimal return, sword first, no detour.
 
-:func:`play_scored` plays whole episodes (episode k from ``reset(seed=seed + k)``,
-in waves of at most ``batch`` sub-envs; :func:`play_episodes` is the same without scores)
+:func:`play_scored` plays whole episodes with :func:`neurosym.agent.play.play_waves`
+(episode k from ``reset(seed=seed + k)``, in waves of at most ``batch`` sub-envs;
+:func:`play_episodes` is the same without scores)
 and keeps, per episode, what the level was and what the agent did about it.
 On Relational-Grid-World envs every level reports its optimal return and its
 kinds (``info["optimal_return"]``, ``info["guarded"]``, rgw_solver), so
@@ -34,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from neurosym.agent.play import play_waves
 from neurosym.agent.rollout import Finished, outcome_of
 
 TOLERANCE = 1e-6
@@ -69,54 +71,33 @@ def play_scored(
     """Play ``episodes`` episodes; ``act(obs, venv)`` gives the actions of a batch.
 
     ``act`` gets the batched env as well, so that a scripted policy (such as
-    rgw_solver's planner in the tests) can read the state. ``levels=False``
+    rgw_solver's planner in the tests) can read the state; it sees the whole
+    batch every step (``act_on="all"`` of :func:`play_waves`). ``levels=False``
     skips the level-aware scoring (its no-sword search costs time at every
     reset): returns, lengths and outcomes only, as the trainer's evaluation wants.
     """
     out = ScoredEpisodes()
     venvs: dict[int, Any] = {}
-    for first in range(0, episodes, batch):
-        n = min(batch, episodes - first)
-        venv = venvs.setdefault(n, make_venv(n))
-        obs, info = venv.reset(seed=[seed + first + i for i in range(n)])
-        rgw = levels and "optimal_return" in info
-        ret = np.zeros(n)
-        length = np.zeros(n, dtype=np.int64)
+    waves = play_waves(
+        act, lambda n: venvs.setdefault(n, make_venv(n)), episodes, seed, batch,
+        act_on="all", max_steps=max_steps,
+    )  # fmt: skip
+    for wave in waves:
+        n, venv = wave.count, wave.venv
         outcome: list[str] = [""] * n
-        live = np.ones(n, dtype=bool)
-        sword_t = np.full(n, -1, dtype=np.int64)
-        enemy_t = np.full(n, -1, dtype=np.int64)
-        if rgw:
-            optimal = np.asarray(info["optimal_return"], dtype=float).copy()
-            guarded = np.asarray(info["guarded"], dtype=bool).copy()
-            no_sword = _no_sword_best(venv, ~guarded)
-        for t in range(max_steps):
-            actions = np.asarray(act(obs, venv), dtype=np.int64)
-            obs, reward, terminated, truncated, info = venv.step(actions)
-            ret += np.where(live, reward, 0.0)
-            length += live
-            if rgw:
-                _mark_events(info["events"], live, t, sword_t, enemy_t)
-            ended = live & (terminated | truncated)
-            for i in np.flatnonzero(ended).tolist():
-                outcome[i] = outcome_of(venv, info, i, bool(truncated[i]))
-            live &= ~ended
-            if not live.any():
-                break
-        else:
-            raise RuntimeError(
-                f"an episode ran {max_steps} steps without ending; the env has no time limit"
-            )
-        out.returns += ret.tolist()
-        out.lengths += length.tolist()
+        scores = (
+            _LevelScores(venv, wave.info, n) if levels and "optimal_return" in wave.info else None
+        )
+        for step in wave.steps():
+            if scores is not None:
+                scores.mark(step.info["events"], step.live, step.t)
+            for i in step.ended.tolist():
+                outcome[i] = outcome_of(venv, step.info, i, bool(step.truncated[i]))
+        out.returns += wave.returns[:n].tolist()
+        out.lengths += wave.lengths[:n].tolist()
         out.outcomes += outcome
-        if rgw:
-            picked = sword_t >= 0
-            out.optimal_return += optimal.tolist()
-            out.guarded += guarded.tolist()
-            out.took_sword += picked.tolist()
-            out.sword_first += (picked & ((enemy_t < 0) | (sword_t < enemy_t))).tolist()
-            out.no_sword_best += no_sword.tolist()
+        if scores is not None:
+            scores.add_to(out)
         else:
             out.optimal_return += [float("nan")] * n
             out.guarded += [False] * n
@@ -124,6 +105,32 @@ def play_scored(
             out.sword_first += [False] * n
             out.no_sword_best += [float("nan")] * n
     return out
+
+
+class _LevelScores:
+    """One wave's RGW level facts (optimal return, guarded, best without the sword) and sword timing."""
+
+    def __init__(self, venv: Any, info: dict[str, Any], n: int) -> None:
+        self.optimal = np.asarray(info["optimal_return"], dtype=float).copy()
+        self.guarded = np.asarray(info["guarded"], dtype=bool).copy()
+        self.no_sword = _no_sword_best(venv, ~self.guarded)
+        self.sword_t = np.full(n, -1, dtype=np.int64)
+        self.enemy_t = np.full(n, -1, dtype=np.int64)
+
+    def mark(self, events: np.ndarray, live: np.ndarray, t: int) -> None:
+        """Note the live episodes' first sword pick-up and first enemy met at step t."""
+        mask = np.zeros(len(self.sword_t), dtype=bool)
+        mask[live] = True
+        _mark_events(events, mask, t, self.sword_t, self.enemy_t)
+
+    def add_to(self, out: ScoredEpisodes) -> None:
+        """Append the wave's per-episode level figures to ``out``."""
+        picked = self.sword_t >= 0
+        out.optimal_return += self.optimal.tolist()
+        out.guarded += self.guarded.tolist()
+        out.took_sword += picked.tolist()
+        out.sword_first += (picked & ((self.enemy_t < 0) | (self.sword_t < self.enemy_t))).tolist()
+        out.no_sword_best += self.no_sword.tolist()
 
 
 def play_episodes(

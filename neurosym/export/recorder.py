@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.play import Wave, play_waves
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
 from neurosym.seeds import check_seed
@@ -288,6 +289,8 @@ class _Recorder:
         self.model = _Columns()  # model outputs per (episode, t)
         self.step_cols = _Columns()  # steps table
         self.ep_rows: list[tuple[int, int, float, str, int]] = []
+        self._grid = np.zeros((0, 0), dtype=np.int64)  # entity codes before the step being played
+        self._intro: Any = None  # the model's introspection of that step's live states
         self.generator = None
         if not greedy:
             import torch
@@ -302,63 +305,53 @@ class _Recorder:
         A sub-env whose episode ended keeps stepping (the env autoresets it)
         until the wave's longest episode ends; its later steps are not recorded.
         Waves need nothing beyond ``reset(seed=[...])``; the price is idle steps
-        when episode lengths differ within a wave.
+        when episode lengths differ within a wave. The model sees only the live
+        sub-envs (``act_on="live"``): idle ones at a wave's end cost nothing.
         """
-        for start in range(0, self.episodes, self.n):
-            self._wave(start, min(self.n, self.episodes - start))
+        waves = play_waves(
+            self._act, lambda _count: self.venv, self.episodes, self.seed, self.n,
+            act_on="live", max_steps=self.max_steps,
+        )  # fmt: skip
+        for wave in waves:
+            self._wave(wave)
         return self._tables()
 
-    def _wave(self, start: int, count: int) -> None:
+    def _act(self, obs: np.ndarray, venv: Any) -> np.ndarray:
+        """The agent's actions for the live sub-envs' observations; keeps the grid and introspection."""
+        self._grid = venv.entity_grid().reshape(self.n, -1)  # (n, N) entity codes before the step
+        acted, self._intro = self.agent.act(
+            obs, greedy=self.greedy, introspect=True, generator=self.generator
+        )
+        return np.asarray(acted)
+
+    def _wave(self, wave: Wave) -> None:
+        """Record one wave: the reset states, then each live sub-env's steps and states."""
         from neurosym.envs import ACTION_NAMES
 
         action_names = np.asarray(ACTION_NAMES, dtype=object)
-        n, venv = self.n, self.venv
-        episode = np.full(n, -1, dtype=np.int64)  # episode each sub-env plays, -1 idle
-        episode[:count] = start + np.arange(count)
-        t = np.zeros(n, dtype=np.int64)
-        ret = np.zeros(n, dtype=np.float64)
-        seeds = [self.seed + start + i for i in range(n)]
-        obs, info = venv.reset(seed=seeds)
-        for i in range(count):
-            self.trace.state(int(episode[i]), 0, venv.decode_info(info, i))
-        while (live := np.flatnonzero(episode >= 0)).size:
-            grid = venv.entity_grid().reshape(n, -1)[live]  # (m, N) entity codes of the live states
-            # the model sees only the live sub-envs: idle ones at a wave's end cost nothing
-            acted, intro = self.agent.act(
-                obs[live] if live.size < n else obs,
-                greedy=self.greedy,
-                introspect=True,
-                generator=self.generator,
-            )
-            actions = np.zeros(n, dtype=np.int64)  # idle sub-envs step "up"; nothing is recorded
-            actions[live] = np.asarray(acted)
-            self._model_outputs(episode[live], t[live], grid, intro)
-            obs, reward, terminated, truncated, info = venv.step(actions)
+        venv = self.venv
+        for i in range(wave.count):
+            self.trace.state(wave.first + i, 0, venv.decode_info(wave.info, i))
+        for step in wave.steps():
+            live, episode = step.live, step.episodes
+            t = np.full(live.size, step.t, dtype=np.int64)
+            self._model_outputs(episode, t, self._grid[live], self._intro)
             self.step_cols.add(
-                episode=episode[live],
-                t=t[live],
-                action=action_names[actions[live]],
-                reward=reward[live],
+                episode=episode,
+                t=t,
+                action=action_names[step.actions[live]],
+                reward=step.reward[live],
             )
-            ret[live] += reward[live]
-            ended = 0
             for i in live.tolist():
-                d = venv.decode_info(info, i)
-                e, s = int(episode[i]), int(t[i]) + 1
+                d = venv.decode_info(step.info, i)
+                e, s = wave.first + i, step.t + 1
                 self.trace.transition(e, s - 1, d)
                 self.trace.state(e, s, d)
-                if terminated[i] or truncated[i]:
-                    outcome = d["outcome"] or ("timeout" if truncated[i] else "terminal")
-                    self.ep_rows.append((e, s, float(ret[i]), str(outcome), self.seed + e))
-                    episode[i] = -1
-                    ended += 1
-                elif s >= self.max_steps:
-                    raise ConfigError(
-                        f"episode {e} ran {s} steps without ending; the env has no time limit"
-                    )
-            t[live] += 1
-            if ended:
-                self.advance(ended)
+                if step.terminated[i] or step.truncated[i]:
+                    outcome = d["outcome"] or ("timeout" if step.truncated[i] else "terminal")
+                    self.ep_rows.append((e, s, float(wave.returns[i]), str(outcome), self.seed + e))
+            if step.ended.size:
+                self.advance(int(step.ended.size))
 
     def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any) -> None:
         """Keep the live states' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.play import SingleAsBatch, play_waves
 from neurosym.errors import ConfigError
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
@@ -83,36 +84,50 @@ class _Play:
         self.attention: dict[int, np.ndarray] = {}  # MHDPA, kept steps only
         self.focus: list[np.ndarray] = []  # MHDPA, per step (heads,)
         self.object_rows: list[tuple[int, str, str, int, int]] = []
+        self._intro: Any = None  # the model's introspection of the state being acted in
 
     def _grid(self) -> np.ndarray:
         return self.names[np.asarray(self.env.unwrapped.entity_grid())]
 
     def run(self, limit: int) -> None:
-        obs, info = self.env.reset(seed=self.seed)
+        """Play the episode (at most ``limit`` steps) with the shared play loop, as a batch of one."""
+        waves = play_waves(
+            self._act, lambda _count: SingleAsBatch(self.env), 1, self.seed, 1,
+            act_on="live", max_steps=limit, stop_at_limit=True,
+        )  # fmt: skip
+        for wave in waves:
+            self._check_shape(wave.obs[0])
+            action_names = _action_names()
+            self.grids.append(self._grid())
+            self._objects(0, wave.info)
+            for step in wave.steps():
+                self._keep(step.t, self._intro)
+                action = int(step.actions[0])
+                self.actions.append(
+                    action_names[action] if action < len(action_names) else str(action)
+                )
+                self.rewards.append(float(step.reward[0]))
+                self.events.extend((step.t, str(e)) for e in step.info.get("events", ()))
+                self.grids.append(self._grid())
+                self._objects(step.t + 1, step.info)
+                if step.ended.size:
+                    truncated = bool(step.truncated[0])
+                    self.outcome = step.info.get("outcome") or ("timeout" if truncated else None)
+
+    def _act(self, obs: np.ndarray, _venv: Any) -> np.ndarray:
+        """The agent's action for the one observation; keeps its introspection."""
+        acts, self._intro = self.agent.act(
+            obs, greedy=self.greedy, introspect=True, generator=self.generator
+        )
+        return np.asarray(acts).reshape(-1)
+
+    def _check_shape(self, obs: np.ndarray) -> None:
         expected = tuple(self.agent.config.obs_shape)
         if tuple(obs.shape) != expected:
             raise ConfigError(
                 f"{Path(str(self.agent.path)).name} expects observations of shape {expected}, "
                 f"but {self.env_name} gives {tuple(obs.shape)}: pick the environment it was trained on"
             )
-        action_names = _action_names()
-        self.grids.append(self._grid())
-        self._objects(0, info)
-        for t in range(limit):
-            acts, intro = self.agent.act(
-                obs[None], greedy=self.greedy, introspect=True, generator=self.generator
-            )
-            self._keep(t, intro)
-            action = int(np.asarray(acts).reshape(-1)[0])
-            obs, reward, terminated, truncated, info = self.env.step(action)
-            self.actions.append(action_names[action] if action < len(action_names) else str(action))
-            self.rewards.append(float(reward))
-            self.events.extend((t, str(e)) for e in info.get("events", ()))
-            self.grids.append(self._grid())
-            self._objects(t + 1, info)
-            if terminated or truncated:
-                self.outcome = info.get("outcome") or ("timeout" if truncated else None)
-                break
 
     def _objects(self, t: int, info: dict[str, Any]) -> None:
         self.object_rows.extend(
