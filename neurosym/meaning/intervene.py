@@ -46,6 +46,7 @@ ablated head related sword and enemy.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime as _dt
 import functools
@@ -470,159 +471,212 @@ def intervene(
     its own); ``env_kwargs``: options on top of the agent's (every experiment
     plays them, with its own change on top). ``progress``: bars on stderr.
     """
-    import torch
-
-    from neurosym.envs import canonical_name, env_family
-    from neurosym.envs.rgw_maps import load_map
-    from neurosym.export.recorder import _resolve_env, record
-    from neurosym.meaning.features import (
-        ablate_heads,
-        head_means,
-        head_vectors,
-        replay_observations,
-    )
+    from neurosym.envs import env_family
+    from neurosym.export.recorder import _resolve_env
+    from neurosym.meaning.features import head_means, head_vectors, replay_observations
     from neurosym.progress import Stages
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
     name, env_kwargs = _resolve_env(agent, env, env_kwargs)
-    env_kwargs = dict(env_kwargs)
-    family = env_family(name)
-    module = agent.config.module
-    stride = 10 ** len(str(episodes - 1))
-    # one wave per experiment where it fits: waves of the recorder's default 64 leave
-    # the model running on small batches (the cost here is the forward pass per step)
-    batch = batch or min(episodes, 256)
-
-    def play(exp: Experiment, index: int, base_means: dict | None) -> Any:
-        # the change goes in as an env option of the env played (not as the agent's own
-        # options, which another env than the agent's would not carry over)
-        kwargs = env_kwargs
-        if exp.map_text is not None:
-            kwargs = {**env_kwargs, "map": exp.map_text}
-        elif exp.edit is not None:
-            kwargs = {**env_kwargs, "edit": exp.edit}
-        play_one = functools.partial(
-            record, agent, name, episodes, seed, greedy, batch, env_kwargs=kwargs
-        )
-        if exp.ablate:
-            with ablate_heads(agent.model, {h: base_means[h] for h in exp.ablate}):
-                rec = play_one()
-        else:
-            rec = play_one()
-        offset = index * stride
-        for table in TRACE_TABLES:
-            df = getattr(rec, table)
-            df["episode"] = df["episode"] + offset
-        return rec
-
+    run = _Run(agent, name, dict(env_kwargs), env_family(name), episodes, seed, greedy,
+               # one wave per experiment where it fits: waves of the recorder's default 64
+               # leave the model running on small batches (the cost is the forward pass)
+               batch or min(episodes, 256))  # fmt: skip
     with Stages(progress) as stages:
         baseline = Experiment("baseline", "baseline", "unchanged")
-        experiments = [baseline]
         stages.stage("experiment baseline", 1)
-        recs = {"baseline": play(baseline, 0, None)}
-        base_rec = recs["baseline"]
-        saved = torch.get_num_threads()
-        torch.set_num_threads(1)
-        try:
-            base_obs = replay_observations(_shifted(base_rec, 0), name, env_kwargs)
-            base_vec, base_p = head_vectors(agent.model, base_obs)
-            means = head_means(agent.model, base_obs)
-        finally:
-            torch.set_num_threads(saved)
-        skipped: list[tuple[str, str]] = []
-        fixed_map = family == "rgw" and name != "rgw-random"
-        base_text = None
-        if levels and fixed_map:
-            grid_map = load_map(env_kwargs.get("map", name))
-            base_text = grid_map.text()
-            route = np.zeros(grid_map.height * grid_map.width, dtype=bool)
-            agent_pos = base_rec.positions[base_rec.positions["object"] == "agent"]
-            route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
-            found, skipped = level_experiments(grid_map, route)
-            experiments += found
-        elif levels and family == "rgw":  # rgw-random: each episode's own level, changed
-            found, skipped = procedural_experiments(env_kwargs)
-            experiments += found
-        elif levels:
-            skipped.append(
-                ("level_changes", "level changes are RGW-only; Box-World levels are generated")
-            )
+        recs = {"baseline": run.play(baseline, 0, None)}
+        with _one_thread():
+            base_obs = replay_observations(_shifted(recs["baseline"], 0), name, run.env_kwargs)
+            base = _Base(recs["baseline"], base_obs, *head_vectors(agent.model, base_obs),
+                         head_means(agent.model, base_obs), None)  # fmt: skip
+        found, skipped, base.text = _plan_experiments(run, recs["baseline"], levels)
+        experiments = [baseline, *found]
         if ablations:
-            experiments += ablation_experiments(int(agent.config.heads), module)
+            experiments += ablation_experiments(int(agent.config.heads), agent.config.module)
         advance = stages.stage("experiments", len(experiments))
         advance(1)  # the baseline
         for index, exp in enumerate(experiments[1:], start=1):
             stages.describe(f"experiment {exp.id}")
-            recs[exp.id] = play(exp, index, means)
+            recs[exp.id] = run.play(exp, index, base.means)
             advance(1)
         advance = stages.stage("effects at the baseline's states", len(experiments) - 1)
-
-        # measures and effects
-        m_rows, e_rows = [], []
-        base_m = behaviour(base_rec, family)
-        for exp in experiments:
-            m = behaviour(recs[exp.id], family)
-            for key, value in m.items():
-                m_rows.append((exp.id, key, value))
-                if exp.id != "baseline":
-                    e_rows.append((exp.id, key, value - base_m[key]))
-            if exp.id == "baseline":
-                continue
-            torch.set_num_threads(1)
-            try:
-                if exp.ablate:
-                    with ablate_heads(agent.model, {h: means[h] for h in exp.ablate}):
-                        vec, p = head_vectors(agent.model, base_obs)
-                else:
-                    if exp.edit is not None:
-                        obs = matched_procedural_observations(
-                            base_obs, _shifted(base_rec, 0), exp.edit, name, env_kwargs
-                        )
-                    else:
-                        obs = matched_observations(
-                            base_obs, base_text, exp.map_text, name, env_kwargs
-                        )
-                    vec, p = head_vectors(agent.model, obs)
-            finally:
-                torch.set_num_threads(saved)
-            advance(1)
-            e_rows.append((exp.id, "kl", _kl(base_p, p)))
-            diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
-            if module == "predinet":
-                J = int(agent.config.relations)
-                shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
-                for h in range(shift.shape[0]):
-                    for j in range(J):
-                        e_rows.append((exp.id, f"relation_shift({h},{j})", float(shift[h, j])))
-            else:
-                shift = np.linalg.norm(diff, axis=2).mean(axis=0)  # (H,)
-                for h in range(len(shift)):
-                    e_rows.append((exp.id, f"head_shift({h})", float(shift[h])))
-    from neurosym import __version__
-
-    meta = {
-        "checkpoint": str(getattr(agent, "path", "") or ""),
-        "env": canonical_name(name),
-        "module": module,
-        "heads": int(agent.config.heads),
-        "relations": int(agent.config.relations) if module == "predinet" else 0,
-        "episodes": int(episodes),
-        "seed": int(seed),
-        "greedy": bool(greedy),
-        "episode_stride": int(stride),
-        "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
-        "version": __version__,
-    }
+        m_rows, e_rows = _measures(run, experiments, recs, base, advance)
     return InterventionReport(
         experiments=experiments,
         measures=pd.DataFrame(m_rows, columns=["experiment", "measure", "value"]),
         effects=pd.DataFrame(e_rows, columns=["experiment", "measure", "value"]),
-        relates=relates_table(base_rec, module),
+        relates=relates_table(recs["baseline"], agent.config.module),
         recordings=recs,
         skipped=skipped,
-        meta=meta,
+        meta=run.meta(),
     )
+
+
+@contextlib.contextmanager
+def _one_thread() -> Any:
+    """torch on one thread for the head-vector passes (batches of states, many small ops)."""
+    import torch
+
+    saved = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(saved)
+
+
+@dataclasses.dataclass
+class _Base:
+    """The baseline's recording, its observations replayed, head vectors, policy and means."""
+
+    rec: Any
+    obs: Any
+    vec: np.ndarray
+    p: Any
+    means: dict
+    text: str | None  # the fixed map's text (level changes on fixed maps), else None
+
+
+@dataclasses.dataclass
+class _Run:
+    """What every experiment of one call plays: the agent, env, episodes and seeds."""
+
+    agent: Any
+    name: str
+    env_kwargs: dict[str, Any]
+    family: str
+    episodes: int
+    seed: int
+    greedy: bool
+    batch: int
+
+    @property
+    def stride(self) -> int:
+        """Episode ids of experiment i start at i * stride (ids stay apart in one KB)."""
+        return 10 ** len(str(self.episodes - 1))
+
+    def play(self, exp: Experiment, index: int, base_means: dict | None) -> Any:
+        """Record ``exp``: its level change goes in as an option of the env played (not as the
+        agent's own options, which another env than the agent's would not carry over)."""
+        from neurosym.export.recorder import record
+        from neurosym.meaning.features import ablate_heads
+
+        kwargs = self.env_kwargs
+        if exp.map_text is not None:
+            kwargs = {**kwargs, "map": exp.map_text}
+        elif exp.edit is not None:
+            kwargs = {**kwargs, "edit": exp.edit}
+        play_one = functools.partial(
+            record, self.agent, self.name, self.episodes, self.seed, self.greedy, self.batch,
+            env_kwargs=kwargs,
+        )  # fmt: skip
+        if exp.ablate:
+            with ablate_heads(self.agent.model, {h: base_means[h] for h in exp.ablate}):
+                rec = play_one()
+        else:
+            rec = play_one()
+        for table in TRACE_TABLES:
+            df = getattr(rec, table)
+            df["episode"] = df["episode"] + index * self.stride
+        return rec
+
+    def meta(self) -> dict[str, Any]:
+        from neurosym import __version__
+        from neurosym.envs import canonical_name
+
+        module = self.agent.config.module
+        return {
+            "checkpoint": str(getattr(self.agent, "path", "") or ""),
+            "env": canonical_name(self.name),
+            "module": module,
+            "heads": int(self.agent.config.heads),
+            "relations": int(self.agent.config.relations) if module == "predinet" else 0,
+            "episodes": int(self.episodes),
+            "seed": int(self.seed),
+            "greedy": bool(self.greedy),
+            "episode_stride": int(self.stride),
+            "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
+            "version": __version__,
+        }
+
+
+def _plan_experiments(
+    run: _Run, base_rec: Any, levels: bool
+) -> tuple[list[Experiment], list[tuple[str, str]], str | None]:
+    """(level experiments, those skipped with why, the fixed map's text or None)."""
+    from neurosym.envs.rgw_maps import load_map
+
+    if not levels:
+        return [], [], None
+    if run.family == "rgw" and run.name != "rgw-random":
+        grid_map = load_map(run.env_kwargs.get("map", run.name))
+        route = np.zeros(grid_map.height * grid_map.width, dtype=bool)
+        agent_pos = base_rec.positions[base_rec.positions["object"] == "agent"]
+        route[agent_pos["row"].to_numpy() * grid_map.width + agent_pos["col"].to_numpy()] = True
+        found, skipped = level_experiments(grid_map, route)
+        return found, skipped, grid_map.text()
+    if run.family == "rgw":  # rgw-random: each episode's own level, changed
+        found, skipped = procedural_experiments(run.env_kwargs)
+        return found, skipped, None
+    reason = "level changes are RGW-only; Box-World levels are generated"
+    return [], [("level_changes", reason)], None
+
+
+def _measures(
+    run: _Run, experiments: list[Experiment], recs: dict[str, Any], base: _Base, advance: Any
+) -> tuple[list[tuple], list[tuple]]:
+    """(measure rows, effect rows): behaviour of every experiment, and at the baseline's
+    states the change of the policy (kl) and of each head's vectors."""
+    m_rows, e_rows = [], []
+    base_m = behaviour(base.rec, run.family)
+    for exp in experiments:
+        m = behaviour(recs[exp.id], run.family)
+        for key, value in m.items():
+            m_rows.append((exp.id, key, value))
+            if exp.id != "baseline":
+                e_rows.append((exp.id, key, value - base_m[key]))
+        if exp.id == "baseline":
+            continue
+        with _one_thread():
+            vec, p = _vectors_at_base_states(run, exp, base)
+        advance(1)
+        e_rows.append((exp.id, "kl", _kl(base.p, p)))
+        e_rows += _shift_rows(run.agent, exp.id, vec, base.vec)
+    return m_rows, e_rows
+
+
+def _vectors_at_base_states(run: _Run, exp: Experiment, base: _Base) -> tuple[np.ndarray, Any]:
+    """The heads' vectors and the policy under ``exp`` at the baseline's states."""
+    from neurosym.meaning.features import ablate_heads, head_vectors
+
+    model = run.agent.model
+    if exp.ablate:
+        with ablate_heads(model, {h: base.means[h] for h in exp.ablate}):
+            return head_vectors(model, base.obs)
+    if exp.edit is not None:
+        obs = matched_procedural_observations(
+            base.obs, _shifted(base.rec, 0), exp.edit, run.name, run.env_kwargs
+        )
+    else:
+        obs = matched_observations(base.obs, base.text, exp.map_text, run.name, run.env_kwargs)
+    return head_vectors(model, obs)
+
+
+def _shift_rows(agent: Any, exp_id: str, vec: np.ndarray, base_vec: np.ndarray) -> list[tuple]:
+    """How far each head's relations (PrediNet) or vector (MHDPA) moved, on average."""
+    diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
+    if agent.config.module == "predinet":
+        J = int(agent.config.relations)
+        shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
+        return [
+            (exp_id, f"relation_shift({h},{j})", float(shift[h, j]))
+            for h in range(shift.shape[0])
+            for j in range(J)
+        ]
+    norms = np.linalg.norm(diff, axis=2).mean(axis=0)  # (H,)
+    return [(exp_id, f"head_shift({h})", float(norms[h])) for h in range(len(norms))]
 
 
 def _shifted(rec: Any, offset: int) -> Any:
