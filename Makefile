@@ -62,7 +62,7 @@ bench: setup
 	$(PY) bench/meaning.py
 
 lint: setup
-	$(PY) -m ruff check neurosym tests bench examples
+	$(PY) -m ruff check neurosym tests bench examples experiments scripts
 
 clean:
 	rm -rf $(VENV) kb_out runs .pytest_cache
