@@ -31,7 +31,7 @@ test: setup
 
 test-fast: setup
 	@bash scripts/setup_browser.sh
-	$(PY) -m pytest -q -m "not expensive"
+	$(PY) -m pytest -q -m "not expensive and not subprocess"
 
 # One story in three steps (under a minute once set up); `neurosym extract --verbose` prints the full tables.
 NS := $(VENV)/bin/neurosym

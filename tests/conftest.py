@@ -43,3 +43,14 @@ def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
         )  # fmt: skip
 
     return run
+
+
+# Fixtures that start a subprocess (the CLI, training) or a browser: tests using them are left
+# out of `make test-fast` with the ones marked expensive.
+SUBPROCESS_FIXTURES = {"run_neurosym", "neurosym", "browser"}
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        if SUBPROCESS_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.subprocess)
