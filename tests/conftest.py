@@ -48,9 +48,14 @@ def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
 # Fixtures that start a subprocess (the CLI, training) or a browser: tests using them are left
 # out of `make test-fast` with the ones marked expensive.
 SUBPROCESS_FIXTURES = {"run_neurosym", "neurosym", "browser"}
+# modules whose tests start their own subprocesses (a terminal, a fresh venv, a umask, a limit)
+SUBPROCESS_MODULES = {"test_cli_output.py", "test_wheel.py", "test_atomic.py", "test_viz_cli.py",
+                      "test_allocator.py"}  # fmt: skip
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
-        if SUBPROCESS_FIXTURES & set(getattr(item, "fixturenames", ())):
+        if item.path.name in SUBPROCESS_MODULES or SUBPROCESS_FIXTURES & set(
+            getattr(item, "fixturenames", ())
+        ):
             item.add_marker(pytest.mark.subprocess)

@@ -107,6 +107,7 @@ def seeing_predinet(obs_shape: tuple[int, ...]) -> ActorCritic:
     return ActorCritic(cfg)
 
 
+@pytest.mark.expensive
 def test_updates_fit_the_planners_labels() -> None:
     """On a fixed buffer of rgw-random states the imitation loss falls well below its start."""
     torch.manual_seed(0)
@@ -120,6 +121,7 @@ def test_updates_fit_the_planners_labels() -> None:
     assert last < 0.5 * first, (first, last)
 
 
+@pytest.mark.expensive
 def test_augmented_updates_fit_the_turned_levels_too() -> None:
     """--augment: fitted on random turns and mirrors, the network also knows the levels turned;
     fitted on the levels as they come, it knows them less well."""

@@ -163,6 +163,7 @@ def test_env_defaults_to_the_checkpoints(run_neurosym, checkpoint: Path, tmp_pat
     assert (out / "kb.pl").is_file()
 
 
+@pytest.mark.subprocess
 def test_example_script_runs(checkpoint: Path, tmp_path: Path) -> None:
     """examples/extract_and_query.py goes from a checkpoint to rule answers."""
     import os

@@ -258,6 +258,7 @@ def test_ctrl_c_stops_any_goal_with_130_and_one_line(tmp_path: Path) -> None:
     assert err == "neurosym query: interrupted\n"
 
 
+@pytest.mark.subprocess
 def test_a_closed_pipe_ends_quietly(tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("".join(f"ok({i}).\n" for i in range(20000)))

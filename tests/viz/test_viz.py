@@ -324,6 +324,7 @@ def test_route_dots_the_teleport_jump(pn: Recording) -> None:
 # ---------------------------------------------------------------- bytes
 
 
+@pytest.mark.expensive
 def test_outputs_are_byte_identical_and_carry_no_timestamps(
     pn: Recording, mh: Recording, tmp_path
 ) -> None:
