@@ -214,49 +214,16 @@ def record(
     try:
         if threads is not None:
             torch.set_num_threads(threads)
-        with _progress_bar(progress, episodes) as advance:
+        from neurosym.progress import Stages
+
+        with Stages(progress) as stages:
+            advance = stages.stage("recording", episodes)
             rec = _Recorder(agent, venv, episodes, seed, greedy, top_keys, max_steps, advance).run()
     finally:
         torch.set_num_threads(saved_threads)
         venv.close()
     rec.meta.update(_meta(agent, name, seed, greedy, kwargs))
     return rec
-
-
-class _progress_bar:
-    """Context manager yielding ``advance(k)``; a rich bar on stderr when enabled."""
-
-    def __init__(self, enabled: bool, total: int) -> None:
-        self.enabled, self.total = enabled, total
-        self._progress: Any = None
-
-    def __enter__(self) -> Callable[[int], None]:
-        if not self.enabled:
-            return lambda k: None
-        from rich.console import Console
-        from rich.progress import (
-            BarColumn,
-            MofNCompleteColumn,
-            Progress,
-            TextColumn,
-            TimeElapsedColumn,
-        )
-
-        self._progress = Progress(
-            TextColumn("recording"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=Console(stderr=True),
-            transient=True,
-        )
-        self._progress.start()
-        task = self._progress.add_task("episodes", total=self.total)
-        return lambda k: self._progress.advance(task, k)
-
-    def __exit__(self, *exc: object) -> None:
-        if self._progress is not None:
-            self._progress.stop()
 
 
 def _by_episode(df: pd.DataFrame) -> pd.DataFrame:
