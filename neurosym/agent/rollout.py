@@ -100,7 +100,8 @@ class Rollout(NamedTuple):
     """n steps of K envs; tensors are (T, K) unless noted."""
 
     obs: torch.Tensor
-    """(T, K, C, H, W) uint8: the observation each action was taken in"""
+    """(T, K, C, H, W) uint8: the observation each action was taken in (on the acting
+    device when that is a GPU, else on the CPU)"""
     last_obs: torch.Tensor
     """(K, C, H, W) uint8: the observation after the last step (the bootstrap)"""
     actions: torch.Tensor
@@ -156,8 +157,11 @@ def collect_rollout(
     acting logits and values without a graph (PPO's behaviour policy).
     ``device``: where the model lives (observations go there, actions are
     drawn on the CPU so that the generator's stream is the same on any device);
-    the recorded logits and values stay there, the rest of the rollout is on the CPU.
+    the recorded logits and values stay there, and on a GPU the observations
+    too (the update reads them there: no second copy of the whole rollout
+    through the host); the rest of the rollout is on the CPU.
     """
+    on_device = device is not None and device.type != "cpu"
     venv, tracker = state.venv, state.tracker
     obs_t, actions_t, rewards, terms, truncs, valids = [], [], [], [], [], []
     logits_t, values_t = [], []
@@ -169,9 +173,9 @@ def collect_rollout(
         for _ in range(n_steps):
             with torch.set_grad_enabled(keep_graph):
                 obs_in = torch.from_numpy(state.obs)
-                logits, value = model(
-                    obs_in if device is None else obs_in.to(device)
-                )  # (K, A), (K,)
+                if device is not None:
+                    obs_in = obs_in.to(device)
+                logits, value = model(obs_in)  # (K, A), (K,)
             if keep_graph or record:
                 logits_t.append(logits)
                 values_t.append(value)
@@ -184,7 +188,7 @@ def collect_rollout(
                 memory.step(state.obs, actions, reward, valid, terminated | truncated)
             if bonus is not None:
                 reward = reward + bonus(obs, valid)
-            obs_t.append(state.obs)
+            obs_t.append(obs_in if on_device else state.obs)
             actions_t.append(actions)
             rewards.append(reward)
             terms.append(terminated)
@@ -192,7 +196,7 @@ def collect_rollout(
             valids.append(valid)
             state.obs = np.ascontiguousarray(obs)
     rollout = Rollout(
-        obs=torch.from_numpy(np.stack(obs_t)),
+        obs=torch.stack(obs_t) if on_device else torch.from_numpy(np.stack(obs_t)),
         last_obs=torch.from_numpy(state.obs),
         actions=torch.from_numpy(np.stack(actions_t).astype(np.int64)),
         rewards=torch.from_numpy(np.stack(rewards).astype(np.float32)),
