@@ -2,14 +2,13 @@
 
 Builds the PPO learner's pieces in this process (model, optimiser, batched
 env, the same ``collect_rollout`` and ``ppo_update`` as ``neurosym train
---algo ppo``), warms up, then times ``--updates`` rollout+update cycles for
-each ``--precision``, synchronising the device around each phase. Prints one
-JSON object per precision: seconds per cycle split into env steps, the rest of
-acting (forwards, action draws, transfers), the update; and frames/s. With
-``--trace FILE`` it also writes torch.profiler's table of one cycle's ops
-(sorted by device time) for the last precision.
+--algo ppo``), warms up, then times ``--updates`` rollout+update cycles,
+synchronising the device around each phase. Prints one JSON object: seconds
+per cycle split into env steps, the rest of acting (forwards, action draws,
+transfers), the update; and frames/s. With ``--trace FILE`` it also writes
+torch.profiler's table of one more cycle's ops (sorted by device time).
 
-    python bench/ppo_profile.py --env bw1 --envs 512 --device cuda --precision fp32 tf32 bf16
+    python bench/ppo_profile.py --env bw1 --envs 512 --device cuda --trace trace.txt
     python bench/ppo_profile.py --env bw1 --envs 16 --n-steps 16 --updates 1   # CPU smoke run
 """
 
@@ -19,7 +18,6 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +27,6 @@ sys.path.insert(0, str(ROOT))
 import torch  # noqa: E402
 
 from neurosym.agent.config import ModelConfig, TrainConfig  # noqa: E402
-from neurosym.agent.learners import precision  # noqa: E402
 from neurosym.agent.learners.optimizers import shared_optimizer  # noqa: E402
 from neurosym.agent.learners.ppo import ppo_update  # noqa: E402
 from neurosym.agent.networks.model import ActorCritic  # noqa: E402
@@ -75,18 +72,17 @@ def cycle(parts: dict[str, Any], config: TrainConfig, device: torch.device) -> d
     return {"env_s": env.seconds, "acting_other_s": t1 - t0 - env.seconds, "update_s": t2 - t1}
 
 
-def build(args: argparse.Namespace, mode: str, device: torch.device) -> tuple[dict, TrainConfig]:
+def build(args: argparse.Namespace, device: torch.device) -> tuple[dict, TrainConfig]:
     name, family, shape, scale = probe_env(args.env, {})
     model_config = ModelConfig.for_family(family, args.module, shape, scale)
     config = TrainConfig.for_family(family, algo="ppo", envs=args.envs, n_steps=args.n_steps)
-    config = replace(config, learner=replace(config.learner, precision=mode))
     torch.manual_seed(0)
     local = ActorCritic(model_config).to(device)
     opt = shared_optimizer(local.parameters(), config)
     env = TimedEnv(make_batched(name, args.envs, seed=0))
     parts = {
-        "model": precision.apply(local, mode, device),
-        "acting": precision.apply(local, mode, device),
+        "model": local,
+        "acting": local,
         "opt": opt,
         "env": env,
         "state": RolloutState(env, 0),
@@ -102,24 +98,20 @@ def main() -> None:
     p.add_argument("--envs", type=int, default=512)
     p.add_argument("--n-steps", type=int, default=128)
     p.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
-    p.add_argument("--precision", nargs="+", default=["fp32"], choices=("fp32", "tf32", "bf16"))
-    p.add_argument("--updates", type=int, default=3, help="timed cycles per precision")
+    p.add_argument("--updates", type=int, default=3, help="timed cycles")
     p.add_argument("--trace", type=Path, help="write the profiler's op table of one cycle here")
     args = p.parse_args()
     device = torch.device(args.device)
-    for mode in args.precision:
-        torch.backends.cuda.matmul.allow_tf32 = False  # each precision starts from fp32
-        parts, config = build(args, mode, device)
-        cycle(parts, config, device)  # warm-up: allocator, cuDNN's algorithm search
-        times = [cycle(parts, config, device) for _ in range(args.updates)]
-        mean = {k: sum(t[k] for t in times) / len(times) for k in times[0]}
-        total = sum(mean.values())
-        frames = args.envs * args.n_steps
-        row = {"env": args.env, "module": args.module, "envs": args.envs,
-               "n_steps": args.n_steps, "device": str(device), "precision": precision.effective(mode, device),
-               **{k: round(v, 4) for k, v in mean.items()},
-               "cycle_s": round(total, 4), "frames_per_s": round(frames / total)}  # fmt: skip
-        print(json.dumps(row), flush=True)
+    parts, config = build(args, device)
+    cycle(parts, config, device)  # warm-up: allocator, cuDNN's algorithm search
+    times = [cycle(parts, config, device) for _ in range(args.updates)]
+    mean = {k: sum(t[k] for t in times) / len(times) for k in times[0]}
+    total = sum(mean.values())
+    frames = args.envs * args.n_steps
+    row = {"env": args.env, "module": args.module, "envs": args.envs, "n_steps": args.n_steps,
+           "device": str(device), **{k: round(v, 4) for k, v in mean.items()},
+           "cycle_s": round(total, 4), "frames_per_s": round(frames / total)}  # fmt: skip
+    print(json.dumps(row), flush=True)
     if args.trace is not None:
         from torch.profiler import ProfilerActivity, profile
 

@@ -50,7 +50,7 @@ def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
 SUBPROCESS_FIXTURES = {"run_neurosym", "neurosym", "browser"}
 # modules whose tests start their own subprocesses (a terminal, a fresh venv, a umask, a limit)
 SUBPROCESS_MODULES = {"test_cli_output.py", "test_wheel.py", "test_atomic.py", "test_viz_cli.py",
-                      "test_allocator.py"}  # fmt: skip
+                      "test_allocator.py", "test_gpu_resume.py"}  # fmt: skip
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

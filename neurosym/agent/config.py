@@ -50,7 +50,6 @@ PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
-PRECISIONS = ("fp32", "tf32", "bf16")
 INITS = ("orthogonal", "torch")
 QUERIES = ("scene", "learned")
 KEYS = ("entities", "cells")
@@ -368,16 +367,10 @@ class PPOConfig:
     (SB3, CleanRL); "running" divides each rollout's by a running RMS of the advantages seen so
     far (A3C's), so that a rollout without reward keeps its small advantages small"""
 
-    precision: str = "fp32"
-    """arithmetic of the forward and backward passes on a CUDA device: "fp32"; "tf32" (TF32
-    matrix products and convolutions); "bf16" (bf16 autocast, losses in fp32). A CPU learner
-    always runs fp32, so a run keeps its setting when it resumes on another machine."""
-
     def __post_init__(self) -> None:
         _check_positive(self, "ppo_epochs", "ppo_minibatches", integer=True)
         _check_positive(self, "clip_range")
         _check_choice(self, "ppo_advantages", PPO_ADVANTAGES)
-        _check_choice(self, "precision", PRECISIONS)
 
 
 @dataclass(frozen=True)

@@ -260,30 +260,3 @@ def test_a3c_loss_with_normalised_advantages_pushes_both_ways() -> None:
     loss.backward()
     # descent raises pi(2 | obs 1) and lowers the others
     assert model.logits.grad[1, 2] < 0 and (model.logits.grad[1, [0, 1, 3]] > 0).all()
-
-
-def test_ppo_precision_is_checked_and_runs_fp32_on_the_cpu() -> None:
-    from neurosym.agent.learners import precision
-
-    with pytest.raises(ConfigError, match="unknown precision 'fp16'; expected one of fp32, tf32, bf16"):
-        PPOConfig(precision="fp16")
-    model = torch.nn.Linear(2, 2)
-    cpu = torch.device("cpu")
-    for mode in ("fp32", "tf32", "bf16"):
-        assert precision.effective(mode, cpu) == "fp32"
-        assert precision.apply(model, mode, cpu) is model  # no autocast wrapper on the CPU
-    assert precision.effective("bf16", torch.device("cuda", 0)) == "bf16"
-
-
-def test_bf16_autocast_wrapper_hands_back_fp32_and_hides_module() -> None:
-    """The wrapper's outputs are fp32 (the losses stay fp32) and it is not taken for DDP's."""
-    from neurosym.agent.learners.precision import Autocast
-
-    class Pair(torch.nn.Module):
-        def forward(self, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-            return x.to(torch.bfloat16), x.sum(-1).to(torch.bfloat16)
-
-    wrapped = Autocast(Pair())
-    logits, value = wrapped(torch.ones(3, 4))
-    assert logits.dtype == value.dtype == torch.float32
-    assert getattr(wrapped, "module", None) is None

@@ -39,7 +39,7 @@ import torch
 import torch.nn.functional as F
 
 from neurosym.agent.config import TrainConfig
-from neurosym.agent.learners import distributed, precision
+from neurosym.agent.learners import distributed
 from neurosym.agent.learners.exploration import CountBonus
 from neurosym.agent.learners.messages import LossStats, Stopped
 from neurosym.agent.learners.optimizers import copy_into_shared, private_copy
@@ -184,8 +184,6 @@ def ppo_learner(ctx: LearnerContext) -> None:
         model: torch.nn.Module = local
         if world.distributed:
             model = _join_group(ctx, local, local_opt, dev)
-        acting = precision.apply(local, config.ppo.precision, dev)
-        model = precision.apply(model, config.ppo.precision, dev)
         venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
         state = RolloutState(venv, ctx.env_seed)
         scale = AdvantageScale()  # used when ppo_advantages is "running"
@@ -200,7 +198,7 @@ def ppo_learner(ctx: LearnerContext) -> None:
             if halt:
                 break
             rollout, finished = collect_rollout(
-                acting, state, config.n_steps, generator, bonus, record=True, device=dev
+                local, state, config.n_steps, generator, bonus, record=True, device=dev
             )
             stats = ppo_update(model, local_opt, rollout, config, generator, scale)
             copy_into_shared(local, local_opt, ctx.shared, ctx.optimizer)

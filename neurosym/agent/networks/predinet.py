@@ -81,11 +81,6 @@ class QueryRecord(NamedTuple):
     parts: list[torch.Tensor]
 
 
-AUTOCAST_DEVICE = "cuda"
-"""the device type whose autocast (a PPO learner's bf16 precision) the backward below
-replays, so that its products see the dtypes the forward saved"""
-
-
 class PrediNetAttention(torch.autograd.Function):
     """(L, W_Q1|W_Q2, W_K, scale[, known first rows of Q]) -> attentions a (B, 2H, N), attended
     entities e (B, 2H, F) and the queries Q (B, 2H D; no gradient flows back through this output).
@@ -101,7 +96,6 @@ class PrediNetAttention(torch.autograd.Function):
     """
 
     @staticmethod
-    @torch.amp.custom_fwd(device_type=AUTOCAST_DEVICE)
     def forward(ctx, L, w_q, w_k, scale, q_head=None, q_learned=None):  # type: ignore[override]
         B, N, F = L.shape
         D = w_k.shape[0]
@@ -124,7 +118,6 @@ class PrediNetAttention(torch.autograd.Function):
         return a, e, q_flat
 
     @staticmethod
-    @torch.amp.custom_bwd(device_type=AUTOCAST_DEVICE)
     def backward(ctx, g_a, g_e, _g_q):  # type: ignore[override]
         L, w_q, w_k, q, qk, a = ctx.saved_tensors
         B, N, F = L.shape
