@@ -4,7 +4,10 @@ For each environment: the single env (gymnasium.make, wrappers included); the
 batched env with n = 1, 64, 1024, 4096 (``copy=True``, the default, returns a
 fresh observation array per step; ``copy=False`` hands out the internal buffer,
 RGW only); and a naive Python loop over n single envs. Actions are uniformly
-random; episodes reset when they end (the batched envs autoreset).
+random; episodes reset when they end (the batched envs autoreset). ``tracked``:
+the batched env of 512 with episodes cut at 16 steps (a trained agent's pace)
+stepped through the learners' ``EpisodeTracker``, which names each ended
+episode's outcome.
 
 Figures are steps per second of wall time and of this thread's CPU time (the
 latter is less disturbed by other processes on a shared machine). The first
@@ -150,6 +153,25 @@ def emit(env: str, mode: str, n: int, result: tuple[int, float, float], **extra)
     print(json.dumps(row), flush=True)
 
 
+def tracked(name: str, n: int, seconds: float) -> tuple[int, float, float]:
+    from neurosym.agent.rollout import EpisodeTracker
+
+    env = make_batched(name, n, seed=0, max_steps=16)
+    env.reset()
+    tracker = EpisodeTracker(n)
+    actions = np.random.default_rng(0).integers(0, 4, (64, n))
+    k = [0]
+
+    def chunk() -> int:
+        for _ in range(8):
+            _, reward, terminated, truncated, info = env.step(actions[k[0] % 64])
+            tracker.step(env, reward, terminated, truncated, info)
+            k[0] += 1
+        return 8 * n
+
+    return timed(chunk, seconds)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--envs", default="rgw2,rgw-random,bw1", help="Comma-separated short names.")
@@ -187,6 +209,7 @@ def main(argv: list[str] | None = None) -> int:
         rgw = env_family(name) == "rgw"
         emit(name, "single", 1, single(name, args.seconds))
         emit(name, "naive_loop", args.naive_n, naive_loop(name, args.naive_n, args.seconds))
+        emit(name, "tracked", 512, tracked(name, 512, args.seconds), max_steps=16)
         for n in sizes:
             emit(name, "batched", n, batched(name, n, args.seconds), copy=True)
             if rgw:

@@ -29,7 +29,7 @@ from neurosym.envs.boxworld_gen import (
     seed_keys,
 )
 from neurosym.envs.boxworld_render import DEFAULT_TILE, ansi_text, rgb_frame
-from neurosym.envs.boxworld_rules import OBS_MODES, BoxWorldState, decode_info
+from neurosym.envs.boxworld_rules import OBS_MODES, OUTCOMES, BoxWorldState, decode_info
 from neurosym.errors import ConfigError
 
 __all__ = [
@@ -363,6 +363,10 @@ class BoxWorldVectorEnv(VectorEnv):
     def decode_info(self, info: dict[str, Any], i: int) -> dict[str, Any]:
         """The dict :class:`BoxWorldEnv` would give for sub-environment ``i``."""
         return decode_info(info, i)
+
+    def episode_outcome(self, info: dict[str, Any], i: int) -> str | None:
+        """``decode_info(info, i)["outcome"]`` without building the rest of that dict."""
+        return OUTCOMES[int(info["outcome"][i])]
 
     def entity_grid(self) -> np.ndarray:
         """(n, 14, 14) entity codes of the current states; names in ``entity_names``."""

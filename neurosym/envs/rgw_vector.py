@@ -259,6 +259,10 @@ class RGWVectorEnv(VectorEnv):
             **LevelInfo(*(info[k] for k in LEVEL_KEYS)).row(i),
         }
 
+    def episode_outcome(self, info: dict[str, Any], i: int) -> str | None:
+        """``decode_info(info, i)["outcome"]`` without building the rest of that dict."""
+        return rules.outcome_name(int(info["events"][i]), bool(info["truncated"][i]))
+
     def _level_objects(self, i: int, seed: int, episode: int) -> LevelObjects:
         """Objects of level (seed, episode): from sub-env i's cells while it plays it, else regenerated."""
         key = (seed, episode)
