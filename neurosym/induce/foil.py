@@ -27,7 +27,8 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from collections import Counter
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -76,8 +77,15 @@ class Clause:
     body: tuple[Literal, ...]
 
     def text(self) -> str:
-        positive = [lit for lit in self.body if not lit.negated]
-        negative = [lit for lit in self.body if lit.negated]
+        """The clause as Prolog text; a variable that occurs once is written ``_``."""
+        uses = Counter(lit.named_var for lit in self.body if lit.named_var)
+        uses.update([HEAD_VAR] if head_var(self.head) else [])
+        body = [
+            lit if not lit.named_var or uses[lit.named_var] > 1 else replace(lit, var="_")
+            for lit in self.body
+        ]
+        positive = [lit for lit in body if not lit.negated]
+        negative = [lit for lit in body if lit.negated]
         positive.sort(key=lambda lit: lit.pred not in CELL_PREDICATES)  # bind E, T through step/4
         goals = [lit.text() for lit in positive + negative]
         if not any(lit.pred in CELL_PREDICATES for lit in positive):
@@ -167,10 +175,9 @@ def _candidates(
     for pred in bias.predicates:
         for value in g.constants(pred):
             out += [Literal(pred, value), Literal(pred, value, negated=True)]
-        for f in g.functors(pred):
-            for var in [*bound, "_"]:
-                out += [Literal(pred, f, f, var), Literal(pred, f, f, var, negated=True)]
-            out += [Literal(pred, f, f, var) for var in fresh]
+        for f in g.functors(pred):  # on equal gain a variable wins over `_` (it can link later)
+            out += [Literal(pred, f, f, var) for var in [*bound, *fresh, "_"]]
+            out += [Literal(pred, f, f, var, negated=True) for var in [*bound, "_"]]
     if has_var and HEAD_VAR not in bound:  # the first literal binds the head's colour
         out = [lit for lit in out if lit.var == HEAD_VAR]
     return [lit for lit in out if lit not in body]

@@ -59,6 +59,8 @@ class WorldRules:
     bias: Bias
     scores: dict[str, EventScore]
     seconds: float
+    """learning time: grounding the KB (load and background answers) plus the search"""
+    ground_seconds: float = 0.0
     holdout: str | None = None
     holdout_episodes: int | None = None
     notes: list[str] = field(default_factory=list)
@@ -111,6 +113,7 @@ def induce_world(
     bias = bias or Bias()
     start = time.perf_counter()
     g = ground(kb)
+    grounded = time.perf_counter() - start
     scores: dict[str, EventScore] = {}
     for template in VOCABULARY[g.family]:
         n_pos = len(positives(g, template))
@@ -127,7 +130,9 @@ def induce_world(
         else:
             scores[template] = EventScore(template, "determined", "", clauses, n, p, r)
     seconds = time.perf_counter() - start
-    rules = WorldRules(str(kb), g.env, g.family, g.n_episodes, g.n_states, bias, scores, seconds)
+    rules = WorldRules(
+        str(kb), g.env, g.family, g.n_episodes, g.n_states, bias, scores, seconds, grounded
+    )
     if holdout is not None:
         h = ground(holdout)
         rules.holdout, rules.holdout_episodes = str(holdout), h.n_episodes
