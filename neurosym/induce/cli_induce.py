@@ -50,8 +50,10 @@ def run(args: argparse.Namespace) -> int:
 
 def run_world(args: argparse.Namespace) -> int:
     """Learn world rules, print them with their scores, write them."""
+    from neurosym.atomic import check_target
     from neurosym.induce.world import induce_world
 
+    check_target(args.out)  # refused before the learning, not after
     rules = induce_world(args.kb, holdout=args.holdout)
     out = rules.write(args.out)
     print(

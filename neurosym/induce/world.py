@@ -71,10 +71,11 @@ class WorldRules:
 
     def write(self, path: str | os.PathLike[str]) -> Path:
         """Write the rules as a self-contained Prolog file (atomically)."""
-        from neurosym.atomic import atomic_write
+        from neurosym.atomic import atomic_write, make_folder
 
         text = render(self)
         path = Path(path)
+        make_folder(path.parent)
         atomic_write(path, lambda p: Path(p).write_text(text))
         return path
 
