@@ -57,7 +57,7 @@ def test_without_holdout_only_train_scores(run_neurosym, kbs, tmp_path: Path) ->
         ),
         (
             ["--kb", "KB", "--what", "rules"],
-            "neurosym induce: error: --what 'rules' is not one of world",
+            "neurosym induce: error: --what 'rules' is not one of ",
         ),
         (
             ["--kb", "EMPTY", "--what", "world"],
