@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from neurosym.errors import ConfigError
 from neurosym.induce.background import BACKGROUND, VOCABULARY
 from neurosym.induce.examples import Grounded, ground
 from neurosym.induce.foil import Bias, Clause, evaluate, head_var, learn, positives
@@ -136,6 +137,11 @@ def induce_world(
     )
     if holdout is not None:
         h = ground(holdout)
+        if h.family != g.family:
+            raise ConfigError(
+                f"held-out KB {holdout} is a {h.family} KB; the rules learned from {kb} are "
+                f"{g.family} rules: give a held-out KB of the same env family"
+            )
         rules.holdout, rules.holdout_episodes = str(holdout), h.n_episodes
         for template, sc in scores.items():
             if sc.status == "determined":

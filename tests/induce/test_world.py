@@ -129,3 +129,12 @@ def test_a_kb_without_steps_or_events_is_one_line_error(tmp_path: Path) -> None:
         induce_world(quiet)
     with pytest.raises(ConfigError, match=r"does not exist"):
         induce_world(tmp_path / "missing.pl")
+
+
+def test_a_held_out_kb_of_another_env_family_is_refused(kbs: tuple, tmp_path: Path) -> None:
+    env, train, _ = kbs
+    other = "bw2" if env == "rgw-random" else "rgw-random"
+    rec = record(small_agent(other), other, 8, actions="random", env_kwargs={"max_steps": 300})
+    path = extract_facts(rec).to_prolog(tmp_path / "other.pl")
+    with pytest.raises(ConfigError, match=r"held-out KB .* is a (boxworld|rgw) KB; the rules"):
+        induce_world(train, holdout=path)
