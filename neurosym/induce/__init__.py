@@ -1,0 +1,30 @@
+"""Rules learned back from knowledge bases (``neurosym induce``).
+
+* :func:`induce_world` (:mod:`neurosym.induce.world`): ``predicts(E, T, Event)``
+  clauses per event of the env's vocabulary, as :class:`WorldRules`
+  (``.scores``, ``.clauses``, ``.write(path)``).
+
+Names are imported on first use, so ``neurosym induce`` imports neither
+torch nor the envs.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_LAZY = {
+    "induce_world": "neurosym.induce.world",
+    "WorldRules": "neurosym.induce.world",
+    "EventScore": "neurosym.induce.world",
+    "Bias": "neurosym.induce.foil",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'neurosym.induce' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)

@@ -1,0 +1,202 @@
+"""World rules learned back from a KB: ``predicts(E, T, Event)`` clauses per event.
+
+>>> rules = induce_world("kb_out/rgw-random/kb.pl", holdout="kb_out/held/kb.pl")
+>>> rules.scores["picked(sword)"].holdout_precision
+1.0
+>>> rules.write("world.pl")
+
+An event of the env's vocabulary is *determined* when the KB shows it and
+the clauses found cover every one of its training examples and no
+counter-example; otherwise it is *undetermined* (no positive example, or
+examples no clause of the bias separates) and is written as a comment,
+not guessed.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from neurosym.errors import ConfigError
+from neurosym.induce.background import BACKGROUND, VOCABULARY
+from neurosym.induce.examples import Grounded, ground
+from neurosym.induce.foil import Bias, Clause, evaluate, head_var, learn, positives
+
+
+@dataclass
+class EventScore:
+    """One event's clauses and scores (precision/recall None where there is nothing to divide)."""
+
+    event: str
+    status: str  # "determined" or "undetermined"
+    reason: str
+    clauses: list[Clause]
+    train_examples: int
+    train_precision: float | None
+    train_recall: float | None
+    holdout_examples: int | None = None
+    holdout_precision: float | None = None
+    holdout_recall: float | None = None
+
+    @property
+    def solved(self) -> bool:
+        """IGGP's "solved perfectly": precision and recall 1.0 on held-out data."""
+        return self.holdout_precision == 1.0 and self.holdout_recall == 1.0
+
+
+@dataclass
+class WorldRules:
+    """The learned clauses per event, their scores, and where they were learned from."""
+
+    kb: str
+    env: str
+    family: str
+    episodes: int
+    states: int
+    bias: Bias
+    scores: dict[str, EventScore]
+    seconds: float
+    """learning time: grounding the KB (load and background answers) plus the search"""
+    ground_seconds: float = 0.0
+    holdout: str | None = None
+    holdout_episodes: int | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def clauses(self) -> list[Clause]:
+        return [c for s in self.scores.values() if s.status == "determined" for c in s.clauses]
+
+    def write(self, path: str | os.PathLike[str]) -> Path:
+        """Write the rules as a self-contained Prolog file (atomically)."""
+        from neurosym.atomic import atomic_write, make_folder
+
+        text = render(self)
+        path = Path(path)
+        make_folder(path.parent)
+        atomic_write(path, lambda p: Path(p).write_text(text))
+        return path
+
+
+def _ratio(num: int, den: int) -> float:
+    """num / den, 1.0 when den is 0 (nothing predicted: no false positive; nothing to find)."""
+    return num / den if den else 1.0
+
+
+def score(
+    g: Grounded, template: str, clauses: list[Clause]
+) -> tuple[int, float | None, float | None]:
+    """(examples, precision, recall) of ``clauses`` for ``template`` on ``g``."""
+    has_var = head_var(template)
+    pos = positives(g, template)
+    parts = [evaluate(g, c.body, has_var) for c in clauses]
+    pred = np.unique(np.concatenate(parts)) if parts else np.zeros(0, np.int64)
+    if has_var and len(g.colours) == 0:
+        pred = np.zeros(0, np.int64)
+    tp = int(np.isin(pred, pos).sum())
+    return len(pos), _ratio(tp, len(pred)), _ratio(tp, len(pos))
+
+
+def induce_world(
+    kb: str | os.PathLike[str],
+    *,
+    holdout: str | os.PathLike[str] | None = None,
+    bias: Bias | None = None,
+) -> WorldRules:
+    """Learn ``predicts/3`` clauses for every event of the KB's env vocabulary it shows.
+
+    ``holdout``: a KB of other episodes to score the clauses on (precision,
+    recall, "solved perfectly"). Learning time (``seconds``) counts grounding
+    the training KB and the search, not the held-out scoring.
+    """
+    bias = bias or Bias()
+    start = time.perf_counter()
+    g = ground(kb)
+    grounded = time.perf_counter() - start
+    scores: dict[str, EventScore] = {}
+    for template in VOCABULARY[g.family]:
+        n_pos = len(positives(g, template))
+        if n_pos == 0:
+            scores[template] = EventScore(
+                template, "undetermined", "no positive example in the KB", [], 0, None, None
+            )
+            continue
+        clauses, left = learn(g, template, bias)
+        n, p, r = score(g, template, clauses)
+        if left or p != 1.0:
+            reason = f"{left} of {n_pos} examples separated by no clause of the bias"
+            scores[template] = EventScore(template, "undetermined", reason, clauses, n, p, r)
+        else:
+            scores[template] = EventScore(template, "determined", "", clauses, n, p, r)
+    seconds = time.perf_counter() - start
+    rules = WorldRules(
+        str(kb), g.env, g.family, g.n_episodes, g.n_states, bias, scores, seconds, grounded
+    )
+    if holdout is not None:
+        h = ground(holdout)
+        if h.family != g.family:
+            raise ConfigError(
+                f"held-out KB {holdout} is a {h.family} KB; the rules learned from {kb} are "
+                f"{g.family} rules: give a held-out KB of the same env family"
+            )
+        rules.holdout, rules.holdout_episodes = str(holdout), h.n_episodes
+        for template, sc in scores.items():
+            if sc.status == "determined":
+                sc.holdout_examples, sc.holdout_precision, sc.holdout_recall = score(
+                    h, template, sc.clauses
+                )
+            else:
+                sc.holdout_examples = len(positives(h, template))
+    return rules
+
+
+def _fmt(x: float | None) -> str:
+    return "-" if x is None else f"{x:.3f}"
+
+
+def render(rules: WorldRules) -> str:
+    """The learned file: PlDoc header, clauses, undetermined events as comments, background."""
+    b = rules.bias
+    lines = [
+        "/** <module> World rules learned from recorded facts (neurosym induce --what world)",
+        "",
+        "predicts(E, T, Event) holds when the step of state T of episode E has event Event.",
+        "Load beside a KB of the same schema (step/4, at/5, object/2, holding/3, terrain/4,",
+        "grid/3): `swipl kb.pl world.pl`.",
+        "",
+        f"Learned from: {rules.kb} (env {rules.env or '?'}, {rules.episodes} episodes, "
+        f"{rules.states} acted states) in {rules.seconds:.1f} s.",
+        f"Learner: FOIL-style clause search (neurosym.induce.foil), max_literals={b.max_literals}, "
+        f"max_new_vars={b.max_new_vars}, max_clauses={b.max_clauses},",
+        f"body predicates {', '.join(b.predicates)} (defined at the end of this file).",
+    ]
+    if rules.holdout:
+        lines.append(f"Held out: {rules.holdout} ({rules.holdout_episodes} episodes).")
+    lines += ["", "Scores (train precision/recall; held-out precision/recall):", ""]
+    for sc in rules.scores.values():
+        lines.append(f"  - {sc.event}: {_describe(sc)}")
+    lines += ["*/", "", ":- discontiguous predicts/3.", ""]
+    for sc in rules.scores.values():
+        if sc.status == "determined":
+            lines.append(f"% {sc.event}: {sc.train_examples} training examples")
+            lines += [c.text() for c in sc.clauses]
+        else:
+            lines.append(f"% undetermined: {sc.event}: {sc.reason}")
+            lines += ["%   " + line for c in sc.clauses for line in c.text().splitlines()]
+        lines.append("")
+    lines.append("% ---- background predicates (neurosym.induce.background) ----")
+    lines.append(BACKGROUND.strip())
+    return "\n".join(lines) + "\n"
+
+
+def _describe(sc: EventScore) -> str:
+    if sc.status != "determined":
+        return f"undetermined ({sc.reason})"
+    text = f"{len(sc.clauses)} clause(s), train {_fmt(sc.train_precision)}/{_fmt(sc.train_recall)}"
+    if sc.holdout_examples is not None:
+        text += f", held-out {_fmt(sc.holdout_precision)}/{_fmt(sc.holdout_recall)} ({sc.holdout_examples} examples)"
+        text += ", solved perfectly" if sc.solved else ""
+    return text
