@@ -68,7 +68,9 @@ class PrologAgent:
     ``policy``: the strategy file (or a :class:`Policy`). ``network``: the
     :class:`~neurosym.agent.checkpoint.LoadedAgent` whose relation facts a
     strategy with ``features: relations`` or ``both`` reads (see
-    :mod:`neurosym.play.relations`). Use :meth:`make_venv` for the envs it
+    :mod:`neurosym.play.relations`), with ``thresholds`` (relation j ->
+    threshold of holds/5) when the strategy file has no threshold/2. Use
+    :meth:`make_venv` for the envs it
     plays, so it sees their infos; close it (or use ``with``) when done.
     """
 
@@ -77,6 +79,7 @@ class PrologAgent:
         policy: str | os.PathLike[str] | Policy,
         network: Any = None,
         *,
+        thresholds: dict[int, float] | None = None,
         inference_limit: int = INFERENCE_LIMIT,
     ) -> None:
         from neurosym.prolog.knowledge_base import KnowledgeBase
@@ -106,7 +109,7 @@ class PrologAgent:
             if self.policy.needs_network:
                 from neurosym.play.relations import RelationFacts
 
-                self.relations = RelationFacts(network, self.kb, self.policy)
+                self.relations = RelationFacts(network, self.kb, self.policy, thresholds)
         except BaseException:
             self.kb.close()
             raise

@@ -10,7 +10,9 @@ it, and scored by the same code, so the two reports compare line by line;
 
 A strategy whose ``%! features:`` line says ``relations`` or ``both`` reads
 the network's relation facts of the live state: give the agent they came
-from with ``--checkpoint`` (its env is then the default ``--env``).
+from with ``--checkpoint`` (its env is then the default ``--env``) and, when
+the strategy file has no ``threshold/2``, the KB it was learned from with
+``--kb`` (its thresholds decide which relations hold).
 """
 
 from __future__ import annotations
@@ -36,6 +38,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="the agent whose relation facts the strategy reads (features: relations or both)",
     )
+    parser.add_argument(
+        "--kb",
+        metavar="FILE",
+        help="the KB the strategy was learned from: its threshold/2 decides which relations "
+        "hold (holds/5) when the strategy file has none",
+    )
     parser.add_argument("--episodes", type=int, default=100, help="episodes to play (100)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode (0)")
     add_env_option(parser)
@@ -59,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
 
         torch.set_num_threads(1)
     report = play_policy(
-        args.policy, args.env, args.episodes, args.seed, options, checkpoint=checkpoint
+        args.policy, args.env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb
     )
     if args.json:
         print(json.dumps(report))

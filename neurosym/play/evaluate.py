@@ -29,12 +29,15 @@ def play_policy(
     env_kwargs: dict[str, Any] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     batch: int = BATCH,
+    kb: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Play ``episodes`` episodes of the strategy ``policy`` on ``env``; a dict of plain values.
 
     ``checkpoint``: the network whose relation facts the strategy reads
     (needed for ``features: relations`` or ``both``); its env is the default
-    ``env``. Keys: those of ``neurosym eval --json`` that do not describe a
+    ``env``; ``kb``: the KB the strategy was learned from, whose
+    ``threshold/2`` sets which relations hold (when the strategy file has
+    none). Keys: those of ``neurosym eval --json`` that do not describe a
     network (mean_return ... outcomes), plus ``policy``, ``features``,
     ``fallbacks`` (steps by cause), ``fallback_steps``, ``goals`` (steps per
     object chosen), ``steps`` and ``steps_per_s`` (env steps per second of the
@@ -60,7 +63,8 @@ def play_policy(
         raise ConfigError("give the env to play (--env NAME, e.g. rgw-random)")
     env = canonical_name(env)
     kwargs = dict(env_kwargs or {})
-    with PrologAgent(spec, network) as agent:
+    thresholds = kb_thresholds(kb) if kb is not None else None
+    with PrologAgent(spec, network, thresholds=thresholds) as agent:
         start = time.perf_counter()
         done = play_scored(
             agent.act,
@@ -86,3 +90,14 @@ def play_policy(
             "steps": steps,
             "steps_per_s": steps / seconds if seconds > 0 else None,
         }
+
+
+def kb_thresholds(kb: str | os.PathLike[str]) -> dict[int, float]:
+    """Relation j -> threshold of a KB's ``threshold/2`` facts; ConfigError when it has none."""
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    with KnowledgeBase(kb) as base:
+        rows = base.query("threshold(J, V)")
+    if not rows:
+        raise ConfigError(f"{kb} has no threshold/2 facts; give the KB the strategy was learned from")
+    return {int(r["J"]): float(r["V"]) for r in rows}
