@@ -95,9 +95,7 @@ class PrologAgent:
         self.inference_limit = int(inference_limit)
         self.kb = KnowledgeBase(None)
         try:
-            self.kb.query(
-                "forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA]
-            )
+            self.kb.query("forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA])
             self.kb.load_rules(rule_file("route"))
             self.kb.load_rules(self.policy.path)
             if not self.kb.query("current_predicate(goal/3)"):

@@ -31,7 +31,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="strategy file defining goal(E, T, Object) (neurosym induce --what strategy)",
     )
     parser.add_argument(
-        "--env", metavar="NAME", help="environment, e.g. rgw-random or bw2 (default: the checkpoint's)"
+        "--env",
+        metavar="NAME",
+        help="environment, e.g. rgw-random or bw2 (default: the checkpoint's)",
     )
     parser.add_argument(
         "--checkpoint",
@@ -81,7 +83,9 @@ def print_report(report: dict) -> None:
     from neurosym.agent.cli_eval import print_figures
     from neurosym.display import plain
 
-    print(f"policy       {plain(report['policy'])} ({plain(report['env'])}, features {report['features']})")
+    print(
+        f"policy       {plain(report['policy'])} ({plain(report['env'])}, features {report['features']})"
+    )
     print(f"episodes     {report['episodes']} (seed {report['seed']})")
     print_figures(report)
     steps = report["steps"]

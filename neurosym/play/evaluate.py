@@ -99,5 +99,7 @@ def kb_thresholds(kb: str | os.PathLike[str]) -> dict[int, float]:
     with KnowledgeBase(kb) as base:
         rows = base.query("threshold(J, V)")
     if not rows:
-        raise ConfigError(f"{kb} has no threshold/2 facts; give the KB the strategy was learned from")
+        raise ConfigError(
+            f"{kb} has no threshold/2 facts; give the KB the strategy was learned from"
+        )
     return {int(r["J"]): float(r["V"]) for r in rows}

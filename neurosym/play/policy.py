@@ -60,7 +60,5 @@ def read_policy(path: str | os.PathLike[str]) -> Policy:
             features = match.group(1)
             break
     if features not in FEATURES:
-        raise ConfigError(
-            f"{file}: '%! features: {features}' is not one of {', '.join(FEATURES)}"
-        )
+        raise ConfigError(f"{file}: '%! features: {features}' is not one of {', '.join(FEATURES)}")
     return Policy(file, features)

@@ -91,7 +91,9 @@ class RelationFacts:
                 a, b = (str(ent1[h]), str(ent2[h])) if value >= 0 else (str(ent2[h]), str(ent1[h]))
                 if (j, a, b) not in seen:
                     seen.add((j, a, b))
-                    facts.append(_fact("holds", e, t, ("$t", "r", [j]), live.encode(a), live.encode(b)))
+                    facts.append(
+                        _fact("holds", e, t, ("$t", "r", [j]), live.encode(a), live.encode(b))
+                    )
         return facts
 
     def _mhdpa(
