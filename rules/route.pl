@@ -21,9 +21,13 @@
     than the goal: entering one triggers an event on the way (RGW: the sword is
     picked up, an unarmed enemy hurts or blocks, a teleport end moves the agent,
     a pit ends the episode, the terminal ends it; Box-World: a loose key is
-    picked up and the held key lost, a lock or a box's content blocks). The
-    only exception: when no such path exists and the agent holds the sword, RGW
-    enemies may be crossed (the env pays +1 and removes them).
+    picked up and the held key lost, a lock or a box's content blocks). When
+    no such path exists, a second search takes the teleport (entering one of
+    its two ends lands on the other), and a third, while the agent holds the
+    sword, also crosses RGW enemies (the env pays +1 and removes them). An
+    unarmed agent has no route to an enemy: meeting it costs -1 (and with a
+    blocking enemy the agent never gets through); nor has any agent a route
+    into a pit, which ends the episode.
 
     Cost: a step costs 1; entering a mountain costs 1 + Rows * Cols, more than
     any path without it. The env pays -0.1 for a mountain and nothing for a
@@ -32,7 +36,8 @@
     to the first action in the order up, right, down, left.
 
     Dijkstra's search over library(heaps), visited cells in library(assoc).
-    Helpers start with route_, so this file loads beside the other rule files.
+    Helpers start with route_pl_, so this file loads beside the other rule
+    files and beside a learned strategy (whose own helpers start with route_).
 */
 
 :- use_module(library(heaps)).
@@ -63,16 +68,13 @@ route(E, T, Goal, Action, Cost) :-
     at(E, T, Goal, GR, GC),
     Goal \== agent,
     \+ (R0 == GR, C0 == GC),
+    \+ object(Goal, pit),
+    \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
     !,
-    grid(E, Rows, Cols),
-    route_mountain_cost_(Rows, Cols, Mountain),
-    (   route_blocked_(E, T, Goal, strict, Blocked),
-        route_search_(R0-C0, GR-GC, Rows, Cols, Blocked, Mountain, E, Action, Cost)
-    ->  true
-    ;   holding(E, T, sword),
-        route_blocked_(E, T, Goal, armed, Blocked),
-        route_search_(R0-C0, GR-GC, Rows, Cols, Blocked, Mountain, E, Action, Cost)
-    ).
+    route_pl_mode_(E, T, Mode),
+    route_pl_map_(E, T, Goal, Mode, GR-GC, Map),
+    route_pl_search_(R0-C0, Map, Action, Cost),
+    !.
 
 %!  route_distance(+E, +T, +Goal, -Cost) is semidet.
 %
@@ -86,11 +88,11 @@ route_distance(E, T, Goal, 0) :-
 route_distance(E, T, Goal, Cost) :-
     route(E, T, Goal, _, Cost).
 
-%!  reachable(+E, +T, +Goal) is semidet.
+%!  route_exists(+E, +T, +Goal) is semidet.
 %
 %   A path to Goal exists (route/4 has an answer).
 
-reachable(E, T, Goal) :-
+route_exists(E, T, Goal) :-
     route(E, T, Goal, _).
 
 %!  safe_step(+E, +T, -Action) is semidet.
@@ -102,143 +104,203 @@ reachable(E, T, Goal) :-
 safe_step(E, T, Action) :-
     at(E, T, agent, R, C),
     grid(E, Rows, Cols),
-    route_blocked_(E, T, none, strict, Blocked),
-    route_move_(Action, R-C, R1-C1),
-    route_inside_(R1-C1, Rows, Cols),
+    route_pl_blocked_(E, T, none, strict, Blocked),
+    route_pl_move_(Action, R-C, R1-C1),
+    route_pl_inside_(R1-C1, Rows, Cols),
     Cell is R1 * Cols + C1,
     \+ get_assoc(Cell, Blocked, _),
     !.
 
 % --------------------------------------------------------------- helpers
 
-route_move_(up,    R-C, R1-C) :- R1 is R - 1.
-route_move_(right, R-C, R-C1) :- C1 is C + 1.
-route_move_(down,  R-C, R1-C) :- R1 is R + 1.
-route_move_(left,  R-C, R-C1) :- C1 is C - 1.
+route_pl_move_(up,    R-C, R1-C) :- R1 is R - 1.
+route_pl_move_(right, R-C, R-C1) :- C1 is C + 1.
+route_pl_move_(down,  R-C, R1-C) :- R1 is R + 1.
+route_pl_move_(left,  R-C, R-C1) :- C1 is C - 1.
 
-route_move_index_(up, 0).
-route_move_index_(right, 1).
-route_move_index_(down, 2).
-route_move_index_(left, 3).
+route_pl_move_index_(up, 0).
+route_pl_move_index_(right, 1).
+route_pl_move_index_(down, 2).
+route_pl_move_index_(left, 3).
 
-route_inside_(R-C, Rows, Cols) :-
+route_pl_inside_(R-C, Rows, Cols) :-
     R >= 0, R < Rows, C >= 0, C < Cols.
 
-route_mountain_cost_(Rows, Cols, Cost) :-
-    Cost is 1 + Rows * Cols.
+%   route_pl_mode_(+E, +T, -Mode): the rules of a search, tried in turn:
+%   strict; then teleport ends as jumps; then, holding the sword, also
+%   through enemies.
+route_pl_mode_(_, _, strict).
+route_pl_mode_(_, _, jumps).
+route_pl_mode_(E, T, armed) :- holding(E, T, sword).
 
-%   route_blocked_(+E, +T, +Goal, +Mode, -Blocked): assoc of the cells (Row *
-%   Cols + Col) a path may not enter: walls (and any terrain other than
-%   mountains) and the objects other than Goal; in Mode armed, RGW enemies
-%   are left open.
-route_blocked_(E, T, Goal, Mode, Blocked) :-
+%   route_pl_map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs,
+%   as map(Rows, Cols, Blocked, Mountains, Jumps, MountainCost, TargetCell);
+%   Blocked, Mountains and Jumps are assocs keyed by cell (Row * Cols + Col).
+route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Blocked, Mountains, Jumps, Mountain, Target)) :-
+    grid(E, Rows, Cols),
+    Mountain is 1 + Rows * Cols,
+    Target is GR * Cols + GC,
+    route_pl_blocked_(E, T, Goal, Mode, Blocked),
+    findall(Cell-m, ( terrain(E, mountain, R, C), Cell is R * Cols + C ), Ms),
+    route_pl_assoc_(Ms, Mountains),
+    route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps).
+
+%   route_pl_jumps_: in modes jumps and armed, entering a teleport end (not
+%   the goal) lands on the other end, when the map has exactly two.
+route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps) :-
+    (   Mode \== strict,
+        findall(Id-(R-C), ( object(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
+        A \== Goal, B \== Goal
+    ->  CellA is RA * Cols + CA, CellB is RB * Cols + CB,
+        route_pl_assoc_([CellA-CellB, CellB-CellA], Jumps)
+    ;   empty_assoc(Jumps)
+    ).
+
+%   route_pl_blocked_(+E, +T, +Goal, +Mode, -Blocked): assoc of the cells a
+%   path may not enter: walls (any terrain but mountains) and the objects
+%   other than Goal; in mode armed, enemies are left open (teleport ends of
+%   a jump are taken care of before Blocked is looked at).
+route_pl_blocked_(E, T, Goal, Mode, Blocked) :-
     grid(E, _, Cols),
     findall(Cell-wall,
             ( terrain(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
             Walls),
     findall(Cell-Id,
             ( at(E, T, Id, R, C), Id \== agent, Id \== Goal,
-              \+ route_open_(Mode, Id),
+              \+ route_pl_open_(Mode, Id),
               Cell is R * Cols + C ),
             Objects),
     append(Walls, Objects, Pairs),
-    list_to_assoc_(Pairs, Blocked).
+    route_pl_assoc_(Pairs, Blocked).
 
-route_open_(armed, Id) :- object(Id, enemy).
+route_pl_open_(armed, Id) :- object(Id, enemy).
 
-list_to_assoc_(Pairs, Assoc) :-
+route_pl_assoc_(Pairs, Assoc) :-
     empty_assoc(A0),
-    foldl(route_put_, Pairs, A0, Assoc).
+    foldl(route_pl_put_, Pairs, A0, Assoc).
 
-route_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
+route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 
-%   route_search_(+Start, +Target, +Rows, +Cols, +Blocked, +Mountain, +E,
-%                 -Action, -Cost): Dijkstra from Start; each queue entry keeps
-%   the first action of its path and is keyed Cost * 4 + the action's index,
-%   so that of equally cheap paths the one whose first action comes first in
-%   up, right, down, left wins. The target is always enterable.
-route_search_(R0-C0, GR-GC, Rows, Cols, Blocked, Mountain, E, Action, Cost) :-
+%   route_pl_search_(+Start, +Map, -Action, -Cost): Dijkstra from Start;
+%   each queue entry keeps the first action of its path and is keyed
+%   Cost * 4 + the action's index, so that of equally cheap paths the one
+%   whose first action comes first in up, right, down, left wins. The
+%   target is always enterable.
+route_pl_search_(R0-C0, Map, Action, Cost) :-
+    Map = map(_, Cols, _, _, _, _, _),
     Start is R0 * Cols + C0,
-    Target is GR * Cols + GC,
-    route_mountains_(E, Cols, Mountains),
     empty_assoc(Done0),
     put_assoc(Start, Done0, true, Done1),
-    route_expand_(R0-C0, none, 0, Rows, Cols, Blocked, Mountains, Mountain,
-                  Target, Done1, Heap0),
-    route_loop_(Heap0, Rows, Cols, Blocked, Mountains, Mountain, Target, Done1,
-                Action, Cost).
+    empty_heap(Heap0),
+    route_pl_expand_(Start, none, 0, Map, Done1, Heap0, Heap1),
+    route_pl_loop_(Heap1, Map, Done1, Action, Cost).
 
-route_mountains_(E, Cols, Mountains) :-
-    findall(Cell-m, ( terrain(E, mountain, R, C), Cell is R * Cols + C ), Pairs),
-    list_to_assoc_(Pairs, Mountains).
-
-route_loop_(Heap0, Rows, Cols, Blocked, Mountains, Mountain, Target, Done0,
-            Action, Cost) :-
+route_pl_loop_(Heap0, Map, Done0, Action, Cost) :-
     get_from_heap(Heap0, Key, Cell-First, Heap1),
     D is Key // 4,
+    Map = map(_, _, _, _, _, _, Target),
     (   Cell =:= Target
     ->  Action = First, Cost = D
     ;   get_assoc(Cell, Done0, _)
-    ->  route_loop_(Heap1, Rows, Cols, Blocked, Mountains, Mountain, Target,
-                    Done0, Action, Cost)
+    ->  route_pl_loop_(Heap1, Map, Done0, Action, Cost)
     ;   put_assoc(Cell, Done0, true, Done1),
-        R is Cell // Cols, C is Cell mod Cols,
-        route_expand_(R-C, First, D, Rows, Cols, Blocked, Mountains, Mountain,
-                      Target, Done1, Heap1, Heap2),
-        route_loop_(Heap2, Rows, Cols, Blocked, Mountains, Mountain, Target,
-                    Done1, Action, Cost)
+        route_pl_expand_(Cell, First, D, Map, Done1, Heap1, Heap2),
+        route_pl_loop_(Heap2, Map, Done1, Action, Cost)
     ).
-
-route_expand_(RC, First, D, Rows, Cols, Blocked, Mountains, Mountain, Target,
-              Done, Heap) :-
-    empty_heap(Heap0),
-    route_expand_(RC, First, D, Rows, Cols, Blocked, Mountains, Mountain,
-                  Target, Done, Heap0, Heap).
 
 %   Neighbours in the order up, right, down, left; a path's first action is
 %   its first move (First is none at the start).
-route_expand_(RC, First, D, Rows, Cols, Blocked, Mountains, Mountain, Target,
-              Done, Heap0, Heap) :-
-    foldl(route_neighbour_(RC, First, D, Rows, Cols, Blocked, Mountains,
-                           Mountain, Target, Done),
+route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
+    Map = map(_, Cols, _, _, _, _, _),
+    R is Cell // Cols, C is Cell mod Cols,
+    foldl(route_pl_neighbour_(R-C, First, D, Map, Done),
           [up, right, down, left], Heap0, Heap).
 
-route_neighbour_(RC, First, D, Rows, Cols, Blocked, Mountains, Mountain,
-                 Target, Done, Move, Heap0, Heap) :-
-    route_move_(Move, RC, R1-C1),
-    Cell is R1 * Cols + C1,
-    (   route_inside_(R1-C1, Rows, Cols),
-        \+ get_assoc(Cell, Done, _),
-        ( Cell =:= Target -> true ; \+ get_assoc(Cell, Blocked, _) )
-    ->  ( get_assoc(Cell, Mountains, _) -> Step is 1 + Mountain ; Step = 1 ),
-        D1 is D + Step,
-        ( First == none -> First1 = Move ; First1 = First ),
-        route_move_index_(First1, I),
-        Key is D1 * 4 + I,
-        add_to_heap(Heap0, Key, Cell-First1, Heap)
+route_pl_neighbour_(RC, First, D, Map, Done, Move, Heap0, Heap) :-
+    Map = map(Rows, Cols, Blocked, Mountains, Jumps, Mountain, Target),
+    route_pl_move_(Move, RC, R1-C1),
+    (   route_pl_inside_(R1-C1, Rows, Cols)
+    ->  Cell0 is R1 * Cols + C1,
+        ( get_assoc(Cell0, Jumps, Landing) -> Cell = Landing ; Cell = Cell0 ),
+        (   \+ get_assoc(Cell, Done, _),
+            ( Cell0 =:= Target -> true ; Cell \== Cell0 -> true ; \+ get_assoc(Cell0, Blocked, _) )
+        ->  ( get_assoc(Cell0, Mountains, _) -> Step is 1 + Mountain ; Step = 1 ),
+            D1 is D + Step,
+            ( First == none -> First1 = Move ; First1 = First ),
+            route_pl_move_index_(First1, I),
+            Key is D1 * 4 + I,
+            add_to_heap(Heap0, Key, Cell-First1, Heap)
+        ;   Heap = Heap0
+        )
     ;   Heap = Heap0
     ).
 
 %!  default_goal(+E, +T, -Object) is semidet.
 %
-%   The object a Prolog agent goes for when its strategy names none: RGW the
-%   terminal; Box-World the lock of the held key's colour, else the nearest
-%   loose key it can reach.
+%   The object a Prolog agent goes for when its strategy names none it can
+%   reach, a hand-written strategy. RGW: the sword while it is on the map and
+%   not held; holding it, the nearest enemy; then the terminal; then a
+%   teleport end. Box-World: the lock of the held key's colour whose box is
+%   worth opening (it holds the gem, or a key for such a lock); else the
+%   nearest loose key of such a lock; else the nearest loose key. Only
+%   objects with a route count.
 %
 %       ?- default_goal(0, 0, G).
 %       G = terminal.
 
-default_goal(E, T, terminal) :-
-    at(E, T, terminal, _, _),
+default_goal(E, T, Goal) :-
+    route_pl_default_(E, T, Goal),
+    route_exists(E, T, Goal),
     !.
-default_goal(E, T, Lock) :-
+
+route_pl_default_(E, T, sword) :-
+    \+ holding(E, T, sword),
+    at(E, T, sword, _, _).
+route_pl_default_(E, T, Enemy) :-
+    holding(E, T, sword),
+    route_pl_nearest_(E, T, X, object(X, enemy), Enemy).
+route_pl_default_(_, _, terminal).
+route_pl_default_(E, T, End) :-
+    object(End, teleport),
+    at(E, T, End, _, _).
+route_pl_default_(E, T, Lock) :-
     holding(E, T, key(C)),
     object(Lock, lock(C)),
+    route_pl_useful_(E, T, Lock).
+route_pl_default_(E, T, Key) :-
+    route_pl_nearest_(E, T, K,
+                      ( object(K, key(C)), route_pl_loose_(E, T, K),
+                        object(L, lock(C)), route_pl_useful_(E, T, L) ),
+                      Key).
+route_pl_default_(E, T, Key) :-
+    route_pl_nearest_(E, T, K, ( object(K, key(_)), route_pl_loose_(E, T, K) ), Key).
+
+%   route_pl_nearest_(+E, +T, ?X, :Cond, -Nearest): of the objects X on the
+%   map for which Cond holds, the one with the cheapest route.
+route_pl_nearest_(E, T, X, Cond, Nearest) :-
+    findall(D-X, ( Cond, at(E, T, X, _, _), route_distance(E, T, X, D) ), Ds),
+    msort(Ds, [_-Nearest|_]).
+
+%   Box-World: a box is a lock with its content in the cell to its left; a
+%   loose key has no lock to its right.
+route_pl_content_(E, T, Lock, Content) :-
+    at(E, T, Lock, R, C),
+    Left is C - 1,
+    at(E, T, X, R, Left),
+    object(X, Content).
+
+route_pl_useful_(E, T, Lock) :-
     at(E, T, Lock, _, _),
-    reachable(E, T, Lock),
+    (   route_pl_content_(E, T, Lock, gem)
+    ->  true
+    ;   route_pl_content_(E, T, Lock, key(C)),
+        object(Next, lock(C)),
+        Next \== Lock,
+        route_pl_useful_(E, T, Next)
+    ),
     !.
-default_goal(E, T, Key) :-
-    findall(Cost-K,
-            ( object(K, key(_)), at(E, T, K, _, _), route_distance(E, T, K, Cost) ),
-            Keys),
-    msort(Keys, [_-Key|_]).
+
+route_pl_loose_(E, T, Key) :-
+    at(E, T, Key, R, C),
+    Right is C + 1,
+    \+ ( at(E, T, X, R, Right), object(X, lock(_)) ).

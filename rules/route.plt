@@ -27,8 +27,23 @@ test(teleport_as_goal, A-C == down-5) :-
 test(unarmed_avoids_the_enemy, [true(A == right), true(C > 20)]) :-
     route(1, 0, terminal, A, C).
 
-test(enemy_as_goal, A-C == down-3) :-
-    route(1, 0, enemy, A, C).
+% Unarmed, meeting the enemy costs -1: no route to it.
+test(no_route_to_an_enemy_unarmed, fail) :-
+    route(1, 0, enemy, _).
+
+test(no_route_into_a_pit, fail) :-
+    route(0, 0, pit, _).
+
+test(enemy_as_goal_armed, A-C == right-1) :-
+    route(2, 1, enemy, A, C).
+
+% The wall column closes the terminal off; entering the teleport end at
+% (0,1) lands on (2,3). Up and right both reach it in 3 steps: up first.
+test(through_the_teleport, A-C == up-6) :-
+    route(4, 0, terminal, A, C).
+
+test(teleport_end_as_goal, A-C == up-3) :-
+    route(4, 0, teleport_1, A, C).
 
 test(no_path_unarmed, fail) :-
     route(2, 0, terminal, _).
@@ -60,8 +75,14 @@ test(safe_step, A == right) :-
 test(safe_step_none, fail) :-
     safe_step(2, 0, _).
 
-test(default_goal_rgw, G == terminal) :-
+test(default_goal_sword_first, G == sword) :-
     default_goal(0, 0, G).
+
+test(default_goal_enemy_when_armed, G == enemy) :-
+    default_goal(2, 1, G).
+
+test(default_goal_terminal, G == terminal) :-
+    default_goal(4, 0, G).
 
 test(default_goal_boxworld_lock, G == lock_red) :-
     default_goal(3, 1, G).

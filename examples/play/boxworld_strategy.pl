@@ -5,7 +5,7 @@
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. A lock is worth opening when its box holds the
     gem, or a key whose lock is worth opening; a loose key lies in no box (no
-    lock right of it). Uses route.pl's reachable/3, which `neurosym play`
+    lock right of it). Uses route.pl's route_exists/3, which `neurosym play`
     loads beside it.
 
         neurosym play --policy examples/play/boxworld_strategy.pl --env bw2
@@ -20,7 +20,7 @@ goal(E, T, Lock) :-
     object(Lock, lock(C)),
     at(E, T, Lock, _, _),
     bws_useful(E, T, Lock),
-    reachable(E, T, Lock).
+    route_exists(E, T, Lock).
 % Else a loose key that opens a lock worth opening.
 goal(E, T, Key) :-
     object(Key, key(C)),
@@ -29,7 +29,7 @@ goal(E, T, Key) :-
     object(Lock, lock(C)),
     at(E, T, Lock, _, _),
     bws_useful(E, T, Lock),
-    reachable(E, T, Key).
+    route_exists(E, T, Key).
 
 bws_content(E, T, Lock, Content) :-
     at(E, T, Lock, R, C),

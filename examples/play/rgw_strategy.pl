@@ -3,7 +3,7 @@
     `neurosym induce --what strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
-    the first answer counts. It uses route.pl's reachable/3 and
+    the first answer counts. It uses route.pl's route_exists/3 and
     route_distance/4, which `neurosym play` loads beside it.
 
         neurosym play --policy examples/play/rgw_strategy.pl --env rgw-random
@@ -17,17 +17,17 @@
 goal(E, T, sword) :-
     \+ holding(E, T, sword),
     at(E, T, sword, _, _),
-    reachable(E, T, sword).
+    route_exists(E, T, sword).
 % Holding the sword: the nearest reachable enemy.
 goal(E, T, Enemy) :-
     holding(E, T, sword),
     findall(D-X, ( object(X, enemy), at(E, T, X, _, _), route_distance(E, T, X, D) ), Ds),
     msort(Ds, [_-Enemy|_]).
 goal(E, T, terminal) :-
-    reachable(E, T, terminal).
+    route_exists(E, T, terminal).
 % The terminal out of reach: through the teleport (an end the agent is not on).
 goal(E, T, End) :-
     object(End, teleport),
     at(E, T, End, _, _),
-    reachable(E, T, End).
+    route_exists(E, T, End).
 goal(_, _, terminal).

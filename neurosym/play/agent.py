@@ -116,6 +116,8 @@ class PrologAgent:
         self.decisions = 0
         self.decide_seconds = 0.0
         self.goals: Counter[str] = Counter()
+        self.last: tuple[str, str, str] | None = None
+        """(status, goal, action) of the latest decision"""
 
     # -- envs -------------------------------------------------------------
 
@@ -156,6 +158,7 @@ class PrologAgent:
         if out[0] == "error":
             raise PrologError(f"{self.policy.path}: {out[1]}")
         (status, goal), action = out
+        self.last = (status, str(goal), action)
         if status != "ok":
             self.fallbacks[status] += 1
         self.goals[str(goal)] += 1
