@@ -45,6 +45,7 @@
 :- use_module(library(lists)).
 
 :- dynamic at/5, object/2, holding/3, terrain/4, grid/3.
+:- dynamic route_pl_memo_/4.
 
 %!  route(+E, +T, +Goal, -Action) is semidet.
 %
@@ -54,7 +55,7 @@
 %   path exists.
 %
 %       ?- route(0, 0, sword, A).
-%       A = right.
+%       A = down.
 
 route(E, T, Goal, Action) :-
     route(E, T, Goal, Action, _).
@@ -64,6 +65,32 @@ route(E, T, Goal, Action) :-
 %   As route/4; Cost is the path's cost (steps, plus Rows * Cols per mountain).
 
 route(E, T, Goal, Action, Cost) :-
+    ground(E-T-Goal),
+    !,
+    (   route_pl_memo_(E, T, Goal, Found)
+    ->  true
+    ;   (   route_pl_(E, T, Goal, A, C)
+        ->  Found = found(A, C)
+        ;   Found = none
+        ),
+        assertz(route_pl_memo_(E, T, Goal, Found))
+    ),
+    Found = found(Action, Cost).
+route(E, T, Goal, Action, Cost) :-
+    route_pl_(E, T, Goal, Action, Cost).
+
+%!  route_forget(+E) is det.
+%
+%   Forget the routes remembered for episode E. route/5 remembers its answer
+%   for each state and goal, since a state's facts do not change (in a KB,
+%   and in the live states of `neurosym play`, which calls this when an
+%   episode ends); call it after changing the facts of a state it was asked
+%   about.
+
+route_forget(E) :-
+    retractall(route_pl_memo_(E, _, _, _)).
+
+route_pl_(E, T, Goal, Action, Cost) :-
     at(E, T, agent, R0, C0),
     at(E, T, Goal, GR, GC),
     Goal \== agent,

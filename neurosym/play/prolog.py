@@ -17,7 +17,8 @@ rule files, route.pl and the strategy, as code):
   ``stuck``) or ``error-Text`` when the strategy raised or ran past Limit
   inferences;
 * ``end_episode(M, E)`` retracts every fact of episode E (not object/2,
-  which, as in a KB, lists the ids of every episode).
+  which, as in a KB, lists the ids of every episode) and the routes
+  route.pl remembered for it (``route_forget/1``).
 
 Values arrive from janus as atoms, numbers and lists; a compound term arrives
 as the tuple ``('$t', Functor, Args)`` and is rebuilt with
@@ -46,6 +47,7 @@ begin_episode(M, E, Objects, Terrain, [Rows, Cols]) :-
     assertz(M:grid(E, Rows, Cols)).
 
 end_episode(M, E) :-
+    (   current_predicate(M:route_forget/1) -> M:route_forget(E) ; true ),
     retractall(M:at(E, _, _, _, _)),
     retractall(M:holding(E, _, _)),
     retractall(M:step(E, _, _, _)),
