@@ -21,10 +21,10 @@
     than the goal: entering one triggers an event on the way (RGW: the sword is
     picked up, an unarmed enemy hurts or blocks, a teleport end moves the agent,
     a pit ends the episode, the terminal ends it; Box-World: a loose key is
-    picked up and the held key lost, a lock or a box's content blocks). When
-    no such path exists, a second search takes the teleport (entering one of
-    its two ends lands on the other), and a third, while the agent holds the
-    sword, also crosses RGW enemies (the env pays +1 and removes them). An
+    picked up and the held key lost, a lock or a box's content blocks). The
+    exception: an agent that holds the sword may cross RGW enemies (the env
+    pays +1 and removes them). When no such path exists, a second search
+    takes the teleport (entering one of its two ends lands on the other). An
     unarmed agent has no route to an enemy: meeting it costs -1 (and with a
     blocking enemy the agent never gets through); nor has any agent a route
     into a pit, which ends the episode.
@@ -98,7 +98,7 @@ route_pl_(E, T, Goal, Action, Cost) :-
     \+ object(Goal, pit),
     \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
     !,
-    route_pl_mode_(E, T, Mode),
+    route_pl_mode_(Mode),
     route_pl_map_(E, T, Goal, Mode, GR-GC, Map),
     route_pl_search_(R0-C0, Map, Action, Cost),
     !.
@@ -131,7 +131,7 @@ route_exists(E, T, Goal) :-
 safe_step(E, T, Action) :-
     at(E, T, agent, R, C),
     grid(E, Rows, Cols),
-    route_pl_blocked_(E, T, none, strict, Blocked),
+    route_pl_blocked_(E, T, none, Blocked),
     route_pl_move_(Action, R-C, R1-C1),
     route_pl_inside_(R1-C1, Rows, Cols),
     Cell is R1 * Cols + C1,
@@ -153,12 +153,10 @@ route_pl_move_index_(left, 3).
 route_pl_inside_(R-C, Rows, Cols) :-
     R >= 0, R < Rows, C >= 0, C < Cols.
 
-%   route_pl_mode_(+E, +T, -Mode): the rules of a search, tried in turn:
-%   strict; then teleport ends as jumps; then, holding the sword, also
-%   through enemies.
-route_pl_mode_(_, _, strict).
-route_pl_mode_(_, _, jumps).
-route_pl_mode_(E, T, armed) :- holding(E, T, sword).
+%   route_pl_mode_(-Mode): the rules of a search, tried in turn: strict,
+%   then with the teleport's ends as jumps.
+route_pl_mode_(strict).
+route_pl_mode_(jumps).
 
 %   route_pl_map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs,
 %   as map(Rows, Cols, Blocked, Mountains, Jumps, MountainCost, TargetCell);
@@ -167,12 +165,12 @@ route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Blocked, Mountains, Jumps
     grid(E, Rows, Cols),
     Mountain is 1 + Rows * Cols,
     Target is GR * Cols + GC,
-    route_pl_blocked_(E, T, Goal, Mode, Blocked),
+    route_pl_blocked_(E, T, Goal, Blocked),
     findall(Cell-m, ( terrain(E, mountain, R, C), Cell is R * Cols + C ), Ms),
     route_pl_assoc_(Ms, Mountains),
     route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps).
 
-%   route_pl_jumps_: in modes jumps and armed, entering a teleport end (not
+%   route_pl_jumps_: in mode jumps, entering a teleport end (not
 %   the goal) lands on the other end, when the map has exactly two.
 route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps) :-
     (   Mode \== strict,
@@ -183,24 +181,24 @@ route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps) :-
     ;   empty_assoc(Jumps)
     ).
 
-%   route_pl_blocked_(+E, +T, +Goal, +Mode, -Blocked): assoc of the cells a
-%   path may not enter: walls (any terrain but mountains) and the objects
-%   other than Goal; in mode armed, enemies are left open (teleport ends of
-%   a jump are taken care of before Blocked is looked at).
-route_pl_blocked_(E, T, Goal, Mode, Blocked) :-
+%   route_pl_blocked_(+E, +T, +Goal, -Blocked): assoc of the cells a path
+%   may not enter: walls (any terrain but mountains) and the objects other
+%   than Goal, but for enemies while the agent holds the sword (teleport
+%   ends of a jump are taken care of before Blocked is looked at).
+route_pl_blocked_(E, T, Goal, Blocked) :-
     grid(E, _, Cols),
     findall(Cell-wall,
             ( terrain(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
             Walls),
     findall(Cell-Id,
             ( at(E, T, Id, R, C), Id \== agent, Id \== Goal,
-              \+ route_pl_open_(Mode, Id),
+              \+ route_pl_open_(E, T, Id),
               Cell is R * Cols + C ),
             Objects),
     append(Walls, Objects, Pairs),
     route_pl_assoc_(Pairs, Blocked).
 
-route_pl_open_(armed, Id) :- object(Id, enemy).
+route_pl_open_(E, T, Id) :- object(Id, enemy), holding(E, T, sword).
 
 route_pl_assoc_(Pairs, Assoc) :-
     empty_assoc(A0),

@@ -48,7 +48,7 @@ test(teleport_end_as_goal, A-C == up-3) :-
 test(no_path_unarmed, fail) :-
     route(2, 0, terminal, _).
 
-test(armed_crosses_the_enemy, A-C == right-3) :-
+test(holding_the_sword_crosses_the_enemy, A-C == right-3) :-
     route(2, 1, terminal, A, C).
 
 test(standing_on_the_goal, fail) :-

@@ -8,10 +8,14 @@ as code beside the strategy) the action. The Prolog side is
 :mod:`neurosym.play.prolog`: one call per sub-env and step.
 
 When goal/3 has no answer, or no route to its object exists, the agent falls
-back to ``default_goal/3`` of route.pl (RGW: the terminal; Box-World: the
-held key's lock, else the nearest loose key), then to ``safe_step/3`` (the
-first move into a free cell), then to ``up``; :attr:`PrologAgent.fallbacks`
-counts those steps by cause (``no_goal``, ``no_route``).
+back to ``default_goal/3`` of route.pl (a hand-written strategy: RGW the
+sword, then enemies, then the terminal; Box-World the held key's lock, else
+a loose key), then to ``safe_step/3`` (the first move into a free cell), then
+to ``up``. It does the same in a state the episode has been in before (the
+same positions and held items): a strategy that reads the state alone would
+choose as it did then and go round the same loop for good.
+:attr:`PrologAgent.fallbacks` counts those steps by cause (``no_goal``,
+``no_route``, ``loop``).
 
 Episode E of the facts is the episode's number (its reset seed minus the
 first seed), T its state; an episode's facts are retracted when it ends.
@@ -143,13 +147,17 @@ class PrologAgent:
     def _decide(self, venv: _Watched, i: int, extra: list[Any]) -> int:
         e, t = int(venv.episode[i]), int(venv.t[i])
         ats, held = venv.state[i]
+        key = (tuple(ats), tuple(held))
+        seen = key in venv.visited[i]
+        venv.visited[i].add(key)
         start = time.perf_counter()
         out = _janus().query_once(
-            f"{play_prolog.MODULE}:decide(M, E, T, S, P, X, L, Out)",
+            f"{play_prolog.MODULE}:decide(M, E, T, S, P, X, L, Seen, Out)",
             {
                 "M": self.module, "E": e, "T": t,
                 "S": [[list(a) for a in ats], [live.encode(h) for h in held]],
                 "P": venv.prev[i], "X": extra, "L": self.inference_limit,
+                "Seen": "true" if seen else "false",
             },
         )["Out"]  # fmt: skip
         self.decide_seconds += time.perf_counter() - start
@@ -235,6 +243,7 @@ class _Watched:
         self.running = np.zeros(n, dtype=bool)
         self.state: list[Any] = [None] * n
         self.prev: list[list[Any]] = [[] for _ in range(n)]
+        self.visited: list[set[Any]] = [set() for _ in range(n)]
         self.info: Any = None
 
     def __getattr__(self, name: str) -> Any:
@@ -252,6 +261,7 @@ class _Watched:
             self.episode[i], self.t[i], self.running[i] = e, 0, True
             self.state[i] = live.state_rows(d)
             self.prev[i] = []
+            self.visited[i] = set()
             self.agent.begin(e, live.episode_facts(d, np.asarray(grids[i]), self.names))
         return obs, info
 

@@ -7,14 +7,15 @@ rule files, route.pl and the strategy, as code):
 
 * ``begin_episode(M, E, Objects, Terrain, Grid)`` asserts ``object/2`` (once
   per id), ``terrain/4`` and ``grid/3`` of episode E;
-* ``decide(M, E, T, State, Prev, Extra, Limit, Out)`` asserts state T's
-  ``at/5`` and ``holding/3``, the previous transition's ``step/4`` and
+* ``decide(M, E, T, State, Prev, Extra, Limit, Seen, Out)`` asserts state
+  T's ``at/5`` and ``holding/3``, the previous transition's ``step/4`` and
   ``event/3``, and Extra (the network's ``holds/5``, ``attends/8`` or
   ``attention/6`` facts of state T), then asks ``goal(E, T, G)`` (first
   answer) and ``route(E, T, G, A)``; when either fails it falls back to
-  ``default_goal/3``, then ``safe_step/3``, then ``up``. Out is
-  ``Status-Goal-Action`` (Status ``ok``, ``no_goal``, ``no_route``,
-  ``stuck``) or ``error-Text`` when the strategy raised or ran past Limit
+  ``default_goal/3``, then ``safe_step/3``, then ``up``. Seen ``true`` (the
+  episode was in this very state before) goes to the fallback at once. Out
+  is ``Status-Goal-Action`` (Status ``ok``, ``no_goal``, ``no_route`` or
+  ``loop``) or ``error-Text`` when the strategy raised or ran past Limit
   inferences;
 * ``end_episode(M, E)`` retracts every fact of episode E (not object/2,
   which, as in a KB, lists the ids of every episode) and the routes
@@ -31,7 +32,7 @@ from __future__ import annotations
 MODULE = "neurosym_play"
 
 SOURCE = r"""
-:- module(neurosym_play, [begin_episode/5, decide/8, end_episode/2]).
+:- module(neurosym_play, [begin_episode/5, decide/9, end_episode/2]).
 :- use_module(library(apply), [maplist/2, maplist/3]).
 :- use_module(library(lists), [member/2]).
 
@@ -74,9 +75,9 @@ assert_state_(M, E, T, [Ats, Held], Prev, Extra) :-
     forall(member(X0, Extra),
            ( term_(X0, X), functor(X, N, A), extra_(N, A), assertz(M:X) )).
 
-decide(M, E, T, State, Prev, Extra, Limit, Out) :-
+decide(M, E, T, State, Prev, Extra, Limit, Seen, Out) :-
     assert_state_(M, E, T, State, Prev, Extra),
-    catch(call_with_inference_limit(choose_(M, E, T, Out0), Limit, Result), Err, true),
+    catch(call_with_inference_limit(choose_(M, E, T, Seen, Out0), Limit, Result), Err, true),
     (   nonvar(Err)
     ->  message_to_codes_(Err, Text), Out = error-Text
     ;   Result == inference_limit_exceeded
@@ -85,7 +86,11 @@ decide(M, E, T, State, Prev, Extra, Limit, Out) :-
     ;   Out = Out0
     ).
 
-choose_(M, E, T, Status-Goal-Action) :-
+choose_(M, E, T, true, Out) :-
+    !,
+    fallback_(M, E, T, loop, none, Status, Goal, Action),
+    Out = Status-Goal-Action.
+choose_(M, E, T, false, Status-Goal-Action) :-
     (   once(M:goal(E, T, G))
     ->  (   M:route(E, T, G, A)
         ->  Status = ok, Goal = G, Action = A
