@@ -38,14 +38,25 @@ def test_the_hand_written_strategy_is_optimal_where_the_planner_is() -> None:
     assert report["optimal_rate"] >= 0.9
 
 
-def test_no_answer_of_goal_falls_back_to_the_terminal(tmp_path: Path) -> None:
+def test_no_answer_of_goal_falls_back_to_the_default_goal(tmp_path: Path) -> None:
+    """route.pl's default_goal/3 plays instead: the sword, the enemy, the terminal."""
     policy = _policy(tmp_path, "goal(_, _, _) :- fail.\n")
-    report = play_policy(policy, "rgw-random", 1, seed=12)  # a decoy level: the terminal is free
+    report = play_policy(policy, "rgw2", 1)
     assert report["fallbacks"] == {"no_goal": report["steps"]}
-    assert report["goals"] == {"terminal": report["steps"]}
+    assert list(report["goals"]) == ["enemy", "sword", "terminal"]
+    assert report["mean_return"] == pytest.approx(10.7) and report["outcomes"] == {"terminal": 1}
+
+
+def test_a_state_seen_before_goes_to_the_default_goal(tmp_path: Path) -> None:
+    """The goal flips with the parity of the agent's cell, so the agent steps back and forth
+    between two cells until the second visit of a state hands the step to the default goal."""
+    flip = _policy(
+        tmp_path,
+        "goal(E, T, O) :- at(E, T, agent, R, C), ( 0 is (R + C) mod 2 -> O = sword ; O = terminal ).\n",
+    )
+    report = play_policy(flip, "rgw-random", 1, seed=12)
+    assert report["fallbacks"].get("loop", 0) > 0
     assert report["outcomes"] == {"terminal": 1}
-    guarded = play_policy(policy, "rgw2", 1)  # the enemy guards the terminal: safe steps only
-    assert guarded["fallbacks"] == {"no_goal": 100} and guarded["outcomes"] == {"timeout": 1}
 
 
 def test_a_goal_off_the_map_counts_as_no_route(tmp_path: Path) -> None:
