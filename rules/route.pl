@@ -35,7 +35,8 @@
     shortest is taken (the step limit is the only price of a step). Ties go
     to the first action in the order up, right, down, left.
 
-    Dijkstra's search over library(heaps), visited cells in library(assoc).
+    Dijkstra's search over library(heaps); the map and the visited cells are
+    terms with one argument per cell, read with arg/3.
     Helpers start with route_pl_, so this file loads beside the other rule
     files and beside a learned strategy (whose own helpers start with route_).
 */
@@ -43,6 +44,7 @@
 :- use_module(library(heaps)).
 :- use_module(library(assoc)).
 :- use_module(library(lists)).
+:- use_module(library(apply)).
 
 :- dynamic at/5, object/2, holding/3, terrain/4, grid/3.
 :- dynamic route_pl_memo_/4.
@@ -159,32 +161,42 @@ route_pl_mode_(strict).
 route_pl_mode_(jumps).
 
 %   route_pl_map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs,
-%   as map(Rows, Cols, Blocked, Mountains, Jumps, MountainCost, TargetCell);
-%   Blocked, Mountains and Jumps are assocs keyed by cell (Row * Cols + Col).
-route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Blocked, Mountains, Jumps, Mountain, Target)) :-
+%   as map(Rows, Cols, Cells, MountainCost, TargetCell). Cells is a term
+%   with one argument per cell (Row * Cols + Col + 1), so that a search looks
+%   a cell up with arg/3: unbound for a free cell, wall (walls, and objects
+%   a path may not enter), mountain, or jump(Landing) for a teleport end.
+route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target)) :-
     grid(E, Rows, Cols),
     Mountain is 1 + Rows * Cols,
     Target is GR * Cols + GC,
-    route_pl_blocked_(E, T, Goal, Blocked),
-    findall(Cell-m, ( terrain(E, mountain, R, C), Cell is R * Cols + C ), Ms),
-    route_pl_assoc_(Ms, Mountains),
-    route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps).
+    N is Rows * Cols,
+    functor(Cells, cells, N),
+    forall(terrain(E, Type, R, C),
+           ( I is R * Cols + C + 1,
+             ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )),
+    forall(( at(E, T, Id, R, C), Id \== agent, Id \== Goal, \+ route_pl_open_(E, T, Id) ),
+           ( I is R * Cols + C + 1, nb_setarg(I, Cells, wall) )),
+    route_pl_jumps_(E, T, Goal, Mode, Cols, Cells).
 
-%   route_pl_jumps_: in mode jumps, entering a teleport end (not
-%   the goal) lands on the other end, when the map has exactly two.
-route_pl_jumps_(E, T, Goal, Mode, Cols, Jumps) :-
+%   route_pl_jumps_: in mode jumps, entering a teleport end (not the goal)
+%   lands on the other end, when the map has exactly two.
+route_pl_jumps_(E, T, Goal, Mode, Cols, Cells) :-
     (   Mode \== strict,
         findall(Id-(R-C), ( object(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
         A \== Goal, B \== Goal
     ->  CellA is RA * Cols + CA, CellB is RB * Cols + CB,
-        route_pl_assoc_([CellA-CellB, CellB-CellA], Jumps)
-    ;   empty_assoc(Jumps)
+        IA is CellA + 1, IB is CellB + 1,
+        nb_setarg(IA, Cells, jump(CellB)),
+        nb_setarg(IB, Cells, jump(CellA))
+    ;   true
     ).
 
+%   Objects a path may cross: enemies, while the agent holds the sword.
+route_pl_open_(E, T, Id) :- object(Id, enemy), holding(E, T, sword).
+
 %   route_pl_blocked_(+E, +T, +Goal, -Blocked): assoc of the cells a path
-%   may not enter: walls (any terrain but mountains) and the objects other
-%   than Goal, but for enemies while the agent holds the sword (teleport
-%   ends of a jump are taken care of before Blocked is looked at).
+%   may not enter (walls, and the objects other than Goal that route/4 does
+%   not cross), for safe_step/3.
 route_pl_blocked_(E, T, Goal, Blocked) :-
     grid(E, _, Cols),
     findall(Cell-wall,
@@ -196,13 +208,8 @@ route_pl_blocked_(E, T, Goal, Blocked) :-
               Cell is R * Cols + C ),
             Objects),
     append(Walls, Objects, Pairs),
-    route_pl_assoc_(Pairs, Blocked).
-
-route_pl_open_(E, T, Id) :- object(Id, enemy), holding(E, T, sword).
-
-route_pl_assoc_(Pairs, Assoc) :-
     empty_assoc(A0),
-    foldl(route_pl_put_, Pairs, A0, Assoc).
+    foldl(route_pl_put_, Pairs, A0, Blocked).
 
 route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 
@@ -210,55 +217,69 @@ route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 %   each queue entry keeps the first action of its path and is keyed
 %   Cost * 4 + the action's index, so that of equally cheap paths the one
 %   whose first action comes first in up, right, down, left wins. The
-%   target is always enterable.
+%   target is always enterable. Done cells are marked in a term with one
+%   argument per cell.
 route_pl_search_(R0-C0, Map, Action, Cost) :-
-    Map = map(_, Cols, _, _, _, _, _),
+    Map = map(Rows, Cols, _, _, _),
     Start is R0 * Cols + C0,
-    empty_assoc(Done0),
-    put_assoc(Start, Done0, true, Done1),
+    N is Rows * Cols,
+    functor(Done, done, N),
+    S1 is Start + 1,
+    nb_setarg(S1, Done, x),
     empty_heap(Heap0),
-    route_pl_expand_(Start, none, 0, Map, Done1, Heap0, Heap1),
-    route_pl_loop_(Heap1, Map, Done1, Action, Cost).
+    route_pl_expand_(Start, none, 0, Map, Done, Heap0, Heap1),
+    route_pl_loop_(Heap1, Map, Done, Action, Cost).
 
-route_pl_loop_(Heap0, Map, Done0, Action, Cost) :-
+route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
     get_from_heap(Heap0, Key, Cell-First, Heap1),
     D is Key // 4,
-    Map = map(_, _, _, _, _, _, Target),
-    (   Cell =:= Target
+    I is Cell + 1,
+    arg(I, Done, Seen),
+    (   arg(5, Map, Target), Cell =:= Target
     ->  Action = First, Cost = D
-    ;   get_assoc(Cell, Done0, _)
-    ->  route_pl_loop_(Heap1, Map, Done0, Action, Cost)
-    ;   put_assoc(Cell, Done0, true, Done1),
-        route_pl_expand_(Cell, First, D, Map, Done1, Heap1, Heap2),
-        route_pl_loop_(Heap2, Map, Done1, Action, Cost)
+    ;   nonvar(Seen)
+    ->  route_pl_loop_(Heap1, Map, Done, Action, Cost)
+    ;   nb_setarg(I, Done, x),
+        route_pl_expand_(Cell, First, D, Map, Done, Heap1, Heap2),
+        route_pl_loop_(Heap2, Map, Done, Action, Cost)
     ).
 
 %   Neighbours in the order up, right, down, left; a path's first action is
 %   its first move (First is none at the start).
 route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
-    Map = map(_, Cols, _, _, _, _, _),
+    arg(2, Map, Cols),
     R is Cell // Cols, C is Cell mod Cols,
-    foldl(route_pl_neighbour_(R-C, First, D, Map, Done),
-          [up, right, down, left], Heap0, Heap).
+    Up is R - 1, Down is R + 1, Left is C - 1, Right is C + 1,
+    route_pl_neighbour_(Up, C, up, First, D, Map, Done, Heap0, Heap1),
+    route_pl_neighbour_(R, Right, right, First, D, Map, Done, Heap1, Heap2),
+    route_pl_neighbour_(Down, C, down, First, D, Map, Done, Heap2, Heap3),
+    route_pl_neighbour_(R, Left, left, First, D, Map, Done, Heap3, Heap).
 
-route_pl_neighbour_(RC, First, D, Map, Done, Move, Heap0, Heap) :-
-    Map = map(Rows, Cols, Blocked, Mountains, Jumps, Mountain, Target),
-    route_pl_move_(Move, RC, R1-C1),
-    (   route_pl_inside_(R1-C1, Rows, Cols)
-    ->  Cell0 is R1 * Cols + C1,
-        ( get_assoc(Cell0, Jumps, Landing) -> Cell = Landing ; Cell = Cell0 ),
-        (   \+ get_assoc(Cell, Done, _),
-            ( Cell0 =:= Target -> true ; Cell \== Cell0 -> true ; \+ get_assoc(Cell0, Blocked, _) )
-        ->  ( get_assoc(Cell0, Mountains, _) -> Step is 1 + Mountain ; Step = 1 ),
-            D1 is D + Step,
-            ( First == none -> First1 = Move ; First1 = First ),
-            route_pl_move_index_(First1, I),
-            Key is D1 * 4 + I,
-            add_to_heap(Heap0, Key, Cell-First1, Heap)
-        ;   Heap = Heap0
-        )
+route_pl_neighbour_(R, C, Move, First, D, Map, Done, Heap0, Heap) :-
+    Map = map(Rows, Cols, Cells, Mountain, Target),
+    (   R >= 0, R < Rows, C >= 0, C < Cols,
+        Cell0 is R * Cols + C,
+        I0 is Cell0 + 1,
+        arg(I0, Cells, Kind),
+        route_pl_enter_(Kind, Cell0, Target, Mountain, Cell, Step),
+        I is Cell + 1,
+        arg(I, Done, Seen),
+        var(Seen)
+    ->  D1 is D + Step,
+        ( First == none -> First1 = Move ; First1 = First ),
+        route_pl_move_index_(First1, MI),
+        Key is D1 * 4 + MI,
+        add_to_heap(Heap0, Key, Cell-First1, Heap)
     ;   Heap = Heap0
     ).
+
+%   route_pl_enter_(+Kind, +Cell0, +Target, +Mountain, -Cell, -Step):
+%   entering Cell0 of Kind puts the agent on Cell at the cost Step; fails
+%   for a cell a path may not enter.
+route_pl_enter_(_, Target, Target, _, Target, 1) :- !.
+route_pl_enter_(Kind, Cell0, _, _, Cell0, 1) :- var(Kind), !.
+route_pl_enter_(mountain, Cell0, _, Mountain, Cell0, Step) :- !, Step is 1 + Mountain.
+route_pl_enter_(jump(Landing), _, _, _, Landing, 1).
 
 %!  default_goal(+E, +T, -Object) is semidet.
 %
