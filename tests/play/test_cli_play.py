@@ -64,3 +64,25 @@ def test_errors(run_neurosym, tmp_path: Path, args: list[str], message: str) -> 
     assert proc.returncode == 1, proc.stdout
     assert proc.stderr.startswith("neurosym play: error: ") and message in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_a_strategy_over_the_networks_relations(run_neurosym, tmp_path: Path) -> None:
+    """features: both: holds/5 computed live from the checkpoint, thresholds from --kb."""
+    policy = tmp_path / "both.pl"
+    policy.write_text(
+        "%! features: both\n"
+        "goal(E, T, sword) :- holds(E, T, r(_), agent, sword), at(E, T, sword, _, _).\n"
+        "goal(E, T, O) :- holds(E, T, r(_), _, _), default_goal(E, T, O).\n"
+    )
+    kb = tmp_path / "kb.pl"
+    kb.write_text("".join(f"threshold({j}, 0.5).\n" for j in range(8)))
+    args = ["play", "--policy", policy, "--checkpoint", "rgw-random-predinet-cellkeys"]
+    proc = run_neurosym(*args, "--kb", kb, "--episodes", "2", "--seed", "3000000000", "--json")
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["env"] == "rgw-random" and report["env_kwargs"] == {"num_mountains": 12}
+    assert report["features"] == "both" and report["success_rate"] == 1.0
+    assert report["fallback_steps"] < report["steps"]  # holds/5 facts were there to read
+    proc = run_neurosym(*args, "--episodes", "1")
+    assert proc.returncode == 1
+    assert "has no threshold/2 for holds/5: give the KB it was learned from (--kb)" in proc.stderr
