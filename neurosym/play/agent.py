@@ -70,12 +70,18 @@ class PrologAgent:
     """Plays with a strategy file's ``goal/3`` and route.pl; ``act(obs, venv)`` as evaluation wants.
 
     ``policy``: the strategy file (or a :class:`Policy`). ``network``: the
-    :class:`~neurosym.agent.checkpoint.LoadedAgent` whose relation facts a
-    strategy with ``features: relations`` or ``both`` reads (see
-    :mod:`neurosym.play.relations`), with ``thresholds`` (relation j ->
-    threshold of holds/5) when the strategy file has no threshold/2. Use
-    :meth:`make_venv` for the envs it
-    plays, so it sees their infos; close it (or use ``with``) when done.
+    loaded checkpoint (:class:`~neurosym.agent.checkpoint.Agent`) whose
+    relation facts a strategy with ``features: relations`` or ``both`` reads
+    (:mod:`neurosym.play.relations`), with ``thresholds`` (relation j ->
+    threshold of holds/5) when the strategy file has no threshold/2. Play
+    the envs :meth:`make_venv` makes, so that the agent sees their infos;
+    close it (or use ``with``) when done.
+
+        >>> with PrologAgent("examples/play/rgw_strategy.pl") as agent:
+        ...     venv = agent.make_venv("rgw2", 1, seed=0)
+        ...     obs, _ = venv.reset(seed=[0])
+        ...     agent.act(obs, venv)
+        array([1])
     """
 
     def __init__(
