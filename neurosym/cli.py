@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | induce | plot | envs | agents.
+"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | induce | play | plot | report | envs | agents.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -208,6 +208,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "induce": (
         "neurosym.induce.cli_induce",
         "Learn rules back from a knowledge base: the world's rules (predicts/3).",
+    ),
+    "play": (
+        "neurosym.play.cli_play",
+        "Play with a strategy file: goal/3 picks the object, route.pl the action; eval's figures.",
     ),
     "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),

@@ -90,10 +90,7 @@ def score(
     The figures of the report (returns, success, lengths, outcomes and, on
     RGW, the level-aware ones); any policy, e.g. a scripted one in tests.
     """
-    import numpy as np
-
-    from neurosym.agent.evaluation import level_scores, play_scored
-    from neurosym.agent.rollout import SUCCESS_OUTCOMES
+    from neurosym.agent.evaluation import play_scored
     from neurosym.envs import make_batched
 
     done = play_scored(
@@ -102,6 +99,16 @@ def score(
         episodes,
         seed,
     )
+    return report_of(done)
+
+
+def report_of(done: Any) -> dict[str, Any]:
+    """The report's figures of played episodes (a :class:`~neurosym.agent.evaluation.ScoredEpisodes`)."""
+    import numpy as np
+
+    from neurosym.agent.evaluation import level_scores
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES
+
     returns = np.asarray(done.returns)
     return {
         "mean_return": float(returns.mean()),
@@ -132,7 +139,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     from neurosym.display import plain
 
-    outcomes = plain(", ".join(f"{k} {v}" for k, v in report["outcomes"].items()))
     frames = report["trained_frames"]
     print(
         f"checkpoint   {plain(report['checkpoint'])} ({plain(report['env'])}, "
@@ -141,6 +147,15 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"episodes     {report['episodes']} ({'greedy' if report['greedy'] else 'sampled'}, seed {report['seed']})"
     )
+    print_figures(report)
+    return 0
+
+
+def print_figures(report: dict[str, Any]) -> None:
+    """The report's figure lines, from mean return to outcomes (``neurosym play`` prints the same)."""
+    from neurosym.display import plain
+
+    outcomes = plain(", ".join(f"{k} {v}" for k, v in report["outcomes"].items()))
     print(f"mean return  {report['mean_return']:.3f} (std {report['std_return']:.3f})")
     print(f"success      {100 * report['success_rate']:.1f} %")
     for key, label in (
@@ -152,7 +167,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"{label} {100 * report[key]:.1f} %{_of(report, key)}")
     print(f"mean length  {report['mean_length']:.1f} steps")
     print(f"outcomes     {outcomes}")
-    return 0
 
 
 def _of(report: dict[str, Any], key: str) -> str:

@@ -1,0 +1,296 @@
+"""PrologAgent: a strategy's ``goal/3`` and route.pl's ``route/4`` playing a batched env.
+
+Each step, for every sub-env whose episode is running, the live state's facts
+(:mod:`neurosym.play.live`) go into SWI-Prolog as data (asserted, never
+consulted), the strategy's first answer of ``goal(E, T, Object)`` names the
+object to go for and ``route(E, T, Object, Action)`` (rules/route.pl, loaded
+as code beside the strategy) the action. The Prolog side is
+:mod:`neurosym.play.prolog`: one call per sub-env and step.
+
+When goal/3 has no answer, or no route to its object exists, the agent falls
+back to ``default_goal/3`` of route.pl (a hand-written strategy: RGW the
+sword, then enemies, then the terminal; Box-World the held key's lock, else
+a loose key), then to ``safe_step/3`` (the first move into a free cell), then
+to ``up``. It does the same in a state the episode has been in before (the
+same positions and held items): a strategy that reads the state alone would
+choose as it did then and go round the same loop for good.
+:attr:`PrologAgent.fallbacks` counts those steps by cause (``no_goal``,
+``no_route``, ``loop``).
+
+Episode E of the facts is the episode's number (its reset seed minus the
+first seed), T its state; an episode's facts are retracted when it ends.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from collections import Counter
+from typing import Any
+
+import numpy as np
+
+from neurosym.envs.actions import ACTION_NAMES
+from neurosym.errors import ConfigError, PrologError
+from neurosym.play import live
+from neurosym.play import prolog as play_prolog
+from neurosym.play.policy import Policy, read_policy
+from neurosym.terms import Term
+
+INFERENCE_LIMIT = 10_000_000
+"""inferences a strategy may take to choose one object (then the run stops with one line)"""
+
+SCHEMA = (
+    "kb_meta/2", "object/2", "episode/4", "step/4", "at/5", "holding/3", "event/3",
+    "attends/8", "relation/7", "holds/5", "threshold/2", "attention/6", "terrain/4", "grid/3",
+)  # fmt: skip
+"""every predicate of the KB schema, declared dynamic in the agent's module"""
+
+_ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
+_loaded = False
+_lock = threading.Lock()
+
+
+def _janus() -> Any:
+    """janus with neurosym_play consulted (once per process)."""
+    global _loaded
+    from neurosym.prolog.locate import import_janus
+
+    janus = import_janus()
+    if not _loaded:
+        with _lock:
+            if not _loaded:
+                janus.consult(f"/neurosym/{play_prolog.MODULE}.pl", data=play_prolog.SOURCE)
+                _loaded = True
+    return janus
+
+
+class PrologAgent:
+    """Plays with a strategy file's ``goal/3`` and route.pl; ``act(obs, venv)`` as evaluation wants.
+
+    ``policy``: the strategy file (or a :class:`Policy`). ``network``: the
+    loaded checkpoint (:class:`~neurosym.agent.checkpoint.Agent`) whose
+    relation facts a strategy with ``features: relations`` or ``both`` reads
+    (:mod:`neurosym.play.relations`), with ``thresholds`` (relation j ->
+    threshold of holds/5) when the strategy file has no threshold/2. Play
+    the envs :meth:`make_venv` makes, so that the agent sees their infos;
+    close it (or use ``with``) when done.
+
+        >>> with PrologAgent("examples/play/rgw_strategy.pl") as agent:
+        ...     venv = agent.make_venv("rgw2", 1, seed=0)
+        ...     obs, _ = venv.reset(seed=[0])
+        ...     agent.act(obs, venv)
+        array([1])
+    """
+
+    def __init__(
+        self,
+        policy: str | os.PathLike[str] | Policy,
+        network: Any = None,
+        *,
+        thresholds: dict[int, float] | None = None,
+        inference_limit: int = INFERENCE_LIMIT,
+    ) -> None:
+        from neurosym.prolog.knowledge_base import KnowledgeBase
+        from neurosym.shipped import rule_file
+
+        self.policy = policy if isinstance(policy, Policy) else read_policy(policy)
+        if self.policy.needs_network and network is None:
+            raise ConfigError(
+                f"{self.policy.path} reads the network's relation facts "
+                f"(features: {self.policy.features}); give the agent they came from "
+                "(--checkpoint)"
+            )
+        self.inference_limit = int(inference_limit)
+        self.kb = KnowledgeBase(None)
+        try:
+            self.kb.query("forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA])
+            self.kb.load_rules(rule_file("route"))
+            self.kb.load_rules(self.policy.path)
+            if not self.kb.query("current_predicate(goal/3)"):
+                raise ConfigError(
+                    f"{self.policy.path} defines no goal/3; a strategy file defines "
+                    "goal(E, T, Object), the object to go for next in state T of episode E"
+                )
+            self.relations = None
+            if self.policy.needs_network:
+                from neurosym.play.relations import RelationFacts
+
+                self.relations = RelationFacts(network, self.kb, self.policy, thresholds)
+        except BaseException:
+            self.kb.close()
+            raise
+        self.module = self.kb.module
+        self.fallbacks: Counter[str] = Counter()
+        self.decisions = 0
+        self.decide_seconds = 0.0
+        self.goals: Counter[str] = Counter()
+        self.last: tuple[str, str, str] | None = None
+        """(status, goal, action) of the latest decision"""
+
+    # -- envs -------------------------------------------------------------
+
+    def make_venv(self, env: str, n: int, seed: int, **env_kwargs: Any) -> _Watched:
+        """A batched env of ``n`` whose resets and steps this agent follows (episode = seed - ``seed``)."""
+        from neurosym.envs import make_batched
+
+        return _Watched(make_batched(env, n, seed=seed, **env_kwargs), self, seed)
+
+    # -- acting -----------------------------------------------------------
+
+    def act(self, obs: np.ndarray, venv: _Watched) -> np.ndarray:
+        """Actions (n,) for the batch: Prolog's choice for every running episode, 0 for idle ones."""
+        actions = np.zeros(len(obs), dtype=np.int64)
+        live = [i for i in range(len(obs)) if venv.running[i]]
+        extra: dict[int, list[Any]] = {}
+        if self.relations is not None and live:
+            extra = self.relations.facts(obs, venv, live)
+        for i in live:
+            actions[i] = self._decide(venv, i, extra.get(i, []))
+        return actions
+
+    def _decide(self, venv: _Watched, i: int, extra: list[Any]) -> int:
+        e, t = int(venv.episode[i]), int(venv.t[i])
+        ats, held = venv.state[i]
+        key = (tuple(ats), tuple(held))
+        seen = key in venv.visited[i]
+        venv.visited[i].add(key)
+        start = time.perf_counter()
+        out = _janus().query_once(
+            f"{play_prolog.MODULE}:decide(M, E, T, S, P, X, L, Seen, Out)",
+            {
+                "M": self.module, "E": e, "T": t,
+                "S": [[list(a) for a in ats], [live.encode(h) for h in held]],
+                "P": venv.prev[i], "X": extra, "L": self.inference_limit,
+                "Seen": "true" if seen else "false",
+            },
+        )["Out"]  # fmt: skip
+        self.decide_seconds += time.perf_counter() - start
+        self.decisions += 1
+        venv.prev[i] = []
+        if out[0] == "error":
+            raise PrologError(f"{self.policy.path}: {out[1]}")
+        (status, goal), action = out
+        self.last = (status, str(goal), action)
+        if status != "ok":
+            self.fallbacks[status] += 1
+        self.goals[str(goal)] += 1
+        return _ACTION_INDEX[action]
+
+    def state_facts(self, episode: int, t: int) -> dict[str, list[tuple[Any, ...]]]:
+        """The at/5, holding/3, step/4 and event/3 facts of (episode, t) now in the agent's KB, as text rows."""
+        goals = {
+            "at": ("at(E, T, Id, R, C)", ("Id", "R", "C")),
+            "holding": ("holding(E, T, I)", ("I",)),
+            "step": ("step(E, T, A, W)", ("A", "W")),
+            "event": ("event(E, T, Ev)", ("Ev",)),
+        }
+        out: dict[str, list[tuple[Any, ...]]] = {}
+        for name, (goal, cols) in goals.items():
+            rows = self.kb.query(goal, E=episode, T=t)
+            out[name] = sorted(tuple(_text(r[c]) for c in cols) for r in rows)
+        return out
+
+    def close(self) -> None:
+        """Unload the strategy and its facts."""
+        self.kb.close()
+
+    def __enter__(self) -> PrologAgent:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- episodes (called by _Watched) -------------------------------------
+
+    def begin(self, episode: int, facts: live.EpisodeFacts) -> None:
+        _janus().query_once(
+            f"{play_prolog.MODULE}:begin_episode(M, E, O, X, G)",
+            {
+                "M": self.module, "E": episode,
+                "O": [[i, live.encode(t)] for i, t in facts.objects],
+                "X": [list(row) for row in facts.terrain],
+                "G": [facts.rows, facts.cols],
+            },
+        )  # fmt: skip
+
+    def end(self, episode: int) -> None:
+        _janus().query_once(
+            f"{play_prolog.MODULE}:end_episode(M, E)", {"M": self.module, "E": episode}
+        )
+
+
+def _indicator(text: str) -> Term:
+    name, arity = text.split("/")
+    return Term("/", (name, int(arity)))
+
+
+def _text(value: Any) -> Any:
+    return value if isinstance(value, int | float) else str(value)
+
+
+class _Watched:
+    """A batched env that tells its PrologAgent about every reset and step.
+
+    Per sub-env it keeps the episode number, the state index t, whether the
+    episode is still running, the state's at/holding rows and the previous
+    transition (action, reward, events) not yet asserted. Everything else is
+    the wrapped env's.
+    """
+
+    def __init__(self, venv: Any, agent: PrologAgent, first_seed: int) -> None:
+        self.venv, self.agent, self.first_seed = venv, agent, first_seed
+        n = venv.num_envs
+        self.num_envs = n
+        self.names = tuple(venv.entity_names)
+        self.episode = np.zeros(n, dtype=np.int64)
+        self.t = np.zeros(n, dtype=np.int64)
+        self.running = np.zeros(n, dtype=bool)
+        self.state: list[Any] = [None] * n
+        self.prev: list[list[Any]] = [[] for _ in range(n)]
+        self.visited: list[set[Any]] = [set() for _ in range(n)]
+        self.info: Any = None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.venv, name)
+
+    def reset(self, seed: list[int]) -> tuple[np.ndarray, Any]:
+        for i in np.flatnonzero(self.running):  # an earlier wave cut short
+            self.agent.end(int(self.episode[i]))
+        obs, info = self.venv.reset(seed=seed)
+        grids = self.venv.entity_grid()
+        self.info = info
+        for i in range(self.num_envs):
+            d = self.venv.decode_info(info, i)
+            e = int(seed[i]) - self.first_seed
+            self.episode[i], self.t[i], self.running[i] = e, 0, True
+            self.state[i] = live.state_rows(d)
+            self.prev[i] = []
+            self.visited[i] = set()
+            self.agent.begin(e, live.episode_facts(d, np.asarray(grids[i]), self.names))
+        return obs, info
+
+    def step(self, actions: np.ndarray) -> tuple[Any, ...]:
+        obs, reward, terminated, truncated, info = self.venv.step(actions)
+        self.info = info
+        for i in np.flatnonzero(self.running):
+            d = self.venv.decode_info(info, i)
+            if terminated[i] or truncated[i]:
+                self.running[i] = False
+                self.agent.end(int(self.episode[i]))
+                continue
+            self.t[i] += 1
+            self.state[i] = live.state_rows(d)
+            self.prev[i] = [
+                ACTION_NAMES[int(actions[i])],
+                float(reward[i]),
+                [live.encode(ev) for ev in d["events"]],
+            ]
+        return obs, reward, terminated, truncated, info
+
+    def close(self) -> None:
+        for i in np.flatnonzero(self.running):
+            self.agent.end(int(self.episode[i]))
+        self.running[:] = False
+        self.venv.close()

@@ -1,0 +1,105 @@
+"""Play and score a strategy file: the figures of ``neurosym eval``, plus fallbacks and speed.
+
+:func:`play_policy` plays ``episodes`` episodes (episode k from
+``reset(seed=seed + k)``, as ``neurosym eval`` does) with a
+:class:`~neurosym.play.agent.PrologAgent` and scores them with the same code
+(:func:`neurosym.agent.evaluation.play_scored`,
+:func:`neurosym.agent.cli_eval.report_of`), so the two reports compare line by
+line under the same names.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from typing import Any
+
+from neurosym.errors import ConfigError
+from neurosym.seeds import check_seed
+
+BATCH = 64
+"""episodes played side by side (sub-envs of one batched env)"""
+
+
+def play_policy(
+    policy: str | os.PathLike[str],
+    env: str | None = None,
+    episodes: int = 100,
+    seed: int = 0,
+    env_kwargs: dict[str, Any] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    batch: int = BATCH,
+    kb: str | os.PathLike[str] | None = None,
+) -> dict[str, Any]:
+    """Play ``episodes`` episodes of the strategy ``policy`` on ``env``; a dict of plain values.
+
+    ``checkpoint``: the network whose relation facts the strategy reads
+    (needed for ``features: relations`` or ``both``); its env is the default
+    ``env``; ``kb``: the KB the strategy was learned from, whose
+    ``threshold/2`` sets which relations hold (when the strategy file has
+    none). Keys: those of ``neurosym eval --json`` that do not describe a
+    network (mean_return ... outcomes), plus ``policy``, ``features``,
+    ``fallbacks`` (steps by cause), ``fallback_steps``, ``goals`` (steps per
+    object chosen), ``steps`` and ``steps_per_s`` (env steps per second of the
+    whole loop: facts, Prolog, env).
+    """
+    from neurosym.agent.cli_eval import report_of
+    from neurosym.agent.evaluation import play_scored
+    from neurosym.envs import canonical_name
+    from neurosym.play.agent import PrologAgent
+    from neurosym.play.policy import read_policy
+
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
+    check_seed(seed, episodes)
+    spec = read_policy(policy)
+    network = None
+    if checkpoint is not None:
+        from neurosym.agent.checkpoint import env_for, load_agent
+
+        network = load_agent(checkpoint)
+        env, env_kwargs = env_for(network, env, env_kwargs)
+    if env is None:
+        raise ConfigError("give the env to play (--env NAME, e.g. rgw-random)")
+    env = canonical_name(env)
+    kwargs = dict(env_kwargs or {})
+    thresholds = kb_thresholds(kb) if kb is not None else None
+    with PrologAgent(spec, network, thresholds=thresholds) as agent:
+        start = time.perf_counter()
+        done = play_scored(
+            agent.act,
+            lambda n: agent.make_venv(env, n, seed, **kwargs),
+            episodes,
+            seed,
+            batch,
+        )
+        seconds = time.perf_counter() - start
+        steps = int(sum(done.lengths))
+        return {
+            "policy": str(spec.path),
+            "features": spec.features,
+            "checkpoint": str(checkpoint) if checkpoint is not None else None,
+            "env": env,
+            "env_kwargs": kwargs,
+            "episodes": episodes,
+            "seed": seed,
+            **report_of(done),
+            "fallbacks": dict(sorted(agent.fallbacks.items())),
+            "fallback_steps": int(sum(agent.fallbacks.values())),
+            "goals": dict(sorted(agent.goals.items())),
+            "steps": steps,
+            "steps_per_s": steps / seconds if seconds > 0 else None,
+        }
+
+
+def kb_thresholds(kb: str | os.PathLike[str]) -> dict[int, float]:
+    """Relation j -> threshold of a KB's ``threshold/2`` facts; ConfigError when it has none."""
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    with KnowledgeBase(kb) as base:
+        rows = base.query("threshold(J, V)")
+    if not rows:
+        raise ConfigError(
+            f"{kb} has no threshold/2 facts; give the KB the strategy was learned from"
+        )
+    return {int(r["J"]): float(r["V"]) for r in rows}

@@ -1,0 +1,88 @@
+"""`neurosym play` end to end: --json with eval's names, the lines for people, one-line errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+RGW = "examples/play/rgw_strategy.pl"
+
+
+def test_json(run_neurosym) -> None:
+    proc = run_neurosym("play", "--policy", RGW, "--env", "rgw2", "--episodes", "2", "--json")
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["mean_return"] == pytest.approx(10.7)
+    assert report["success_rate"] == 1.0 and report["optimal_rate"] == 1.0
+    assert report["sword_first_guarded"] == 1.0 and report["no_detour_decoy"] is None
+    assert report["outcomes"] == {"terminal": 2} and report["fallback_steps"] == 0
+    assert report["steps_per_s"] > 0 and report["features"] == "world"
+
+
+def test_text_and_env_option(run_neurosym) -> None:
+    proc = run_neurosym(
+        "play", "--policy", RGW, "--env", "rgw-random", "--episodes", "3", "--seed", "1000",
+        "--env-option", "enemy=end",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert [line.split()[0] for line in lines[:5]] == [
+        "policy", "episodes", "mean", "success", "optimal",
+    ]  # fmt: skip
+    assert [line.split()[0] for line in lines[-4:]] == ["mean", "outcomes", "fallbacks", "speed"]
+    assert lines[3] == "success      100.0 %"
+    assert lines[-2] == "fallbacks    0 of " + lines[-2].split()[3] + " steps (0.0 %)"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--policy", "no/such.pl", "--env", "rgw2"], "no such policy file: no/such.pl"),
+        (["--policy", "{nogoal}", "--env", "rgw2"], "defines no goal/3"),
+        (
+            ["--policy", "{relations}", "--env", "rgw2"],
+            "give the agent they came from (--checkpoint)",
+        ),
+        (["--policy", RGW], "give the env to play (--env NAME"),
+        (["--policy", RGW, "--env", "rgw2", "--episodes", "0"], "--episodes must be a positive"),
+        (
+            ["--policy", RGW, "--env", "rgw2", "--env-option", "colour=red"],
+            "unknown option 'colour'",
+        ),
+    ],
+)
+def test_errors(run_neurosym, tmp_path: Path, args: list[str], message: str) -> None:
+    (tmp_path / "nogoal.pl").write_text("foo(1).\n")
+    (tmp_path / "relations.pl").write_text("%! features: relations\ngoal(_, _, terminal).\n")
+    args = [
+        a.format(nogoal=tmp_path / "nogoal.pl", relations=tmp_path / "relations.pl") for a in args
+    ]
+    proc = run_neurosym("play", *args)
+    assert proc.returncode == 1, proc.stdout
+    assert proc.stderr.startswith("neurosym play: error: ") and message in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_a_strategy_over_the_networks_relations(run_neurosym, tmp_path: Path) -> None:
+    """features: both: holds/5 computed live from the checkpoint, thresholds from --kb."""
+    policy = tmp_path / "both.pl"
+    policy.write_text(
+        "%! features: both\n"
+        "goal(E, T, sword) :- holds(E, T, r(_), agent, sword), at(E, T, sword, _, _).\n"
+        "goal(E, T, O) :- holds(E, T, r(_), _, _), default_goal(E, T, O).\n"
+    )
+    kb = tmp_path / "kb.pl"
+    kb.write_text("".join(f"threshold({j}, 0.5).\n" for j in range(8)))
+    args = ["play", "--policy", policy, "--checkpoint", "rgw-random-predinet-cellkeys"]
+    proc = run_neurosym(*args, "--kb", kb, "--episodes", "2", "--seed", "3000000000", "--json")
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["env"] == "rgw-random" and report["env_kwargs"] == {"num_mountains": 12}
+    assert report["features"] == "both" and report["success_rate"] == 1.0
+    assert report["fallback_steps"] < report["steps"]  # holds/5 facts were there to read
+    proc = run_neurosym(*args, "--episodes", "1")
+    assert proc.returncode == 1
+    assert "has no threshold/2 for holds/5: give the KB it was learned from (--kb)" in proc.stderr

@@ -1,0 +1,65 @@
+"""rules/route.pl from Python: the hand-made states of its plunit file, and routes on real levels."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from neurosym.play import PrologAgent, play_policy
+from neurosym.prolog.knowledge_base import KnowledgeBase
+
+ROOT = Path(__file__).resolve().parents[2]
+FACTS = ROOT / "rules" / "tests" / "route_facts.pl"
+
+
+@pytest.mark.parametrize(
+    ("episode", "t", "goal", "answer"),
+    [
+        (0, 0, "sword", ("down", 8)),  # around the mountain
+        (0, 0, "terminal", ("down", 7)),  # past the pit and the teleport end
+        (2, 1, "terminal", ("right", 3)),  # holding the sword: through the enemy
+        (3, 1, "lock_red", ("right", 6)),  # around the loose key and the box
+    ],
+)
+def test_route_through_janus(episode: int, t: int, goal: str, answer: tuple) -> None:
+    with KnowledgeBase(None, rules=[FACTS, "route"]) as kb:
+        rows = kb.query("route(E, T, G, A, C)", E=episode, T=t, G=goal)
+    assert [(r["A"], r["C"]) for r in rows] == [answer]
+
+
+def test_no_route_past_an_unarmed_enemy() -> None:
+    with KnowledgeBase(None, rules=[FACTS, "route"]) as kb:
+        assert kb.query("route(2, 0, terminal, A)") == []
+
+
+def _only(tmp_path: Path, body: str) -> Path:
+    path = tmp_path / "strategy.pl"
+    path.write_text(f"%! features: world\n{body}\n")
+    return path
+
+
+@pytest.mark.parametrize(("env", "seed"), [("rgw2", 0), ("rgw-random", 12), ("rgw-random", 13)])
+def test_following_the_route_reaches_the_sword_and_nothing_else(
+    tmp_path: Path, env: str, seed: int
+) -> None:
+    """Going for the sword only: the first event of the episode is picking it up."""
+    policy = _only(tmp_path, "goal(_, _, sword).")
+    with PrologAgent(policy) as agent:
+        venv = agent.make_venv(env, 1, seed)
+        obs, _ = venv.reset(seed=[seed])
+        events: list[tuple[str, ...]] = []
+        for _ in range(40):
+            obs, _r, _term, _trunc, info = venv.step(agent.act(obs, venv))
+            events.append(venv.decode_info(info, 0)["events"])
+            if "picked(sword)" in events[-1]:
+                break
+        venv.close()
+    assert events[-1] == ("picked(sword)",)
+    assert not any(events[:-1]) or set().union(*events[:-1]) <= {"crossed(mountain)"}
+
+
+def test_box_world_key_then_lock(tmp_path: Path) -> None:
+    report = play_policy(ROOT / "examples" / "play" / "boxworld_strategy.pl", "bw3", 4, seed=5)
+    assert report["success_rate"] == 1.0 and report["fallback_steps"] == 0
+    assert report["mean_return"] == 12.0  # two boxes on the way (+1 each) and the gem (+10)
