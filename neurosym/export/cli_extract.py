@@ -1,7 +1,7 @@
 """``neurosym extract``: record episodes, extract the R-vector facts, write the KB, print answers.
 
     neurosym extract --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--episodes 20] [--seed 0]
-        [--greedy|--sample] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
+        [--greedy|--sample] [--actions agent|random] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
         [--format pl,parquet] [--qlf] [--verbose]
 
 Writes into ``--out`` (default ``kb_out/<env>``):
@@ -51,6 +51,14 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="episode k is played from seed S + k (default: 0)",
     )
     add_action_mode(parser)
+    parser.add_argument(
+        "--actions",
+        choices=("agent", "random"),
+        default="agent",
+        help="who chooses the actions: the agent, or uniformly random draws seeded by each "
+        "episode's seed (the network still runs on every state, so its facts are extracted; "
+        "kb_meta(actions, random)) (default: agent)",
+    )
     parser.add_argument(
         "--threshold",
         default="quantile:0.9",
@@ -141,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
         progress=show and _tty(),
         top_keys=args.top_keys or 1,
         env_kwargs=env_kwargs,
+        actions=args.actions,
     )
     facts = extract_facts(rec, threshold=threshold)
     written = write_outputs(out, rec, facts, formats, qlf=args.qlf)

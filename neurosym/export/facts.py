@@ -5,6 +5,7 @@
 
     kb_meta(Key, Value)            object(Id, Type)
     episode(E, Steps, Return, Outcome)
+    grid(E, Rows, Cols)            terrain(E, Type, Row, Col)
     step(E, T, Action, Reward)     at(E, T, Id, Row, Col)
     holding(E, T, Item)            event(E, T, Event)
     attends(E, T, Head, Arg, Entity, Row, Col, Weight)
@@ -47,6 +48,8 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "kb_meta": ("key", "value"),
     "object": ("id", "type"),
     "episode": ("episode", "steps", "return", "outcome"),
+    "grid": ("episode", "rows", "cols"),
+    "terrain": ("episode", "type", "row", "col"),
     "step": ("episode", "t", "action", "reward"),
     "at": ("episode", "t", "id", "row", "col"),
     "holding": ("episode", "t", "item"),
@@ -61,6 +64,7 @@ PREDICATES: dict[str, tuple[str, ...]] = {
 # predicate -> columns holding Prolog term text (written as terms, not quoted atoms).
 TERM_COLUMNS: dict[str, tuple[str, ...]] = {
     "object": ("type",),
+    "terrain": ("type",),
     "holding": ("item",),
     "event": ("event",),
     "attends": ("entity",),
@@ -233,8 +237,10 @@ class FactSet:
         return (
             "neurosym knowledge base: facts extracted from recorded episodes.\n"
             f"{meta}\nthreshold={self.threshold}\n"
-            "Schema (docs/design.md): kb_meta/2, object/2, episode/4, step/4, at/5, holding/3, event/3,\n"
-            "attends/8, relation/7, holds/5, threshold/2, attention/6. Heads and relations count from 0."
+            "Schema (docs/design.md): kb_meta/2, object/2, episode/4, grid/3, terrain/4, step/4, at/5,\n"
+            "holding/3, event/3, "
+            "attends/8, relation/7, holds/5, threshold/2, attention/6.\n"
+            "Heads and relations count from 0."
         )
 
 
@@ -306,6 +312,8 @@ def extract_facts(
                 "outcome": ep["outcome"],
             },
         ),
+        "grid": _frame("grid", rec.grids),
+        "terrain": _frame("terrain", rec.terrain),
         "step": _frame("step", rec.steps),
         "at": _frame(
             "at",

@@ -37,6 +37,26 @@ DEFAULT_BATCH = 64
 _BACKGROUND = ("empty", "wall")
 
 
+ACTION_SOURCES = ("agent", "random")
+"""who chooses the recorded actions: the agent, or a uniform random draw (the network still runs)"""
+
+
+def random_actions(episode_seeds: np.ndarray, t: int, count: int = 4) -> np.ndarray:
+    """Uniform actions 0..count-1 for step ``t`` of the episodes reset with ``episode_seeds``.
+
+    A SplitMix64 hash of (episode seed, t): the draw depends on nothing but the
+    episode and the step, so a recording is the same at any batch size and
+    any episode can be replayed alone.
+    """
+    with np.errstate(over="ignore"):
+        x = episode_seeds.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(t)
+        x ^= np.uint64(0xD1B54A32D192ED03)
+        for shift, mult in ((30, 0xBF58476D1CE4E5B9), (27, 0x94D049BB133111EB)):
+            x = (x ^ (x >> np.uint64(shift))) * np.uint64(mult)
+        x ^= x >> np.uint64(31)
+    return (x % np.uint64(count)).astype(np.int64)
+
+
 def _meta(
     agent: Any, env_name: str, seed: int, greedy: bool, env_kwargs: dict[str, Any]
 ) -> dict[str, Any]:
@@ -94,6 +114,23 @@ class _Trace:
         self.held: list[tuple] = []  # held items of each state
         self.event_keys: list[tuple[int, int]] = []  # (episode, t) of each transition
         self.events: list[tuple] = []  # event texts of each transition
+        self.terrain: list[tuple[int, str, int, int]] = []  # (episode, type, row, col)
+        self.grids: list[tuple[int, int, int]] = []  # (episode, rows, cols)
+
+    def map(self, episode: int, names: np.ndarray, info: dict[str, Any]) -> None:
+        """Episode's map size and terrain: the (H, W) entity names after its reset.
+
+        Terrain is every cell that is neither empty, nor the agent, nor one of
+        the named objects of ``info["objects"]`` (RGW's walls and mountains,
+        Box-World's walls). It does not change within an episode.
+        """
+        H, W = names.shape
+        self.grids.append((episode, H, W))
+        taken = {(int(r), int(c)) for _, _, r, c in info["objects"]}
+        taken.add(tuple(int(x) for x in info["agent"]))
+        for r, c in zip(*np.nonzero((names != "empty") & (names != "agent")), strict=True):
+            if (int(r), int(c)) not in taken:
+                self.terrain.append((episode, str(names[r, c]), int(r), int(c)))
 
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
@@ -121,6 +158,12 @@ class _Trace:
             np.repeat(key[:, 1], lens),
             list(chain.from_iterable(groups)),
         )
+
+    def map_tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """terrain (row-major per episode) and grids, ordered by episode."""
+        terrain = pd.DataFrame(self.terrain, columns=["episode", "type", "row", "col"])
+        grids = pd.DataFrame(self.grids, columns=["episode", "rows", "cols"])
+        return _by_episode(terrain), _by_episode(grids)
 
     def tables(self) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
         """positions, holding and events, ordered by episode then t."""
@@ -171,8 +214,14 @@ def record(
     max_steps: int = 100_000,
     threads: int | None = 1,
     env_kwargs: dict[str, Any] | None = None,
+    actions: str = "agent",
 ) -> Recording:
     """Play ``episodes`` episodes of ``agent`` on ``env`` (default: the env it was trained on).
+
+    ``actions="random"`` plays uniformly random actions instead of the agent's
+    (drawn by :func:`random_actions` from each episode's seed and step, so
+    reproducible); the network still runs on every state, so its introspection
+    is recorded as usual. ``meta["actions"]`` says which.
 
     ``env`` may be any env of the agent's family with its observation shape
     (an rgw-random agent on rgw2, say); ``env_kwargs`` adds env options such
@@ -200,6 +249,8 @@ def record(
         raise ConfigError(f"batch must be a positive integer, got {batch!r}")
     if top_keys < 1:
         raise ConfigError(f"top_keys must be at least 1, got {top_keys}")
+    if actions not in ACTION_SOURCES:
+        raise ConfigError(f"actions must be one of {', '.join(ACTION_SOURCES)}, got {actions!r}")
     name, kwargs = _resolve_env(agent, env, env_kwargs)
     waves = -(-episodes // (batch or DEFAULT_BATCH))
     n = -(-episodes // waves)  # equal waves: 100 episodes at batch 64 run as 2 x 50
@@ -218,11 +269,14 @@ def record(
 
         with Stages(progress) as stages:
             advance = stages.stage("recording", episodes)
-            rec = _Recorder(agent, venv, episodes, seed, greedy, top_keys, max_steps, advance).run()
+            recorder = _Recorder(agent, venv, episodes, seed, greedy, top_keys, max_steps, advance)
+            recorder.random = actions == "random"
+            rec = recorder.run()
     finally:
         torch.set_num_threads(saved_threads)
         venv.close()
     rec.meta.update(_meta(agent, name, seed, greedy, kwargs))
+    rec.meta["actions"] = actions
     return rec
 
 
@@ -258,6 +312,9 @@ class _Recorder:
         self.ep_rows: list[tuple[int, int, float, str, int]] = []
         self._grid = np.zeros((0, 0), dtype=np.int64)  # entity codes before the step being played
         self._intro: Any = None  # the model's introspection of that step's live states
+        self.random = False  # play random_actions instead of the agent's
+        self._live_seeds = np.zeros(0, dtype=np.int64)  # reset seeds of the live episodes
+        self._t = 0  # the step about to be played
         self.generator = None
         if not greedy:
             import torch
@@ -289,6 +346,8 @@ class _Recorder:
         acted, self._intro = self.agent.act(
             obs, greedy=self.greedy, introspect=True, generator=self.generator
         )
+        if self.random:
+            return random_actions(self._live_seeds, self._t)
         return np.asarray(acted)
 
     def _wave(self, wave: Wave) -> None:
@@ -297,8 +356,13 @@ class _Recorder:
 
         action_names = np.asarray(ACTION_NAMES, dtype=object)
         venv = self.venv
+        names = self.names[venv.entity_grid()]  # (n, H, W) entity names after the reset
         for i in range(wave.count):
-            self.trace.state(wave.first + i, 0, venv.decode_info(wave.info, i))
+            decoded = venv.decode_info(wave.info, i)
+            self.trace.state(wave.first + i, 0, decoded)
+            self.trace.map(wave.first + i, names[i], decoded)
+        live_mask = np.arange(self.n) < wave.count
+        self._live_seeds, self._t = self.seed + wave.first + np.flatnonzero(live_mask), 0
         for step in wave.steps():
             live, episode = step.live, step.episodes
             t = np.full(live.size, step.t, dtype=np.int64)
@@ -319,6 +383,9 @@ class _Recorder:
                     self.ep_rows.append((e, s, float(wave.returns[i]), str(outcome), self.seed + e))
             if step.ended.size:
                 self.advance(int(step.ended.size))
+                live_mask[step.ended] = False
+            self._live_seeds = self.seed + wave.first + np.flatnonzero(live_mask)
+            self._t = step.t + 1
 
     def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any) -> None:
         """Keep the live states' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
@@ -361,7 +428,8 @@ class _Recorder:
             {c: sc.get(c, np.zeros(0)) for c in ("episode", "t", "action", "reward")}
         )
         positions, holding, events = self.trace.tables()
-        tables: dict[str, pd.DataFrame] = {}
+        terrain, grids = self.trace.map_tables()
+        tables: dict[str, pd.DataFrame] = {"terrain": terrain, "grids": grids}
         if self.module == "predinet":
             tables.update(self._predinet_tables(W))
         else:

@@ -45,6 +45,8 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
         ("col", "int64"),
     ),
     "holding": (("episode", "int64"), ("t", "int64"), ("item", "str")),
+    "terrain": (("episode", "int64"), ("type", "str"), ("row", "int64"), ("col", "int64")),
+    "grids": (("episode", "int64"), ("rows", "int64"), ("cols", "int64")),
     "events": (("episode", "int64"), ("t", "int64"), ("event", "str")),
     "attends": (
         ("episode", "int64"),
@@ -86,7 +88,12 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
     ),
 }
 
-META_KEYS = ("checkpoint", "env", "module", "heads", "relations", "seed", "created", "version")
+META_KEYS = (
+    "checkpoint", "env", "module", "heads", "relations", "seed", "actions", "created", "version",
+)  # fmt: skip
+
+OPTIONAL_TABLES = ("terrain", "grids")
+"""tables that recordings of older versions lack: they load as empty tables"""
 
 _FORMAT = "neurosym-recording"
 _FORMAT_VERSION = 1
@@ -131,7 +138,9 @@ class Recording:
     """Episodes recorded from one agent: pandas tables per docs/interfaces.md plus ``meta``.
 
     Missing tables default to empty ones (an MHDPA recording has no ``relations``,
-    a PrediNet one no ``attention``). Tables are brought to the schema on
+    a PrediNet one no ``attention``; a hand-made one may have no ``terrain``
+    (the cells of each episode's map that hold terrain, read after the reset)
+    or ``grids`` (each episode's map size)). Tables are brought to the schema on
     construction, so column order and dtypes are always the documented ones.
     """
 
@@ -139,6 +148,8 @@ class Recording:
     steps: pd.DataFrame = field(default_factory=lambda: empty_table("steps"))
     positions: pd.DataFrame = field(default_factory=lambda: empty_table("positions"))
     holding: pd.DataFrame = field(default_factory=lambda: empty_table("holding"))
+    terrain: pd.DataFrame = field(default_factory=lambda: empty_table("terrain"))
+    grids: pd.DataFrame = field(default_factory=lambda: empty_table("grids"))
     events: pd.DataFrame = field(default_factory=lambda: empty_table("events"))
     attends: pd.DataFrame = field(default_factory=lambda: empty_table("attends"))
     relations: pd.DataFrame = field(default_factory=lambda: empty_table("relations"))
@@ -200,6 +211,9 @@ class Recording:
         tables: dict[str, pd.DataFrame] = {}
         for name in SCHEMA:
             path = meta_path.parent / f"{name}.parquet"
+            if name in OPTIONAL_TABLES and not path.exists():
+                tables[name] = empty_table(name)
+                continue
             try:
                 tables[name] = pd.read_parquet(path)
             except (OSError, ValueError) as exc:

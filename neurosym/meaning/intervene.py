@@ -64,7 +64,7 @@ from neurosym.terms import Term
 DEFAULT_EPISODES = 100
 """episodes per experiment by default (sampled actions, seeds S..S+99)"""
 
-TRACE_TABLES = ("episodes", "steps", "positions", "holding", "events")
+TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
 
 
 @dataclass(frozen=True)
@@ -175,11 +175,11 @@ class InterventionReport:
             + ", ".join(f"{k}={v}" for k, v in self.meta.items())
             + "\nexperiment(X, Kind, Detail), experiment_episode(X, E), experiment_skipped(Kind,"
             " Reason),\nmeasure(X, Measure, Value), effect(X, Measure, Change), relates(Head, A,"
-            " B, Share),\nand the trace facts (episode/4, step/4, at/5, holding/3, event/3) of"
-            " every experiment."
+            " B, Share),\nand the trace facts (episode/4, grid/3, terrain/4, step/4, at/5,"
+            " holding/3, event/3) of every experiment."
         )
         dynamic = predicate_indicators(
-            ["kb_meta", "object", "episode", "step", "at", "holding", "event"]
+            ["kb_meta", "object", "episode", "grid", "terrain", "step", "at", "holding", "event"]
         ) + [
             "experiment/3",
             "experiment_episode/2",
