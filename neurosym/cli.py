@@ -205,6 +205,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "neurosym.viz.cli_plot",
         "Draw attention maps, R-vector heat maps and episode renderings.",
     ),
+    "induce": (
+        "neurosym.induce.cli_induce",
+        "Learn rules back from a knowledge base: the agent's strategy as goal/3 clauses.",
+    ),
     "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
     "agents": (

@@ -1,0 +1,29 @@
+"""Rules learned back from knowledge bases (``neurosym induce``).
+
+* :func:`induce_strategy` (:mod:`neurosym.induce.strategy`): ``goal(E, T, Object)``
+  clauses, the object the agent goes for next, as a :class:`Strategy`
+  (``.fidelity``, ``.predict(trace)``, ``.write(path)``).
+
+Names are imported on first use, so ``neurosym induce`` imports neither
+torch nor the envs.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_LAZY = {
+    "induce_strategy": "neurosym.induce.strategy",
+    "Strategy": "neurosym.induce.strategy",
+    "load_trace": "neurosym.induce.strategy_data",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'neurosym.induce' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)

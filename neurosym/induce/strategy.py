@@ -22,7 +22,9 @@ import pandas as pd
 from neurosym.errors import ConfigError
 from neurosym.induce.strategy_data import Trace, candidates, labels, load_trace
 from neurosym.induce.strategy_features import FEATURE_SETS, Feature, features
-from neurosym.induce.strategy_tree import DecisionList, fit
+from neurosym.induce.strategy_tree import DecisionList
+
+LEARNERS = ("covering", "tree")
 
 MAX_CLAUSES = 20
 """At most this many goal/3 clauses per strategy."""
@@ -79,6 +81,7 @@ class Strategy:
     train_fidelity: float
     train_states: int
     seconds: float
+    max_clauses: int = MAX_CLAUSES
     meta: dict[str, str] = field(default_factory=dict)
 
     def predict(self, trace: Trace) -> pd.DataFrame:
@@ -104,9 +107,10 @@ class Strategy:
         return write_bytes_atomic(path, self.text().encode("utf-8"))
 
 
-def _split(trace: Trace, holdout: str | Path | None, share: float) -> tuple[Trace, Trace, str]:
+def _split(trace: Trace, holdout: str | Path | Trace | None, share: float) -> tuple[Trace, Trace, str]:
     if holdout is not None:
-        return trace, load_trace(holdout), f"the episodes of {holdout}"
+        test = holdout if isinstance(holdout, Trace) else load_trace(holdout)
+        return trace, test, f"the episodes of {test.path}"
     if not 0 < share < 1:
         raise ConfigError(f"--holdout-share must be between 0 and 1 (exclusive), got {share}")
     episodes = trace.episodes()
@@ -125,9 +129,11 @@ def induce_strategy(
     kb: str | Path | Trace,
     features: str = "world",
     *,
-    holdout: str | Path | None = None,
+    holdout: str | Path | Trace | None = None,
     holdout_share: float = 0.3,
     max_clauses: int = MAX_CLAUSES,
+    learner: str = "covering",
+    penalty: float = 1.0,
     seed: int = 0,
 ) -> Strategy:
     """Learn which object the agent goes for next from ``kb``'s episodes.
@@ -148,11 +154,20 @@ def induce_strategy(
         raise ConfigError(f"{trace.path} has no state with a next object (no contact event); nothing to learn")
     if not names:
         raise ConfigError(f"{trace.path} has no {features} features (no relation facts?)")
-    model = fit(names, tab.x, tab.y, max_clauses, seed)
+    if learner == "covering":
+        from neurosym.induce.strategy_covering import fit as fit_covering
+
+        model = fit_covering(names, tab.x, tab.y, tab.state, max_clauses, penalty)
+    elif learner == "tree":
+        from neurosym.induce.strategy_tree import fit as fit_tree
+
+        model = fit_tree(names, tab.x, tab.y, max_clauses, seed)
+    else:
+        raise ConfigError(f"unknown learner {learner!r}; use one of {', '.join(LEARNERS)}")
     train_fid, train_n = fidelity(model, tab)
     _, test_tab = table(test, features, names)
     fid, n = fidelity(model, test_tab)
     return Strategy(
         model, features, trace.path, held, fid, n, train_fid, train_n,
-        time.perf_counter() - start, trace.meta,
+        time.perf_counter() - start, max_clauses, trace.meta,
     )

@@ -49,6 +49,10 @@ TABLES = {
     "holds": "holds(E, T, r(J), X0, Y0), term_to_atom(X0, X), term_to_atom(Y0, Y)",
     "attention": "attention(E, T, H, Q0, K0, _), term_to_atom(Q0, Q), term_to_atom(K0, K)",
     "meta": "kb_meta(Key, V0), term_to_atom(V0, V)",
+    "terrain": (
+        "catch(terrain(E, Ty0, R, C), error(existence_error(_, _), _), fail), term_to_atom(Ty0, Ty)"
+    ),
+    "grid": "catch(grid(E, Rows, Cols), error(existence_error(_, _), _), fail)",
 }
 """The goal that reads each table, compound terms as their Prolog text."""
 
@@ -66,6 +70,8 @@ class Trace:
     attends: pd.DataFrame
     holds: pd.DataFrame
     attention: pd.DataFrame
+    terrain: pd.DataFrame
+    grid: pd.DataFrame
     meta: dict[str, str]
 
     def episodes(self) -> list[int]:
@@ -77,7 +83,7 @@ class Trace:
         keep = set(episodes)
         parts = {
             name: getattr(self, name)[getattr(self, name)["E"].isin(keep)].reset_index(drop=True)
-            for name in ("at", "step", "event", "holding", "attends", "holds", "attention")
+            for name in ("at", "step", "event", "holding", "attends", "holds", "attention", "terrain", "grid")
         }
         return Trace(self.path, self.object, meta=self.meta, **parts)
 

@@ -33,6 +33,13 @@ import numpy as np
 import pandas as pd
 
 from neurosym.induce.strategy_data import Trace
+from neurosym.induce.strategy_route import (
+    PASSABLE_KINDS,
+    PASSABLE_TERRAIN,
+    UNREACHABLE,
+    route_lengths,
+    shortcuts,
+)
 
 FEATURE_SETS = ("world", "relations", "both")
 
@@ -209,9 +216,86 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
     add("distance", "agent_distance(E, T, O, V)", lambda e, t, o, r, c: float(dist(e, t, r, c)), True)
     add("nearest_of_kind", "nearest_of_kind(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, True))
     add("nearest_object", "nearest_object(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, False))
+    if not trace.grid.empty:
+        _routes(trace, pairs, types, kinds, add)
     if any(_kind(types[o]) in ("key", "lock") for o in pairs["O"].unique()):
         _box_world(add, types, holding, at_cell, locks, content)
     return feats, np.array([cols[f.name] for f in feats], dtype=float).T
+
+
+def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: list[str], add) -> None:  # type: ignore[no-untyped-def]
+    """Route features (:mod:`neurosym.induce.strategy_route`): reachable, route length, nearest reachable."""
+    size = {int(e): (int(r), int(c)) for e, r, c in trace.grid.itertuples(index=False)}
+    walls: dict[int, set[tuple[int, int]]] = {}
+    terrain = trace.terrain
+    for e, ty, r, c in zip(terrain["E"], terrain["Ty"], terrain["R"], terrain["C"], strict=True):
+        if ty not in PASSABLE_TERRAIN:
+            walls.setdefault(int(e), set()).add((int(r), int(c)))
+    lengths: dict[tuple[int, int, str], int] = {}
+    cuts: dict[tuple[int, int, str], set[str]] = {}
+    for (e, t), group in trace.at.groupby(["E", "T"], sort=False):
+        cells = {o: (int(r), int(c)) for o, r, c in zip(group["O"], group["R"], group["C"], strict=True)}
+        if "agent" not in cells:
+            continue
+        start = cells.pop("agent")
+        closed = walls.get(int(e), set()) | {
+            rc for o, rc in cells.items() if _kind(types[o]) not in PASSABLE_KINDS
+        }
+        if int(e) in size:
+            found = route_lengths(start, cells, size[int(e)], closed)
+            kind_of = {o: _kind(types[o]) for o in cells}
+            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed).items():
+                cuts[(int(e), int(t), o)] = ks
+        else:
+            found = dict.fromkeys(cells, UNREACHABLE)
+        for o, d in found.items():
+            lengths[(int(e), int(t), o)] = d
+    by_state: dict[tuple[int, int], list[str]] = {}
+    for e, t, o in zip(pairs["E"], pairs["T"], pairs["O"], strict=True):
+        by_state.setdefault((e, t), []).append(o)
+
+    def length(e: int, t: int, o: str) -> int:
+        return lengths.get((e, t, o), UNREACHABLE)
+
+    def nearest(e: int, t: int, o: str, r: int, c: int) -> float:
+        d, k = length(e, t, o), _kind(types[o])
+        return float(
+            d < UNREACHABLE
+            and not any(
+                o2 != o and _kind(types[o2]) == k and length(e, t, o2) < d for o2 in by_state[(e, t)]
+            )
+        )
+
+    add("route_length", "route_length(E, T, O, V)", lambda e, t, o, r, c: float(length(e, t, o)), True)
+    add("reachable", "reachable(E, T, O)", lambda e, t, o, r, c: float(length(e, t, o) < UNREACHABLE))
+    add("nearest_reachable_of_kind", "nearest_reachable_of_kind(E, T, O)", nearest)
+    for k in kinds:
+        if k != "teleport" and "teleport" in kinds:
+            add(
+                f"teleport_shortcut={k}",
+                f"teleport_shortcut(E, T, O, {k})",
+                lambda e, t, o, r, c, k=k: float(k in cuts.get((e, t, o), ())),
+            )
+    for k in kinds:
+        add(
+            f"route_not_longer={k}",
+            f"route_not_longer(E, T, O, {k})",
+            lambda e, t, o, r, c, k=k: float(
+                length(e, t, o) < UNREACHABLE
+                and not any(
+                    o2 != o and _kind(types[o2]) == k and length(e, t, o2) < length(e, t, o)
+                    for o2 in by_state[(e, t)]
+                )
+            ),
+        )
+    for k in kinds:
+        add(
+            f"reachable_kind={k}",
+            f"reachable_kind(E, T, {k})",
+            lambda e, t, o, r, c, k=k: float(
+                any(_kind(types[o2]) == k and length(e, t, o2) < UNREACHABLE for o2 in by_state[(e, t)])
+            ),
+        )
 
 
 def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: ignore[no-untyped-def]

@@ -43,13 +43,14 @@ class DecisionList:
 
     features: list[Feature]
     clauses: list[Clause]
-    tree: object  # sklearn.tree.DecisionTreeClassifier
+    learner: str  # "tree" or "covering"
 
     def ranks(self, x: np.ndarray) -> np.ndarray:
-        """Each pair's clause rank (its leaf's position in the list); len(clauses) for none."""
-        order = {c.leaf: i for i, c in enumerate(self.clauses)}
-        leaves = self.tree.apply(x) if len(x) else np.zeros(0, dtype=int)  # type: ignore[attr-defined]
-        return np.array([order.get(int(leaf), len(self.clauses)) for leaf in leaves], dtype=int)
+        """Each pair's rank: the first clause whose tests it passes; len(clauses) for none."""
+        ranks = np.full(len(x), len(self.clauses), dtype=int)
+        for i in range(len(self.clauses) - 1, -1, -1):
+            ranks[holds(self.clauses[i].tests, x)] = i
+        return ranks
 
     def choose(self, x: np.ndarray, state: np.ndarray) -> dict[int, int]:
         """State index -> index of the chosen pair (pairs in candidate order within a state)."""
@@ -61,6 +62,15 @@ class DecisionList:
         return {s: i for s, (_, i) in best.items()}
 
 
+def holds(tests: list[Test], x: np.ndarray) -> np.ndarray:
+    """Which pairs (rows of ``x``) pass every test."""
+    mask = np.ones(len(x), dtype=bool)
+    for t in tests:
+        col = x[:, t.feature]
+        mask &= col <= t.threshold if t.low else col > t.threshold
+    return mask
+
+
 def fit(
     features: list[Feature], x: np.ndarray, y: np.ndarray, max_clauses: int, seed: int = 0
 ) -> DecisionList:
@@ -68,7 +78,7 @@ def fit(
     from sklearn.tree import DecisionTreeClassifier
 
     tree = DecisionTreeClassifier(max_leaf_nodes=max(2, max_clauses), random_state=seed)
-    tree.fit(x, y)
+    tree.fit(x.astype(np.float32), y)
     t = tree.tree_
     positive = list(tree.classes_).index(1) if 1 in tree.classes_ else None
     clauses: list[Clause] = []
@@ -86,7 +96,7 @@ def fit(
 
     walk(0, [])
     clauses.sort(key=lambda c: (-c.share, -c.pairs, c.leaf))
-    return DecisionList(features, clauses[:max_clauses], tree)
+    return DecisionList(features, clauses[:max_clauses], "tree")
 
 
 def simplify(tests: list[Test], features: list[Feature]) -> list[Test]:

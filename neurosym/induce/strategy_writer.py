@@ -5,15 +5,23 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from neurosym.induce.strategy_features import BACKGROUND, Feature
+from neurosym.induce.strategy_route import PROLOG as ROUTE
 from neurosym.induce.strategy_tree import Clause, simplify
 
 if TYPE_CHECKING:
     from neurosym.induce.strategy import Strategy
 
+LEARNERS = {
+    "covering": "sequential covering over tests of (state, candidate object) features, each clause "
+    "grown greedily to raise right - wrong choices on the states no earlier clause decides",
+    "tree": "a scikit-learn decision tree over (state, candidate object) pairs, one clause per leaf "
+    "holding next objects, ordered by their share",
+}
+
 READS = {
-    "world": "at/5, holding/3, object/2",
+    "world": "at/5, holding/3, object/2, grid/3, terrain/4",
     "relations": "at/5 and object/2 (to map cells and entities to objects), attends/8, holds/5, attention/6",
-    "both": "at/5, holding/3, object/2, attends/8, holds/5, attention/6",
+    "both": "at/5, holding/3, object/2, grid/3, terrain/4, attends/8, holds/5, attention/6",
 }
 
 
@@ -66,9 +74,7 @@ The clauses are a decision list: the FIRST answer of goal/3 is the choice.
 Learned by `neurosym induce --what strategy` from {strategy.kb}
 (checkpoint {meta.get('checkpoint', '?')}, env {meta.get('env', '?')}, module {meta.get('module', '?')}).
 Features: {strategy.features} (reads {READS[strategy.features]}).
-Learner: scikit-learn decision tree over (state, candidate object) pairs,
-at most {len(model.clauses) if model.clauses else 0} clauses kept of a tree of at most {model.tree.get_n_leaves()} leaves; one clause per leaf
-that holds next objects, ordered by their share.
+Learner: {LEARNERS[model.learner]}; {len(model.clauses)} clauses (at most {strategy.max_clauses}).
 Scores: fidelity {strategy.fidelity:.4f} on {strategy.states} held-out states ({strategy.holdout});
 {strategy.train_fidelity:.4f} on the {strategy.train_states} training states.
 Learning took {strategy.seconds:.1f} s.
@@ -81,4 +87,4 @@ Load it beside a KB of the same schema (every predicate below is defined here):
 :- use_module(library(aggregate)).
 
 """
-    return header + clauses_text(strategy) + "\n% Background predicates\n" + BACKGROUND
+    return header + clauses_text(strategy) + "\n% Background predicates\n" + BACKGROUND + ROUTE

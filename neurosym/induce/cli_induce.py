@@ -1,0 +1,92 @@
+"""``neurosym induce``: learn rules back from a knowledge base.
+
+    neurosym induce --kb KB.pl --what strategy --out strategy.pl [--features world|relations|both]
+                    [--holdout KB2.pl | --holdout-share 0.3]
+
+``--what strategy`` learns which object the agent goes for next, as
+``goal(E, T, Object)`` clauses whose first answer is the choice
+(:mod:`neurosym.induce.strategy`), prints the clauses and the fidelity (share
+of held-out states whose first answer is the labelled next object) and
+writes them as a Prolog file that loads in plain swipl beside a KB.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+
+from neurosym.errors import ConfigError
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the induce options."""
+    parser.add_argument("--kb", required=True, metavar="FILE", help="knowledge base (.pl) to learn from")
+    parser.add_argument(
+        "--what", required=True, metavar="WHAT", help=f"what to learn: {', '.join(WHATS)}"
+    )
+    parser.add_argument("--out", required=True, metavar="FILE", help="learned rules (.pl) to write")
+    held = parser.add_mutually_exclusive_group()
+    held.add_argument(
+        "--holdout", metavar="FILE", help="a KB of other episodes to score the learned rules on"
+    )
+    held.add_argument(
+        "--holdout-share",
+        type=float,
+        metavar="S",
+        help="strategy: without --holdout, score on the last share S of the KB's episodes, "
+        "learning from the rest (default: 0.3)",
+    )
+    parser.add_argument(
+        "--features",
+        choices=("world", "relations", "both"),
+        default="world",
+        help="strategy: the facts the clauses may read: the world's (at/5, holding/3, ...), "
+        "the network's relations (attends/8, holds/5, attention/6) or both (default: world)",
+    )
+    parser.add_argument(
+        "--learner",
+        choices=("covering", "tree"),
+        default="covering",
+        help="strategy: sequential covering of states, or a scikit-learn decision tree over "
+        "(state, object) pairs (default: covering)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Dispatch on --what."""
+    learner = WHATS.get(args.what)
+    if learner is None:
+        raise ConfigError(f"--what {args.what!r} is not one of {', '.join(WHATS)}")
+    for name in ("kb", "holdout"):
+        path = getattr(args, name)
+        if path is not None and not Path(path).is_file():
+            raise ConfigError(f"--{name} {path} does not exist (give a KB written by neurosym extract)")
+    return learner(args)
+
+
+def run_strategy(args: argparse.Namespace) -> int:
+    """Learn the agent's next-object strategy, print its clauses and fidelity, write it."""
+    from neurosym.induce.strategy import induce_strategy
+    from neurosym.induce.strategy_writer import clauses_text
+
+    share = 0.3 if args.holdout_share is None else args.holdout_share
+    strategy = induce_strategy(
+        args.kb, args.features, holdout=args.holdout, holdout_share=share, learner=args.learner
+    )
+    out = strategy.write(args.out)
+    print(
+        f"learned from {strategy.kb} ({strategy.features} features, {args.learner}) in "
+        f"{strategy.seconds:.1f} s: {len(strategy.model.clauses)} clause(s)"
+    )
+    print(clauses_text(strategy), end="")
+    print(
+        f"fidelity {strategy.fidelity:.4f} on {strategy.states} held-out states ({strategy.holdout}); "
+        f"{strategy.train_fidelity:.4f} on {strategy.train_states} training states"
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+WHATS: dict[str, Callable[[argparse.Namespace], int]] = {"strategy": run_strategy}
+"""--what -> the function that learns and writes it"""
