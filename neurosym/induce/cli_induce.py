@@ -46,10 +46,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--learner",
-        choices=("covering", "tree"),
-        default="covering",
-        help="strategy: sequential covering of states, or a scikit-learn decision tree over "
-        "(state, object) pairs (default: covering)",
+        choices=("tree", "covering"),
+        default="tree",
+        help="strategy: a scikit-learn decision tree over (state, object) pairs, or sequential "
+        "covering of states (default: tree)",
     )
 
 

@@ -132,7 +132,7 @@ def induce_strategy(
     holdout: str | Path | Trace | None = None,
     holdout_share: float = 0.3,
     max_clauses: int = MAX_CLAUSES,
-    learner: str = "covering",
+    learner: str = "tree",
     penalty: float = 1.0,
     seed: int = 0,
 ) -> Strategy:

@@ -276,6 +276,13 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
                 f"teleport_shortcut(E, T, O, {k})",
                 lambda e, t, o, r, c, k=k: float(k in cuts.get((e, t, o), ())),
             )
+            add(
+                f"teleport_shortcut_to={k}",
+                f"teleport_shortcut_to(E, T, {k})",
+                lambda e, t, o, r, c, k=k: float(
+                    any(k in cuts.get((e, t, o2), ()) for o2 in by_state[(e, t)])
+                ),
+            )
     for k in kinds:
         add(
             f"route_not_longer={k}",

@@ -31,6 +31,11 @@ route_from_(E, T, R0-C0, O, D) :-
     ;   D = 999
     ).
 
+%!  teleport_shortcut_to(+E, +T, ?Kind) is semidet.
+%   Some teleport end on the map is a shortcut to an object of this kind.
+teleport_shortcut_to(E, T, K) :-
+    once(( goal_candidate(E, T, O), teleport_shortcut(E, T, O, K) )).
+
 %!  route_not_longer(+E, +T, +O, ?Kind) is semidet.
 %   O is reachable and its route is not longer than that of any object of this kind
 %   (true when none of the kind is reachable).

@@ -33,7 +33,11 @@ def body(clause: Clause, features: list[Feature]) -> list[str]:
     """The literals of one clause, candidate first, numeric bounds as comparisons."""
     lits = ["goal_candidate(E, T, O)"]
     names: dict[int, str] = {}
-    for test in simplify(clause.tests, features):
+    tests = simplify(clause.tests, features)
+    if any(features[t.feature].name.startswith("kind=") and not t.low for t in tests):
+        # O's kind is fixed by a positive test: tests that it is not of another kind are implied
+        tests = [t for t in tests if not (features[t.feature].name.startswith("kind=") and t.low)]
+    for test in tests:
         f = features[test.feature]
         if f.numeric:
             var = names.setdefault(test.feature, f"V{len(names) + 1}")
