@@ -14,9 +14,11 @@ machine.
         --seed 2000000000 --out kbs/bw1-predinet-train
     neurosym extract --checkpoint checkpoints/bw1-predinet.pt --env bw1 --episodes 100 \\
         --seed 3000000000 --out kbs/bw1-predinet-test
-    python bench/strategy.py --kbs kbs --agents bw1-predinet [--learners covering,tree] [--out DIR]
+    python bench/strategy.py --kbs kbs --agents bw1-predinet [--learners best] [--out DIR]
 
-With ``--out DIR`` each strategy is also written to ``DIR/NAME.FEATURES.pl``.
+``best`` fits both learners and keeps the one with the higher training
+fidelity (``kept``). With ``--out DIR`` each strategy is also written to
+``DIR/NAME.FEATURES.pl`` (the last learner's).
 """
 
 from __future__ import annotations
@@ -51,7 +53,9 @@ def main() -> None:
     parser.add_argument("--kbs", type=Path, required=True, help="folder of NAME-train and NAME-test KBs")
     parser.add_argument("--agents", default=",".join(AGENTS), help="comma-separated agent names")
     parser.add_argument("--features", default="world,relations,both", help="feature sets")
-    parser.add_argument("--learners", default="covering", help="comma-separated: covering, tree")
+    parser.add_argument(
+        "--learners", default="tree,covering,best", help="comma-separated: tree, covering, best"
+    )
     parser.add_argument("--out", type=Path, help="write each strategy to OUT/NAME.FEATURES.pl")
     args = parser.parse_args()
     print(json.dumps({"machine": platform.node(), "cpus": os.cpu_count(), "load": os.getloadavg()}))
@@ -66,6 +70,7 @@ def main() -> None:
                 seconds = time.perf_counter() - start
                 line = {
                     "agent": name, "features": features, "learner": learner,
+                    "kept": s.model.learner,
                     "fidelity": round(s.fidelity, 4), "states": s.states,
                     "train_fidelity": round(s.train_fidelity, 4), "train_states": s.train_states,
                     "clauses": len(s.model.clauses), "seconds": round(seconds, 1),

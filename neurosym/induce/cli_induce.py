@@ -46,10 +46,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--learner",
-        choices=("tree", "covering"),
-        default="tree",
-        help="strategy: a scikit-learn decision tree over (state, object) pairs, or sequential "
-        "covering of states (default: tree)",
+        choices=("best", "tree", "covering"),
+        default="best",
+        help="strategy: a scikit-learn decision tree over (state, object) pairs, sequential "
+        "covering of states, or best: both, keeping the higher training fidelity (default: best)",
     )
 
 
@@ -76,7 +76,7 @@ def run_strategy(args: argparse.Namespace) -> int:
     )
     out = strategy.write(args.out)
     print(
-        f"learned from {strategy.kb} ({strategy.features} features, {args.learner}) in "
+        f"learned from {strategy.kb} ({strategy.features} features, {strategy.model.learner}) in "
         f"{strategy.seconds:.1f} s: {len(strategy.model.clauses)} clause(s)"
     )
     print(clauses_text(strategy), end="")

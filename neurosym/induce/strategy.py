@@ -24,7 +24,7 @@ from neurosym.induce.strategy_data import Trace, candidates, labels, load_trace
 from neurosym.induce.strategy_features import FEATURE_SETS, Feature, features
 from neurosym.induce.strategy_tree import DecisionList
 
-LEARNERS = ("covering", "tree")
+LEARNERS = ("best", "tree", "covering")
 
 MAX_CLAUSES = 20
 """At most this many goal/3 clauses per strategy."""
@@ -107,6 +107,22 @@ class Strategy:
         return write_bytes_atomic(path, self.text().encode("utf-8"))
 
 
+def _learn(
+    names: list[Feature], tab: Table, learner: str, max_clauses: int, penalty: float, seed: int
+) -> tuple[DecisionList, tuple[float, int]]:
+    """Fit the learner; ``best`` fits both and keeps the higher training fidelity (then fewer clauses)."""
+    from neurosym.induce.strategy_covering import fit as fit_covering
+    from neurosym.induce.strategy_tree import fit as fit_tree
+
+    fitted = []
+    if learner in ("tree", "best"):
+        fitted.append(fit_tree(names, tab.x, tab.y, max_clauses, seed))
+    if learner in ("covering", "best"):
+        fitted.append(fit_covering(names, tab.x, tab.y, tab.state, max_clauses, penalty))
+    scored = [(m, fidelity(m, tab)) for m in fitted]
+    return max(scored, key=lambda ms: (ms[1][0], -len(ms[0].clauses)))
+
+
 def _split(trace: Trace, holdout: str | Path | Trace | None, share: float) -> tuple[Trace, Trace, str]:
     if holdout is not None:
         test = holdout if isinstance(holdout, Trace) else load_trace(holdout)
@@ -132,7 +148,7 @@ def induce_strategy(
     holdout: str | Path | Trace | None = None,
     holdout_share: float = 0.3,
     max_clauses: int = MAX_CLAUSES,
-    learner: str = "tree",
+    learner: str = "best",
     penalty: float = 1.0,
     seed: int = 0,
 ) -> Strategy:
@@ -154,17 +170,9 @@ def induce_strategy(
         raise ConfigError(f"{trace.path} has no state with a next object (no contact event); nothing to learn")
     if not names:
         raise ConfigError(f"{trace.path} has no {features} features (no relation facts?)")
-    if learner == "covering":
-        from neurosym.induce.strategy_covering import fit as fit_covering
-
-        model = fit_covering(names, tab.x, tab.y, tab.state, max_clauses, penalty)
-    elif learner == "tree":
-        from neurosym.induce.strategy_tree import fit as fit_tree
-
-        model = fit_tree(names, tab.x, tab.y, max_clauses, seed)
-    else:
+    if learner not in LEARNERS:
         raise ConfigError(f"unknown learner {learner!r}; use one of {', '.join(LEARNERS)}")
-    train_fid, train_n = fidelity(model, tab)
+    model, (train_fid, train_n) = _learn(names, tab, learner, max_clauses, penalty, seed)
     _, test_tab = table(test, features, names)
     fid, n = fidelity(model, test_tab)
     return Strategy(

@@ -7,8 +7,8 @@ at a time on the states no earlier clause fires in: a clause starts empty and
 greedily takes the test that most raises ``right - penalty * wrong`` over the
 states it fires in, as long as that rises (FOIL's and CN2's greedy
 specialisation, scored on the choice the clause makes rather than on pairs);
-the states it fires in are then decided. This scores exactly what fidelity
-measures, which a tree fitted to pairs does not.
+the states it fires in are then decided. This scores what fidelity measures,
+which a tree fitted to pairs does not.
 """
 
 from __future__ import annotations
@@ -71,7 +71,11 @@ def fit(
     features: list[Feature], x: np.ndarray, y: np.ndarray, state: np.ndarray,
     max_clauses: int, penalty: float = 1.0,
 ) -> DecisionList:
-    """Learn up to ``max_clauses`` clauses; stop when no clause chooses more right than wrong."""
+    """Learn up to ``max_clauses`` clauses; stop when no clause makes a right choice.
+
+    A state no clause fires in counts as wrong, so a clause that is right in some states
+    adds to fidelity even when it is wrong in more; the score only orders the clauses.
+    """
     tests = candidate_tests(features, x)
     columns = [x[:, t.feature] <= t.threshold if t.low else x[:, t.feature] > t.threshold for t in tests]
     open_ = np.ones(len(y), dtype=bool)  # pairs of states no clause fires in yet
@@ -80,7 +84,7 @@ def fit(
         chosen, mask, score, right, wrong = _grow(
             x[open_], y[open_], state[open_], [c[open_] for c in columns], tests, penalty
         )
-        if right <= wrong:
+        if right == 0:
             break
         share = right / (right + wrong)
         clauses.append(Clause(len(clauses), chosen, share, right + wrong))
