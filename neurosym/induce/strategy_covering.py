@@ -55,7 +55,7 @@ def _grow(x, y, state, columns, tests, penalty):  # type: ignore[no-untyped-def]
     best, right, wrong = _score(mask, y, state, penalty)
     while len(chosen) < MAX_TESTS:
         step = None
-        for k, t in enumerate(tests):
+        for k in range(len(tests)):
             m = mask & columns[k]
             score, r, w = _score(m, y, state, penalty)
             if score > best + 1e-9:
