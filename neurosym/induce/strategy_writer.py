@@ -54,12 +54,16 @@ def body(clause: Clause, features: list[Feature]) -> list[str]:
 
 
 def clauses_text(strategy: Strategy) -> str:
-    """The goal/3 clauses, each with a comment: share of next objects among its training pairs."""
+    """The goal/3 clauses, each with a comment: how often it was right in training."""
     out = []
     for i, clause in enumerate(strategy.model.clauses, 1):
         lits = body(clause, strategy.model.features)
+        if strategy.model.learner == "covering":
+            note = f"right in {clause.share:.3f} of the {clause.pairs} training states it decides"
+        else:
+            note = f"{clause.share:.3f} of its {clause.pairs} training pairs are next objects"
         out.append(
-            f"% clause {i}: {clause.share:.3f} of its {clause.pairs} training pairs are next objects\n"
+            f"% clause {i}: {note}\n"
             "goal(E, T, O) :-\n    " + ",\n    ".join(lits) + ".\n"
         )
     return "\n".join(out)
