@@ -89,9 +89,8 @@ class Strategy:
         _, tab = table(trace, self.features, self.model.features)
         chosen = self.model.choose(tab.x, tab.state)
         out = tab.states.copy()
-        out["Choice"] = [
-            tab.pairs["O"].iloc[chosen[s]] if s in chosen else None for s in range(len(out))
-        ]
+        choices = [tab.pairs["O"].iloc[chosen[s]] if s in chosen else None for s in range(len(out))]
+        out["Choice"] = pd.Series(choices, index=out.index, dtype=object)  # None: no clause fires
         return out
 
     def text(self) -> str:
