@@ -233,6 +233,7 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
             walls.setdefault(int(e), set()).add((int(r), int(c)))
     lengths: dict[tuple[int, int, str], int] = {}
     cuts: dict[tuple[int, int, str], set[str]] = {}
+    ties: dict[tuple[int, int, str], set[str]] = {}
     for (e, t), group in trace.at.groupby(["E", "T"], sort=False):
         cells = {o: (int(r), int(c)) for o, r, c in zip(group["O"], group["R"], group["C"], strict=True)}
         if "agent" not in cells:
@@ -246,6 +247,8 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
             kind_of = {o: _kind(types[o]) for o in cells}
             for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed).items():
                 cuts[(int(e), int(t), o)] = ks
+            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed, ties=True).items():
+                ties[(int(e), int(t), o)] = ks
         else:
             found = dict.fromkeys(cells, UNREACHABLE)
         for o, d in found.items():
@@ -275,6 +278,11 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
                 f"teleport_shortcut={k}",
                 f"teleport_shortcut(E, T, O, {k})",
                 lambda e, t, o, r, c, k=k: float(k in cuts.get((e, t, o), ())),
+            )
+            add(
+                f"teleport_not_longer={k}",
+                f"teleport_not_longer(E, T, O, {k})",
+                lambda e, t, o, r, c, k=k: float(k in ties.get((e, t, o), ())),
             )
             add(
                 f"teleport_shortcut_to={k}",

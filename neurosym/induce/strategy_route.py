@@ -36,6 +36,15 @@ route_from_(E, T, R0-C0, O, D) :-
 teleport_shortcut_to(E, T, K) :-
     once(( goal_candidate(E, T, O), teleport_shortcut(E, T, O, K) )).
 
+%!  teleport_not_longer(+E, +T, +O, ?Kind) is semidet.
+%   Like teleport_shortcut/4, but the route through O may be as long as the one without.
+teleport_not_longer(E, T, O, K) :-
+    object_kind(O, teleport), route_length(E, T, O, D1), D1 < 999,
+    goal_candidate(E, T, X), X \== O, object_kind(X, teleport), at(E, T, X, XR, XC), !,
+    once(( goal_candidate(E, T, Y), object_kind(Y, K), K \== teleport,
+           route_from_(E, T, XR-XC, Y, D2), D2 < 999, route_length(E, T, Y, D),
+           D1 + D2 =< D )).
+
 %!  route_not_longer(+E, +T, +O, ?Kind) is semidet.
 %   O is reachable and its route is not longer than that of any object of this kind
 %   (true when none of the kind is reachable).
@@ -95,8 +104,10 @@ def shortcuts(
     kinds: dict[str, str],
     size: tuple[int, int],
     closed: set[tuple[int, int]],
+    ties: bool = False,
 ) -> dict[str, set[str]]:
-    """Teleport end -> the kinds it is a shortcut to (:pl:`teleport_shortcut/4`)."""
+    """Teleport end -> the kinds it is a shortcut to (:pl:`teleport_shortcut/4`; ``ties``:
+    :pl:`teleport_not_longer/4`, the route through it as long as the one without allowed)."""
     direct = route_lengths(agent, cells, size, closed)
     ends = sorted(o for o in cells if kinds[o] == "teleport")
     out: dict[str, set[str]] = {}
@@ -108,7 +119,9 @@ def shortcuts(
         out[o] = {
             kinds[y]
             for y in cells
-            if kinds[y] != "teleport" and after[y] < UNREACHABLE and direct[o] + after[y] < direct[y]
+            if kinds[y] != "teleport"
+            and after[y] < UNREACHABLE
+            and (direct[o] + after[y] <= direct[y] if ties else direct[o] + after[y] < direct[y])
         }
     return out
 
