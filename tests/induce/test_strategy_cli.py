@@ -57,3 +57,19 @@ def test_cli_errors_are_one_line(run_neurosym, kbs, tmp_path: Path, args, code, 
     if code == 1:
         assert len(r.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "s.pl").exists()
+
+
+def test_induce_imports_neither_torch_nor_the_envs() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, neurosym.cli, neurosym.induce.cli_induce, neurosym.induce.strategy, "
+        "neurosym.induce.strategy_writer, neurosym.induce.strategy_covering; "
+        "print('torch' in sys.modules, 'neurosym.envs' in sys.modules)"
+    )
+    repo = Path(__file__).resolve().parents[2]
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo
+    )
+    assert out.stdout.split() == ["False", "False"]

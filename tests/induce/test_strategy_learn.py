@@ -87,5 +87,9 @@ def test_bad_settings_are_one_line_errors(kbs: tuple[Path, Path], tmp_path: Path
         induce_strategy(train, "colour")
     with pytest.raises(ConfigError, match="between 0 and 1"):
         induce_strategy(train, "world", holdout_share=1.5)
+    with pytest.raises(ConfigError, match="max_clauses must be 1 to 20, got 21"):
+        induce_strategy(train, "world", max_clauses=21)
+    with pytest.raises(ConfigError, match="unknown learner 'ilp'; use one of best, tree, covering"):
+        induce_strategy(train, "world", learner="ilp")
     with pytest.raises(ConfigError, match="no knowledge base at"):
         induce_strategy(tmp_path / "missing.pl")
