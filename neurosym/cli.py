@@ -207,7 +207,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "induce": (
         "neurosym.induce.cli_induce",
-        "Learn rules back from a knowledge base: the agent's strategy as goal/3 clauses.",
+        "Learn rules back from a knowledge base: the world's rules (predicts/3), "
+        "the agent's strategy (goal/3).",
     ),
     "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),

@@ -73,3 +73,11 @@ def test_induce_imports_neither_torch_nor_the_envs() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo
     )
     assert out.stdout.split() == ["False", "False"]
+
+
+def test_cli_refuses_a_folder_as_out_before_learning(run_neurosym, kbs, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    train, _ = kbs
+    r = run_neurosym("induce", "--kb", train, "--what", "strategy", "--out", tmp_path)
+    assert r.returncode == 1
+    assert r.stderr.startswith("neurosym induce: error: ") and len(r.stderr.strip().splitlines()) == 1
+    assert "learned from" not in r.stdout
