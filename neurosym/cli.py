@@ -207,7 +207,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "induce": (
         "neurosym.induce.cli_induce",
-        "Learn rules back from a knowledge base: the world's rules (predicts/3).",
+        "Learn rules back from a knowledge base: the world's rules (predicts/3), "
+        "the agent's strategy (goal/3).",
     ),
     "play": (
         "neurosym.play.cli_play",

@@ -1,6 +1,8 @@
 """``neurosym induce``: learn rules back from a knowledge base.
 
     neurosym induce --kb KB.pl --what world --out world.pl [--holdout KB2.pl]
+    neurosym induce --kb KB.pl --what strategy --out strategy.pl [--features world|relations|both]
+                    [--holdout KB2.pl | --holdout-share 0.3] [--learner best|tree|covering]
 
 ``--what world`` learns, for every event of the env's vocabulary that the KB
 shows, ``predicts(E, T, Event)`` clauses over the state facts and the action
@@ -9,6 +11,12 @@ precision/recall, held-out precision/recall with ``--holdout`` and whether
 it is solved perfectly (precision and recall 1.0 held out), and writes the
 clauses as a Prolog file that loads beside a KB of other episodes.
 Events the KB cannot decide are reported as undetermined, not guessed.
+
+``--what strategy`` learns which object the agent goes for next, as
+``goal(E, T, Object)`` clauses whose first answer is the choice
+(:mod:`neurosym.induce.strategy`), prints the clauses and the fidelity (share
+of held-out states whose first answer is the labelled next object) and
+writes them as a Prolog file that loads in plain swipl beside a KB.
 """
 
 from __future__ import annotations
@@ -29,8 +37,30 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--what", required=True, metavar="WHAT", help=f"what to learn: {', '.join(WHATS)}"
     )
     parser.add_argument("--out", required=True, metavar="FILE", help="learned rules (.pl) to write")
-    parser.add_argument(
+    held = parser.add_mutually_exclusive_group()
+    held.add_argument(
         "--holdout", metavar="FILE", help="a KB of other episodes to score the learned rules on"
+    )
+    held.add_argument(
+        "--holdout-share",
+        type=float,
+        metavar="S",
+        help="strategy: without --holdout, score on the last share S of the KB's episodes, "
+        "learning from the rest (default: 0.3)",
+    )
+    parser.add_argument(
+        "--features",
+        choices=("world", "relations", "both"),
+        default="world",
+        help="strategy: the facts the clauses may read: the world's (at/5, holding/3, ...), "
+        "the network's relations (attends/8, holds/5, attention/6) or both (default: world)",
+    )
+    parser.add_argument(
+        "--learner",
+        choices=("best", "tree", "covering"),
+        default="best",
+        help="strategy: a scikit-learn decision tree over (state, object) pairs, sequential "
+        "covering of states, or best: both, keeping the higher training fidelity (default: best)",
     )
 
 
@@ -97,5 +127,33 @@ def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f}"
 
 
-WHATS: dict[str, Callable[[argparse.Namespace], int]] = {"world": run_world}
+def run_strategy(args: argparse.Namespace) -> int:
+    """Learn the agent's next-object strategy, print its clauses and fidelity, write it."""
+    from neurosym.atomic import check_target
+    from neurosym.induce.strategy import induce_strategy
+    from neurosym.induce.strategy_writer import clauses_text
+
+    check_target(args.out)  # refused before the learning, not after
+    share = 0.3 if args.holdout_share is None else args.holdout_share
+    strategy = induce_strategy(
+        args.kb, args.features, holdout=args.holdout, holdout_share=share, learner=args.learner
+    )
+    out = strategy.write(args.out)
+    print(
+        f"learned from {strategy.kb} ({strategy.features} features, {strategy.model.learner}) in "
+        f"{strategy.seconds:.1f} s: {len(strategy.model.clauses)} clause(s)"
+    )
+    print(clauses_text(strategy), end="")
+    print(
+        f"fidelity {strategy.fidelity:.4f} on {strategy.states} held-out states ({strategy.holdout}); "
+        f"{strategy.train_fidelity:.4f} on {strategy.train_states} training states"
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+WHATS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "world": run_world,
+    "strategy": run_strategy,
+}
 """--what -> the function that learns and writes it"""

@@ -1,0 +1,156 @@
+"""The data a strategy is learned from: a KB's trace tables, its states' candidates and labels.
+
+A *state* is (episode E, step T). Its *candidates* are the objects on the map
+in that state (``at/5`` facts other than the agent's), in the standard order
+of their ids (the order the learned file's ``strategy_candidate/3`` gives).
+Its *label* (the next object) is the object of the first contact at T' >= T:
+the object in the cell that the action at T' moves into, on a step whose
+events include a contact (:data:`CONTACTS`). States after the last contact
+have no label and are left out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from neurosym.errors import ConfigError
+
+CONTACTS = frozenset(
+    {
+        # Relational-Grid-World
+        "picked(sword)",
+        "defeated(enemy)",
+        "hurt_by(enemy)",
+        "bumped(enemy)",
+        "killed_by(enemy)",
+        "teleported",
+        "reached(terminal)",
+        "fell(pit)",
+        # Box-World: picking a loose key, opening a box
+        "opened",
+        "got_loose_key",
+    }
+)
+"""Events that are a contact with the object in the cell moved into (Box-World by functor)."""
+
+MOVES = {"up": (-1, 0), "right": (0, 1), "down": (1, 0), "left": (0, -1)}
+"""Action -> (row, col) offset of the cell it moves into."""
+
+TABLES = {
+    "object": "object(O, Ty0), term_to_atom(Ty0, Ty)",
+    "at": "at(E, T, O, R, C)",
+    "step": "step(E, T, A, _)",
+    "event": "event(E, T, Ev0), term_to_atom(Ev0, Ev)",
+    "holding": "holding(E, T, I0), term_to_atom(I0, I)",
+    "attends": "attends(E, T, H, Arg, _, R, C, _)",
+    "holds": "holds(E, T, r(J), X0, Y0), term_to_atom(X0, X), term_to_atom(Y0, Y)",
+    "attention": "attention(E, T, H, Q0, K0, _), term_to_atom(Q0, Q), term_to_atom(K0, K)",
+    "meta": "kb_meta(Key, V0), term_to_atom(V0, V)",
+    "terrain": (
+        "catch(terrain(E, Ty0, R, C), error(existence_error(_, _), _), fail), term_to_atom(Ty0, Ty)"
+    ),
+    "grid": "catch(grid(E, Rows, Cols), error(existence_error(_, _), _), fail)",
+}
+"""The goal that reads each table, compound terms as their Prolog text."""
+
+
+@dataclass
+class Trace:
+    """A KB's tables (DataFrames, columns named as the goals' variables in :data:`TABLES`)."""
+
+    path: Path
+    object: pd.DataFrame
+    at: pd.DataFrame
+    step: pd.DataFrame
+    event: pd.DataFrame
+    holding: pd.DataFrame
+    attends: pd.DataFrame
+    holds: pd.DataFrame
+    attention: pd.DataFrame
+    terrain: pd.DataFrame
+    grid: pd.DataFrame
+    meta: dict[str, str]
+
+    def episodes(self) -> list[int]:
+        """The episode ids that have states, sorted."""
+        return sorted(int(e) for e in self.at["E"].unique())
+
+    def subset(self, episodes: list[int]) -> Trace:
+        """The same tables restricted to ``episodes``."""
+        keep = set(episodes)
+        parts = {
+            name: getattr(self, name)[getattr(self, name)["E"].isin(keep)].reset_index(drop=True)
+            for name in ("at", "step", "event", "holding", "attends", "holds", "attention", "terrain", "grid")
+        }
+        return Trace(self.path, self.object, meta=self.meta, **parts)
+
+
+def _columns(df: pd.DataFrame) -> pd.DataFrame:
+    """Drop the goals' helper variables (those ending in 0: the terms before term_to_atom)."""
+    return df[[c for c in df.columns if not c.endswith("0")]]
+
+
+def load_trace(path: str | Path) -> Trace:
+    """Read a KB file's trace and relation facts (as data: nothing in it runs)."""
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"no knowledge base at {path}; pass a kb.pl written by neurosym extract")
+    with KnowledgeBase(path) as kb:
+        tables = {name: _columns(kb.query_df(goal)) for name, goal in TABLES.items()}
+    meta = dict(zip(tables["meta"]["Key"], tables["meta"]["V"], strict=True))
+    trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
+    if trace.at.empty:
+        raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
+    return trace
+
+
+def _contact(events: list[str], target: str | None, types: dict[str, str]) -> bool:
+    """Whether a step with these events is a contact with ``target`` (the object moved into)."""
+    if target is None:
+        return False
+    kind = types.get(target, "")
+    for ev in events:
+        if ev in CONTACTS:
+            return True
+        if ev.startswith("opened(") and kind.startswith("lock("):
+            return True
+        if ev.startswith("got(key(") and kind.startswith("key("):
+            return True  # walking into a key's cell: a loose key (a box's content blocks)
+    return False
+
+
+def labels(trace: Trace) -> pd.DataFrame:
+    """The next object of every labelled state: columns E, T, Goal, sorted by (E, T)."""
+    types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
+    cells = {(e, t, r, c): o for e, t, o, r, c in trace.at.itertuples(index=False) if o != "agent"}
+    agent = {(e, t): (r, c) for e, t, o, r, c in trace.at.itertuples(index=False) if o == "agent"}
+    events: dict[tuple[int, int], list[str]] = {}
+    for e, t, ev in trace.event.itertuples(index=False):
+        events.setdefault((e, t), []).append(ev)
+    contacts: dict[int, list[tuple[int, str]]] = {}
+    for e, t, a in trace.step.sort_values(["E", "T"]).itertuples(index=False):
+        if (e, t) not in events or (e, t) not in agent or a not in MOVES:
+            continue
+        r, c = agent[(e, t)]
+        dr, dc = MOVES[a]
+        target = cells.get((e, t, r + dr, c + dc))
+        if _contact(events[(e, t)], target, types):
+            contacts.setdefault(e, []).append((t, target))
+    rows = []
+    states = trace.at[["E", "T"]].drop_duplicates().sort_values(["E", "T"])
+    for e, t in states.itertuples(index=False):
+        nxt = next((o for tc, o in contacts.get(e, []) if tc >= t), None)
+        if nxt is not None:
+            rows.append((int(e), int(t), nxt))
+    return pd.DataFrame(rows, columns=["E", "T", "Goal"])
+
+
+def candidates(trace: Trace) -> pd.DataFrame:
+    """Every (state, object on the map) pair but the agent: columns E, T, O, R, C, ordered by (E, T, O)."""
+    pairs = trace.at[trace.at["O"] != "agent"]
+    return pairs.sort_values(["E", "T", "O"], kind="stable").reset_index(drop=True)

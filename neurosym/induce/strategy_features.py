@@ -1,0 +1,393 @@
+"""Features of (state, candidate object) pairs, computed in Python and defined in Prolog.
+
+Every feature is a literal over ``E, T, O`` (state and candidate) that the
+learned file can state: a binary one is a goal that holds or not, a numeric
+one a goal that binds ``V``. :data:`BACKGROUND` defines, in Prolog, every
+predicate these goals use; it is copied into each learned file, so the file
+needs nothing but the KB's facts. The Python side computes the same values
+(tests check that the two agree through SWI-Prolog).
+
+Feature sets:
+
+* ``world``: the object's kind, the agent's distance to it (Manhattan), whether
+  it is the nearest of its kind or of all, what the agent holds, which kinds
+  are on the map, and Box-World's key/lock facts (the lock of the held key, a
+  loose key that has a lock, a box holding the gem or a key that opens another
+  lock). Read from ``at/5``, ``holding/3``, ``object/2``.
+* ``relations``: PrediNet, whether head H's argument A attends the object's
+  cell (``attends/8``, the cell mapped to the object through ``at/5``) and
+  whether relation J holds with the object's entity as first or second
+  argument (``holds/5``; the entity is matched by its name, the object's
+  ``object/2`` type); MHDPA, whether head H's agent query attends the object's
+  entity, whether the object's query attends the agent, and how many queries
+  attend the object's entity (``attention/6``, entities matched by name).
+* ``both``: the union.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from neurosym.induce.strategy_data import Trace
+from neurosym.induce.strategy_route import (
+    PASSABLE_KINDS,
+    PASSABLE_TERRAIN,
+    UNREACHABLE,
+    route_lengths,
+    shortcuts,
+)
+
+FEATURE_SETS = ("world", "relations", "both")
+
+
+@dataclass(frozen=True)
+class Feature:
+    """One column: its name, the Prolog goal over E, T, O (binding V when numeric)."""
+
+    name: str
+    goal: str
+    numeric: bool = False
+
+
+BACKGROUND = r"""
+%!  goal_candidate(?E, ?T, -O) is nondet.
+%   The objects on the map in state T (at/5, not the agent), in the standard order of their ids.
+goal_candidate(E, T, O) :-
+    setof(O1, R^C^(at(E, T, O1, R, C), O1 \== agent), Os),
+    member(O, Os).
+
+%!  object_kind(?O, ?Kind) is nondet.
+%   The kind of object O: its type, or the type's functor (key, lock) for key(C), lock(C).
+object_kind(O, K) :- object(O, Ty), ( compound(Ty) -> functor(Ty, K, _) ; K = Ty ).
+
+%!  object_colour(?O, ?C) is nondet.
+object_colour(O, C) :- object(O, Ty), compound(Ty), arg(1, Ty, C).
+
+%!  holding_kind(+E, +T, ?Kind) is nondet.
+holding_kind(E, T, K) :- holding(E, T, I), ( compound(I) -> functor(I, K, _) ; K = I ).
+
+%!  on_map(+E, +T, ?Kind) is semidet.
+%   An object of this kind is on the map in state T.
+on_map(E, T, K) :- once((goal_candidate(E, T, O), object_kind(O, K))).
+
+%!  agent_distance(+E, +T, +O, -D) is semidet.
+%   Manhattan distance from the agent to object O in state T.
+agent_distance(E, T, O, D) :-
+    at(E, T, agent, R0, C0), at(E, T, O, R, C), !,
+    D is abs(R - R0) + abs(C - C0).
+
+%!  nearest_of_kind(+E, +T, +O) is semidet.
+%   No object of O's kind is strictly nearer to the agent.
+nearest_of_kind(E, T, O) :-
+    object_kind(O, K), agent_distance(E, T, O, D),
+    \+ ( goal_candidate(E, T, O2), O2 \== O, object_kind(O2, K),
+         agent_distance(E, T, O2, D2), D2 < D ).
+
+%!  nearest_object(+E, +T, +O) is semidet.
+%   No object is strictly nearer to the agent.
+nearest_object(E, T, O) :-
+    agent_distance(E, T, O, D),
+    \+ ( goal_candidate(E, T, O2), O2 \== O, agent_distance(E, T, O2, D2), D2 < D ).
+
+%!  lock_of_held_key(+E, +T, +O) is semidet.
+%   Box-World: O is a lock of the colour of the key the agent holds.
+lock_of_held_key(E, T, O) :-
+    object_kind(O, lock), object_colour(O, C), holding(E, T, key(C)), !.
+
+%!  key_fits_lock(+E, +T, +O) is semidet.
+%   Box-World: O is a key and a lock of its colour is on the map.
+key_fits_lock(E, T, O) :-
+    object_kind(O, key), object_colour(O, C),
+    once(( goal_candidate(E, T, L), object(L, lock(C)) )).
+
+%!  loose(+E, +T, +O) is semidet.
+%   Box-World: O is a key with no lock to its right (not a box's content).
+loose(E, T, O) :-
+    object_kind(O, key), at(E, T, O, R, C), !, C1 is C + 1,
+    \+ ( at(E, T, L, R, C1), object_kind(L, lock) ).
+
+%!  box_content(+E, +T, +Lock, -Content) is semidet.
+%   Box-World: the object in the cell left of the lock.
+box_content(E, T, L, X) :-
+    object_kind(L, lock), at(E, T, L, R, C), !, C0 is C - 1,
+    at(E, T, X, R, C0), X \== agent, !.
+
+%!  box_holds_gem(+E, +T, +O) is semidet.
+box_holds_gem(E, T, O) :- box_content(E, T, O, X), object_kind(X, gem).
+
+%!  box_holds_useful_key(+E, +T, +O) is semidet.
+%   Box-World: O's box holds a key of a colour some other lock on the map takes.
+box_holds_useful_key(E, T, O) :-
+    box_content(E, T, O, X), object_kind(X, key), object_colour(X, C),
+    once(( goal_candidate(E, T, L), L \== O, object(L, lock(C)) )).
+
+%!  attended_by(+E, +T, ?H, ?Arg, +O) is nondet.
+%   PrediNet: head H's argument Arg attends the cell of object O (the cell mapped through at/5).
+attended_by(E, T, H, A, O) :- at(E, T, O, R, C), attends(E, T, H, A, _, R, C, _).
+
+%!  related(+E, +T, ?J, ?Pos, +O) is nondet.
+%   PrediNet: relation J holds with O's entity (its object/2 type) as argument Pos (1 or 2).
+related(E, T, J, 1, O) :- object(O, Ty), holds(E, T, r(J), Ty, _).
+related(E, T, J, 2, O) :- object(O, Ty), holds(E, T, r(J), _, Ty).
+
+%!  agent_query_attends(+E, +T, ?H, +O) is nondet.
+%   MHDPA: head H's query from the agent's cell attends O's entity (its object/2 type).
+agent_query_attends(E, T, H, O) :- object(O, Ty), attention(E, T, H, agent, Ty, _).
+
+%!  query_attends_agent(+E, +T, ?H, +O) is nondet.
+%   MHDPA: head H's query from O's entity attends the agent.
+query_attends_agent(E, T, H, O) :- object(O, Ty), attention(E, T, H, Ty, agent, _).
+
+%!  attending_queries(+E, +T, +H, +O, -N) is det.
+%   MHDPA: how many of head H's query cells attend O's entity.
+attending_queries(E, T, H, O, N) :-
+    object(O, Ty), aggregate_all(count, attention(E, T, H, _, Ty, _), N).
+"""
+
+
+def _kind(ty: str) -> str:
+    return ty.split("(", 1)[0]
+
+
+def _colour(ty: str) -> str | None:
+    return ty[ty.index("(") + 1 : -1] if "(" in ty else None
+
+
+def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
+    """The world feature columns of ``pairs`` (E, T, O, R, C rows) and their Prolog goals."""
+    types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
+    kinds = sorted({_kind(types[o]) for o in pairs["O"].unique()})
+    held = sorted({_kind(i) for i in trace.holding["I"].unique()})
+    agent = {(e, t): (r, c) for e, t, o, r, c in trace.at.itertuples(index=False) if o == "agent"}
+    holding = {(e, t, i) for e, t, i in trace.holding.itertuples(index=False)}
+    by_state: dict[tuple[int, int], list[tuple[str, int, int]]] = {}
+    for e, t, o, r, c in pairs.itertuples(index=False):
+        by_state.setdefault((e, t), []).append((o, r, c))
+    cols: dict[str, list[float]] = {}
+    feats: list[Feature] = []
+
+    def add(name: str, goal: str, fn: Callable[..., float], numeric: bool = False) -> None:
+        feats.append(Feature(name, goal, numeric))
+        cols[name] = [fn(e, t, o, r, c) for e, t, o, r, c in pairs.itertuples(index=False)]
+
+    def dist(e: int, t: int, r: int, c: int) -> int:
+        r0, c0 = agent[(e, t)]
+        return abs(r - r0) + abs(c - c0)
+
+    def nearest(e: int, t: int, o: str, r: int, c: int, same_kind: bool) -> float:
+        d = dist(e, t, r, c)
+        k = _kind(types[o])
+        return float(
+            not any(
+                o2 != o and (not same_kind or _kind(types[o2]) == k) and dist(e, t, r2, c2) < d
+                for o2, r2, c2 in by_state[(e, t)]
+            )
+        )
+
+    def at_cell(e: int, t: int, r: int, c: int) -> str | None:
+        return next((o2 for o2, r2, c2 in by_state[(e, t)] if (r2, c2) == (r, c)), None)
+
+    def locks(e: int, t: int, colour: str | None, but: str = "") -> bool:
+        return any(types[o2] == f"lock({colour})" and o2 != but for o2, _, _ in by_state[(e, t)])
+
+    def content(e: int, t: int, o: str, r: int, c: int) -> str | None:
+        return at_cell(e, t, r, c - 1) if _kind(types[o]) == "lock" else None
+
+    for k in kinds:
+        add(f"kind={k}", f"object_kind(O, {k})", lambda e, t, o, r, c, k=k: float(_kind(types[o]) == k))
+    for k in held:
+        add(
+            f"holding={k}",
+            f"holding_kind(E, T, {k})",
+            lambda e, t, o, r, c, k=k: float(
+                any((e, t, i) in holding for i in trace.holding["I"].unique() if _kind(i) == k)
+            ),
+        )
+    for k in kinds:
+        add(
+            f"on_map={k}",
+            f"on_map(E, T, {k})",
+            lambda e, t, o, r, c, k=k: float(any(_kind(types[o2]) == k for o2, _, _ in by_state[(e, t)])),
+        )
+    add("distance", "agent_distance(E, T, O, V)", lambda e, t, o, r, c: float(dist(e, t, r, c)), True)
+    add("nearest_of_kind", "nearest_of_kind(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, True))
+    add("nearest_object", "nearest_object(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, False))
+    if not trace.grid.empty:
+        _routes(trace, pairs, types, kinds, add)
+    if any(_kind(types[o]) in ("key", "lock") for o in pairs["O"].unique()):
+        _box_world(add, types, holding, at_cell, locks, content)
+    return feats, np.array([cols[f.name] for f in feats], dtype=float).T
+
+
+def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: list[str], add) -> None:  # type: ignore[no-untyped-def]
+    """Route features (:mod:`neurosym.induce.strategy_route`): reachable, route length, nearest reachable."""
+    size = {int(e): (int(r), int(c)) for e, r, c in trace.grid.itertuples(index=False)}
+    walls: dict[int, set[tuple[int, int]]] = {}
+    terrain = trace.terrain
+    for e, ty, r, c in zip(terrain["E"], terrain["Ty"], terrain["R"], terrain["C"], strict=True):
+        if ty not in PASSABLE_TERRAIN:
+            walls.setdefault(int(e), set()).add((int(r), int(c)))
+    lengths: dict[tuple[int, int, str], int] = {}
+    cuts: dict[tuple[int, int, str], set[str]] = {}
+    ties: dict[tuple[int, int, str], set[str]] = {}
+    for (e, t), group in trace.at.groupby(["E", "T"], sort=False):
+        cells = {o: (int(r), int(c)) for o, r, c in zip(group["O"], group["R"], group["C"], strict=True)}
+        if "agent" not in cells:
+            continue
+        start = cells.pop("agent")
+        closed = walls.get(int(e), set()) | {
+            rc for o, rc in cells.items() if _kind(types[o]) not in PASSABLE_KINDS
+        }
+        if int(e) in size:
+            found = route_lengths(start, cells, size[int(e)], closed)
+            kind_of = {o: _kind(types[o]) for o in cells}
+            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed).items():
+                cuts[(int(e), int(t), o)] = ks
+            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed, ties=True).items():
+                ties[(int(e), int(t), o)] = ks
+        else:
+            found = dict.fromkeys(cells, UNREACHABLE)
+        for o, d in found.items():
+            lengths[(int(e), int(t), o)] = d
+    by_state: dict[tuple[int, int], list[str]] = {}
+    for e, t, o in zip(pairs["E"], pairs["T"], pairs["O"], strict=True):
+        by_state.setdefault((e, t), []).append(o)
+
+    def length(e: int, t: int, o: str) -> int:
+        return lengths.get((e, t, o), UNREACHABLE)
+
+    def nearest(e: int, t: int, o: str, r: int, c: int) -> float:
+        d, k = length(e, t, o), _kind(types[o])
+        return float(
+            d < UNREACHABLE
+            and not any(
+                o2 != o and _kind(types[o2]) == k and length(e, t, o2) < d for o2 in by_state[(e, t)]
+            )
+        )
+
+    add("route_length", "route_length(E, T, O, V)", lambda e, t, o, r, c: float(length(e, t, o)), True)
+    add("reachable", "reachable(E, T, O)", lambda e, t, o, r, c: float(length(e, t, o) < UNREACHABLE))
+    add("nearest_reachable_of_kind", "nearest_reachable_of_kind(E, T, O)", nearest)
+    for k in kinds:
+        if k != "teleport" and "teleport" in kinds:
+            add(
+                f"teleport_shortcut={k}",
+                f"teleport_shortcut(E, T, O, {k})",
+                lambda e, t, o, r, c, k=k: float(k in cuts.get((e, t, o), ())),
+            )
+            add(
+                f"teleport_not_longer={k}",
+                f"teleport_not_longer(E, T, O, {k})",
+                lambda e, t, o, r, c, k=k: float(k in ties.get((e, t, o), ())),
+            )
+            add(
+                f"teleport_shortcut_to={k}",
+                f"teleport_shortcut_to(E, T, {k})",
+                lambda e, t, o, r, c, k=k: float(
+                    any(k in cuts.get((e, t, o2), ()) for o2 in by_state[(e, t)])
+                ),
+            )
+    for k in kinds:
+        add(
+            f"route_not_longer={k}",
+            f"route_not_longer(E, T, O, {k})",
+            lambda e, t, o, r, c, k=k: float(
+                length(e, t, o) < UNREACHABLE
+                and not any(
+                    o2 != o and _kind(types[o2]) == k and length(e, t, o2) < length(e, t, o)
+                    for o2 in by_state[(e, t)]
+                )
+            ),
+        )
+    for k in kinds:
+        add(
+            f"reachable_kind={k}",
+            f"reachable_kind(E, T, {k})",
+            lambda e, t, o, r, c, k=k: float(
+                any(_kind(types[o2]) == k and length(e, t, o2) < UNREACHABLE for o2 in by_state[(e, t)])
+            ),
+        )
+
+
+def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: ignore[no-untyped-def]
+    """Box-World's key and lock features (only where the KB has keys or locks)."""
+    add(
+        "lock_of_held_key",
+        "lock_of_held_key(E, T, O)",
+        lambda e, t, o, r, c: float(
+            _kind(types[o]) == "lock" and (e, t, f"key({_colour(types[o])})") in holding
+        ),
+    )
+    add(
+        "key_fits_lock",
+        "key_fits_lock(E, T, O)",
+        lambda e, t, o, r, c: float(_kind(types[o]) == "key" and locks(e, t, _colour(types[o]))),
+    )
+
+    def loose(e: int, t: int, o: str, r: int, c: int) -> float:
+        right = at_cell(e, t, r, c + 1)
+        return float(_kind(types[o]) == "key" and not (right and _kind(types[right]) == "lock"))
+
+    def gem_box(e: int, t: int, o: str, r: int, c: int) -> float:
+        x = content(e, t, o, r, c)
+        return float(x is not None and _kind(types[x]) == "gem")
+
+    def useful_box(e: int, t: int, o: str, r: int, c: int) -> float:
+        x = content(e, t, o, r, c)
+        return float(x is not None and _kind(types[x]) == "key" and locks(e, t, _colour(types[x]), o))
+
+    add("loose", "loose(E, T, O)", loose)
+    add("box_holds_gem", "box_holds_gem(E, T, O)", gem_box)
+    add("box_holds_useful_key", "box_holds_useful_key(E, T, O)", useful_box)
+
+
+def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
+    """The network's relation columns: PrediNet attends/holds, MHDPA attention."""
+    types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
+    heads = int(trace.meta.get("heads", 0))
+    feats: list[Feature] = []
+    cols: list[list[float]] = []
+    rows = list(pairs.itertuples(index=False))
+    if not trace.attends.empty or trace.meta.get("module") == "predinet":
+        cells = {(e, t, h, a, r, c) for e, t, h, a, r, c in trace.attends.itertuples(index=False)}
+        for h in range(heads):
+            for a in (1, 2):
+                feats.append(Feature(f"attended_by({h},{a})", f"attended_by(E, T, {h}, {a}, O)"))
+                cols.append([float((e, t, h, a, r, c) in cells) for e, t, o, r, c in rows])
+        first = {(e, t, j, x) for e, t, j, x, y in trace.holds.itertuples(index=False)}
+        second = {(e, t, j, y) for e, t, j, x, y in trace.holds.itertuples(index=False)}
+        for j in range(int(trace.meta.get("relations", 0))):
+            for pos, table in ((1, first), (2, second)):
+                feats.append(Feature(f"related({j},{pos})", f"related(E, T, {j}, {pos}, O)"))
+                cols.append([float((e, t, j, types[o]) in table) for e, t, o, r, c in rows])
+    if not trace.attention.empty or trace.meta.get("module") == "mhdpa":
+        att = trace.attention
+        from_agent = {(e, t, h, k) for e, t, h, q, k in att.itertuples(index=False) if q == "agent"}
+        to_agent = {(e, t, h, q) for e, t, h, q, k in att.itertuples(index=False) if k == "agent"}
+        count = att.groupby(["E", "T", "H", "K"]).size().to_dict()
+        for h in range(heads):
+            feats.append(Feature(f"agent_query_attends({h})", f"agent_query_attends(E, T, {h}, O)"))
+            cols.append([float((e, t, h, types[o]) in from_agent) for e, t, o, r, c in rows])
+            feats.append(Feature(f"query_attends_agent({h})", f"query_attends_agent(E, T, {h}, O)"))
+            cols.append([float((e, t, h, types[o]) in to_agent) for e, t, o, r, c in rows])
+            feats.append(
+                Feature(f"attending_queries({h})", f"attending_queries(E, T, {h}, O, V)", True)
+            )
+            cols.append([float(count.get((e, t, h, types[o]), 0)) for e, t, o, r, c in rows])
+    matrix = np.array(cols, dtype=float).T if cols else np.zeros((len(rows), 0))
+    return feats, matrix
+
+
+def features(trace: Trace, pairs: pd.DataFrame, which: str) -> tuple[list[Feature], np.ndarray]:
+    """The columns of feature set ``which`` (``world``, ``relations`` or ``both``)."""
+    parts = []
+    if which in ("world", "both"):
+        parts.append(world_features(trace, pairs))
+    if which in ("relations", "both"):
+        parts.append(relation_features(trace, pairs))
+    feats = [f for fs, _ in parts for f in fs]
+    return feats, np.hstack([m for _, m in parts]) if parts else np.zeros((len(pairs), 0))
