@@ -21,13 +21,13 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
     from neurosym.shipped import checkpoint_file, rule_file, rules_dir, shipped_rule_names
 
     assert rules_dir() == REPO / "rules"
-    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "relations", "rgw"]
+    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "relations", "rgw", "route"]
     monkeypatch.chdir(tmp_path)
     assert rule_file("rgw") == REPO / "rules" / "rgw.pl"
     assert rule_file("boxworld.pl") == REPO / "rules" / "boxworld.pl"
     assert rule_file("mine.pl") == Path("mine.pl")  # not there: the loader says so
     with pytest.raises(
-        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw\)"
+        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw, route\)"
     ):
         rule_file("rgx")
     (tmp_path / "rgw").write_text("my_rule.\n")  # a file of the user's wins over the shipped name
