@@ -13,8 +13,7 @@ The top-level names are imported lazily so that ``import neurosym`` (and the
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from neurosym.lazy import lazy_attributes
 
 __version__ = "0.1.0"
 
@@ -39,9 +38,4 @@ _LAZY = {
 __all__ = ["__version__", *_LAZY]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'neurosym' has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)

@@ -14,8 +14,7 @@ torch nor the envs.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from neurosym.lazy import lazy_attributes
 
 _LAZY = {
     "induce_world": "neurosym.induce.world",
@@ -30,8 +29,4 @@ _LAZY = {
 __all__ = sorted(_LAZY)
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'neurosym.induce' has no attribute {name!r}")
-    return getattr(importlib.import_module(module), name)
+__getattr__ = lazy_attributes(__name__, _LAZY)

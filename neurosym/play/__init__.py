@@ -13,8 +13,7 @@ torch nor janus.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from neurosym.lazy import lazy_attributes
 
 _API = {
     "PrologAgent": "neurosym.play.agent",
@@ -28,8 +27,4 @@ _API = {
 __all__ = sorted(_API)
 
 
-def __getattr__(name: str) -> Any:
-    module = _API.get(name)
-    if module is None:
-        raise AttributeError(f"module 'neurosym.play' has no attribute {name!r}")
-    return getattr(importlib.import_module(module), name)
+__getattr__ = lazy_attributes(__name__, _API)

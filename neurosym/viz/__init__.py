@@ -14,8 +14,7 @@ Names are imported lazily so that ``neurosym plot --help`` does not load matplot
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from neurosym.lazy import lazy_attributes
 
 _LAZY = {
     "mhdpa_figure": "neurosym.viz.attention",
@@ -37,9 +36,4 @@ _LAZY = {
 __all__ = list(_LAZY)
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'neurosym.viz' has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
