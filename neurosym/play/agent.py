@@ -24,7 +24,6 @@ first seed), T its state; an episode's facts are retracted when it ends.
 from __future__ import annotations
 
 import os
-import threading
 import time
 from collections import Counter
 from typing import Any
@@ -48,22 +47,13 @@ SCHEMA = (
 """every predicate of the KB schema, declared dynamic in the agent's module"""
 
 _ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
-_loaded = False
-_lock = threading.Lock()
 
 
 def _janus() -> Any:
     """janus with neurosym_play consulted (once per process)."""
-    global _loaded
-    from neurosym.prolog.locate import import_janus
+    from neurosym.prolog.locate import janus_with
 
-    janus = import_janus()
-    if not _loaded:
-        with _lock:
-            if not _loaded:
-                janus.consult(f"/neurosym/{play_prolog.MODULE}.pl", data=play_prolog.SOURCE)
-                _loaded = True
-    return janus
+    return janus_with(play_prolog)
 
 
 class PrologAgent:

@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import itertools
 import re
-import threading
 import warnings
 import weakref
 from collections.abc import Iterable, Sequence
@@ -71,7 +70,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from neurosym.errors import ConfigError, NeurosymError, OutputError, PrologError
 from neurosym.prolog import bridge, fact_reader, signature
-from neurosym.prolog.locate import import_janus
+from neurosym.prolog.locate import janus_with
 from neurosym.prolog.qlf import is_fresh, qcompile, qlf_path
 from neurosym.prolog.snapshot import Snapshot, nesting_bound, nesting_of, snapshot
 from neurosym.terms import MAX_DEPTH, Term, Var
@@ -93,8 +92,6 @@ _GOAL_NESTING = 5_000
 _C_STACK_BASE = 16 << 20
 _C_STACK_PER_LEVEL = 768
 _ids = itertools.count(1)
-_bridge_lock = threading.Lock()
-_bridge_loaded = False
 
 
 MAX_TIMEOUT = 1e9
@@ -132,16 +129,8 @@ def _trust(trusted: bool | PathArg | Sequence[PathArg]) -> Any:
 
 
 def _janus() -> Any:
-    """janus with the bridge module loaded (once per process)."""
-    global _bridge_loaded
-    janus = import_janus()
-    if not _bridge_loaded:
-        with _bridge_lock:
-            if not _bridge_loaded:
-                janus.consult(f"/neurosym/{bridge.MODULE}.pl", data=bridge.SOURCE)
-                janus.consult(f"/neurosym/{fact_reader.MODULE}.pl", data=fact_reader.SOURCE)
-                _bridge_loaded = True
-    return janus
+    """janus with the bridge module and the fact reader loaded (once per process)."""
+    return janus_with(bridge, fact_reader)
 
 
 def _call_once(goal: str, inputs: dict[str, Any]) -> dict[str, Any]:

@@ -20,6 +20,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -116,3 +117,20 @@ def import_janus() -> ModuleType:
             f"janus-swi is not installed ({exc}); run `make setup`, which builds it against {find_swipl().executable}"
         ) from exc
     return janus_swi
+
+
+_consulted: set[str] = set()
+_consult_lock = threading.Lock()
+
+
+def janus_with(*modules: ModuleType) -> ModuleType:
+    """janus with each embedded Prolog module (a Python module holding its ``MODULE`` name and
+    ``SOURCE`` text) consulted, in order, once per process."""
+    janus = import_janus()
+    if any(m.MODULE not in _consulted for m in modules):
+        with _consult_lock:
+            for m in modules:
+                if m.MODULE not in _consulted:
+                    janus.consult(f"/neurosym/{m.MODULE}.pl", data=m.SOURCE)
+                    _consulted.add(m.MODULE)
+    return janus
