@@ -35,6 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from neurosym.agent.evaluation import play_scored  # noqa: E402
+from neurosym.cli import parse_env_options  # noqa: E402
 from neurosym.play import PrologAgent  # noqa: E402
 
 EXAMPLES = [
@@ -45,14 +46,6 @@ EXAMPLES = [
 
 def emit(**fields: Any) -> None:
     print(json.dumps(fields), flush=True)
-
-
-def options(text: list[str]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for item in text:
-        key, _, value = item.partition("=")
-        out[key] = int(value) if value.isdigit() else value
-    return out
 
 
 def play_once(policy: Path, env: str, episodes: int, seed: int, kwargs: dict) -> dict[str, Any]:
@@ -118,7 +111,7 @@ def main() -> None:
         python=platform.python_version(),
     )
     runs = [(args.policy, args.env)] if args.policy else EXAMPLES
-    kwargs = options(args.env_option)
+    kwargs = parse_env_options(args.env_option, args.env)
     for policy, env in runs:
         results = [
             play_once(policy, env, args.episodes, args.seed, kwargs) for _ in range(args.repeat)

@@ -37,10 +37,10 @@ def select_actions(
 def outcome_of(venv: Any, info: dict[str, Any], i: int, truncated: bool) -> str:
     """Outcome name of sub-env i's episode that ended on this step."""
     quick = getattr(venv, "episode_outcome", None)  # the outcome alone: no objects decoded
-    decode = getattr(venv, "decode_info", None)
     if quick is not None:
         outcome = quick(info, i)
     else:
+        decode = getattr(venv, "decode_info", None)
         outcome = decode(info, i).get("outcome") if decode is not None else None
     return str(outcome) if outcome else ("timeout" if truncated else "terminal")
 

@@ -255,7 +255,7 @@ class RGWVectorEnv(VectorEnv):
             "holding": ("sword",) if info["holding"][i] else (),
             "objects": objects.with_agent(pos, int(info["removed"][i])),
             "events": rules.EVENT_TUPLES[int(info["events"][i])],
-            "outcome": rules.outcome_name(int(info["events"][i]), bool(info["truncated"][i])),
+            "outcome": self.episode_outcome(info, i),
             **LevelInfo(*(info[k] for k in LEVEL_KEYS)).row(i),
         }
 
