@@ -60,6 +60,7 @@ bench: setup
 	$(PY) bench/train.py
 	$(PY) bench/extract.py
 	$(PY) bench/meaning.py
+	$(PY) bench/structure.py
 
 lint: setup
 	$(PY) -m ruff check neurosym tests bench examples experiments scripts
