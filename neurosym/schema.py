@@ -1,0 +1,175 @@
+"""The knowledge bases' fact schema, declared once.
+
+Every predicate a neurosym KB holds is one :class:`Predicate`: its name, its
+arguments (the table column each comes from, the name rules and docs call it,
+and its kind), one line of meaning, and the commands that write it. The fact
+tables, the writers' ``:- dynamic`` lines and ``%!`` header lines, and the
+schema tables of docs/design.md are made from these declarations.
+
+A new predicate is one declaration here plus the code that fills its table
+(docs/design.md, "Facts", says where).
+
+Argument kinds: ``int``, ``float``, ``atom`` (a plain name), ``term`` (Prolog
+term text such as ``key(red)``, written as a term, not a quoted atom) and
+``value`` (any of these, per row).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+KINDS = ("int", "float", "atom", "term", "value")
+
+
+@dataclass(frozen=True)
+class Arg:
+    """One argument: the table column it is read from, its name in rules and docs, its kind."""
+
+    column: str
+    name: str
+    kind: str
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"argument {self.column}: unknown kind {self.kind!r}")
+
+
+@dataclass(frozen=True)
+class Predicate:
+    """One KB predicate: ``name(args...)``, what it means, which group of KBs and commands hold it."""
+
+    name: str
+    args: tuple[Arg, ...]
+    meaning: str
+    group: str
+    """``trace`` (extract's KBs; intervene's hold the behavioural part), ``probe``, ``experiment``"""
+    writers: tuple[str, ...]
+
+    @property
+    def arity(self) -> int:
+        return len(self.args)
+
+    @property
+    def indicator(self) -> str:
+        return f"{self.name}/{self.arity}"
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        return tuple(a.column for a in self.args)
+
+    @property
+    def term_columns(self) -> tuple[str, ...]:
+        return tuple(a.column for a in self.args if a.kind == "term")
+
+    @property
+    def head(self) -> str:
+        """``name(Arg, ...)`` as rules and docs write it."""
+        return f"{self.name}({', '.join(a.name for a in self.args)})"
+
+
+def _p(name: str, args: str, meaning: str, group: str, writers: str) -> Predicate:
+    """A declaration from ``column:Name:kind`` words (``column:kind`` when Name is the column)."""
+    parsed = []
+    for word in args.split():
+        parts = word.split(":")
+        column, kind = parts[0], parts[-1]
+        parsed.append(Arg(column, parts[1] if len(parts) == 3 else column.capitalize(), kind))
+    return Predicate(name, tuple(parsed), meaning, group, tuple(writers.split()))
+
+
+TRACE, PROBE, EXPERIMENT = "trace", "probe", "experiment"
+
+SCHEMA: dict[str, Predicate] = {
+    p.name: p
+    for p in (
+        _p("kb_meta", "key:atom value:value",
+           "what the KB recorded: checkpoint, env, env options, module, heads, relations, "
+           "seed, actions (`agent` or `random`), created, version, threshold",
+           TRACE, "extract probe intervene"),
+        _p("object", "id:Id:atom type:term", "every named object of the recorded maps",
+           TRACE, "extract intervene"),
+        _p("episode", "episode:E:int steps:int return:float outcome:atom",
+           "Outcome: `terminal`, `pit`, `enemy`, `timeout`, `gem`, `distractor`",
+           TRACE, "extract intervene"),
+        _p("grid", "episode:E:int rows:int cols:int",
+           "the size of episode E's map (the entity grid's shape)", TRACE, "extract intervene"),
+        _p("terrain", "episode:E:int type:term row:int col:int",
+           "every non-empty cell of E's map after the reset that holds no object and is not "
+           "the agent (RGW `wall`, `mountain`; Box-World `wall`); terrain never changes within "
+           "an episode", TRACE, "extract intervene"),
+        _p("step", "episode:E:int t:T:int action:atom reward:float",
+           "the action taken in state T (`up, right, down, left`) and its reward",
+           TRACE, "extract intervene"),
+        _p("at", "episode:E:int t:T:int id:Id:atom row:int col:int",
+           "where object Id is in state T (T in 0..S)", TRACE, "extract intervene"),
+        _p("holding", "episode:E:int t:T:int item:term",
+           "what the agent holds in state T (`sword`, `key(red)`)", TRACE, "extract intervene"),
+        _p("event", "episode:E:int t:T:int event:term",
+           "an event of the step from state T to T+1 (`picked(sword)`, `defeated(enemy)`, "
+           "`opened(lock(red))`, ...)", TRACE, "extract intervene"),
+        _p("attends",
+           "episode:E:int t:T:int head:int arg:int entity:term row:int col:int weight:float",
+           "PrediNet: Arg 1 or 2, the argmax cell of a1 or a2, the entity there and its weight",
+           TRACE, "extract"),
+        _p("relation", "episode:E:int t:T:int head:int j:J:int a:A:term b:B:term value:float",
+           "PrediNet: D^h_j between the two attended entities A (arg 1) and B (arg 2)",
+           TRACE, "extract"),
+        _p("holds", "episode:E:int t:T:int j:r(J):term a:A:term b:B:term",
+           "relation J's value had |value| above `threshold(J, _)`, oriented so that it is "
+           "positive", TRACE, "extract"),
+        _p("threshold", "j:J:int value:float", "the threshold used for relation J",
+           TRACE, "extract"),
+        _p("attention", "episode:E:int t:T:int head:int query:term key:term weight:float",
+           "MHDPA: each query cell's strongest key (`--top-keys N`: N of them)",
+           TRACE, "extract"),
+        _p("probe", "head:int j:J:value predicate:term accuracy:float control:float",
+           "held-out accuracy and control accuracy", PROBE, "probe"),
+        _p("probe_untrained", "head:int j:J:value predicate:term accuracy:float control:float",
+           "the same on an untrained network of the same shape", PROBE, "probe"),
+        _p("probe_skipped", "predicate:term reason:atom",
+           "predicates constant on the recorded states", PROBE, "probe"),
+        _p("experiment", "x:X:atom kind:term detail:term",
+           "X `baseline` or e.g. `remove_sword`; Kind `baseline`, `remove(sword)`, "
+           "`remove(enemy)`, `move(enemy, R, C)`, `move(sword, R, C)`, `swap(sword, enemy)`, "
+           "`ablate(head(H))`, `ablate(heads)`; Detail what was changed (the cells, or "
+           "`every_level(Edit)` on rgw-random)", EXPERIMENT, "intervene"),
+        _p("experiment_episode", "x:X:atom episode:E:int", "episode E belongs to experiment X",
+           EXPERIMENT, "intervene"),
+        _p("experiment_skipped", "kind:term reason:atom",
+           "an experiment that does not apply (moving an object on procedural levels)",
+           EXPERIMENT, "intervene"),
+        _p("measure", "experiment:X:atom measure:term value:float",
+           "Measure `return`, `success`, `steps`, `sword_picked`, `sword_before_enemy`, "
+           "`enemy_met`, `enemy_unarmed`, `enemy_defeated` (means over X's episodes; RGW)",
+           EXPERIMENT, "intervene"),
+        _p("effect", "experiment:X:atom measure:term value:Change:float",
+           "the measure's change against the baseline, and at the baseline's own states `kl` "
+           "(of the action distributions), `relation_shift(H, J)` (PrediNet: mean absolute "
+           "change of D^h_j) or `head_shift(H)` (MHDPA)", EXPERIMENT, "intervene"),
+        _p("relates", "head:int a:A:term b:B:term share:float",
+           "the share of baseline states on which Head relates A to B", EXPERIMENT, "intervene"),
+    )
+}
+
+
+def group(name: str) -> list[Predicate]:
+    """The predicates of one group, in declaration order."""
+    return [p for p in SCHEMA.values() if p.group == name]
+
+
+def indicators(names: Iterable[str]) -> list[str]:
+    """``name/arity`` of the named predicates (for ``:- dynamic``)."""
+    return [SCHEMA[n].indicator for n in names]
+
+
+def header_lines(names: Iterable[str]) -> list[str]:
+    """PlDoc-style ``%!`` lines naming each predicate's arguments, for a KB's header."""
+    return [f"%!  {SCHEMA[n].head}: {SCHEMA[n].meaning}" for n in names]
+
+
+def markdown_table(name: str) -> str:
+    """The schema table of one group, as docs/design.md shows it."""
+    rows = ["| fact | arguments |", "| --- | --- |"]
+    rows += [f"| `{p.head}` | {p.meaning} |" for p in group(name)]
+    return "\n".join(rows)
