@@ -84,7 +84,7 @@ SCHEMA: dict[str, Predicate] = {
     p.name: p
     for p in (
         _p("kb_meta", "key:atom value:value",
-           "what the KB recorded: checkpoint, env, env options, module, heads, relations, "
+           "checkpoint, env, module, heads, relations, "
            "seed, actions (`agent` or `random`), created, version, threshold",
            TRACE, "extract probe intervene"),
         _p("object", "id:Id:atom type:term", "every named object of the recorded maps",
