@@ -325,7 +325,7 @@ def test_old_swipl_on_path_is_not_used(tmp_path: Path, monkeypatch, fresh_locate
     monkeypatch.setattr(sys, "prefix", str(tmp_path / "empty-venv"))
     old = _fake_swipl(tmp_path / "bin", 90004)
     monkeypatch.setenv("PATH", str(old.parent))
-    with pytest.raises(NeurosymError, match=r"swipl on PATH .* is version 9\.0\.4; .*make setup"):
+    with pytest.raises(NeurosymError, match=r"swipl on PATH .* is version 9\.0\.4; .*neurosym setup-prolog"):
         fresh_locate.find_swipl()
 
 
