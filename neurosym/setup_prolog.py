@@ -29,7 +29,7 @@ import sys
 from pathlib import Path
 
 from neurosym.errors import NeurosymError
-from neurosym.prolog.locate import ENV_VAR, SwiProlog, check_swipl, find_swipl
+from neurosym.prolog.locate import ENV_VAR, SETUP_HINT, SwiProlog, check_swipl, find_swipl
 
 JANUS_REQUIREMENT = "janus-swi>=1.5.3"
 """what pip installs; pyproject.toml's ``prolog`` extra names the same (tests/test_wheel.py)"""
@@ -78,8 +78,9 @@ def choose_swipl(explicit: str | None, prefix: Path) -> tuple[SwiProlog, str]:
         return find_swipl(), ENV_VAR  # a bad NEUROSYM_SWIPL is the user's to fix: one line
     try:
         return find_swipl(), "found"
-    except NeurosymError as exc:
-        print(f"{exc}; building SWI-Prolog into {prefix / 'swipl'}", flush=True)
+    except NeurosymError as exc:  # what was found, without the advice to run this command
+        found = str(exc).partition(SETUP_HINT)[0].rstrip(": ")
+        print(f"{found}: building SWI-Prolog into {prefix / 'swipl'}", flush=True)
     built = build_swipl(prefix)
     find_swipl.cache_clear()
     return check_swipl(built, f"the swipl built into {prefix / 'swipl'}"), "built"
