@@ -56,10 +56,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     prefix = Path(sys.prefix)
-    if not os.access(prefix / "bin", os.W_OK):
+    own = sys.prefix != sys.base_prefix or os.environ.get("CONDA_PREFIX") == sys.prefix
+    if not own or not os.access(prefix / "bin", os.W_OK):  # never the system's /usr/bin
         raise NeurosymError(
-            f"cannot write to {prefix / 'bin'}: run it in a virtual environment "
-            "(python3 -m venv .venv && . .venv/bin/activate)"
+            f"{sys.executable} is not a virtual environment's Python that may write to "
+            f"{prefix / 'bin'}: run it in one (python3 -m venv .venv && . .venv/bin/activate)"
         )
     swipl, how = choose_swipl(args.swipl, prefix)
     print(f"SWI-Prolog {swipl.version_text}: {swipl.executable} ({how})", flush=True)
@@ -91,7 +92,7 @@ def build_swipl(prefix: Path) -> Path:
     script = importlib.resources.files("neurosym") / "setup_swipl.sh"
     with importlib.resources.as_file(script) as path:
         proc = subprocess.run(["bash", str(path), str(prefix)], stdout=subprocess.PIPE, text=True)
-    lines = proc.stdout.split()
+    lines = proc.stdout.splitlines()
     if proc.returncode != 0 or not lines:
         raise NeurosymError(
             f"building SWI-Prolog into {prefix / 'swipl'} failed (its messages are above); "

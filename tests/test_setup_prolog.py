@@ -4,6 +4,7 @@ tests/test_wheel.py runs the command in a fresh venv."""
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 from pathlib import Path
@@ -84,3 +85,12 @@ def test_the_venv_link_points_at_the_prolog_and_is_replaced_whole(
         NeurosymError, match=r"^.*/bin/swipl is another program, not a link; remove"
     ):
         setup_prolog.link_swipl(bare_prefix, other)
+
+
+def test_it_writes_into_a_virtual_environment_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(sys, "base_prefix", sys.prefix)  # the system's Python, as pip --user has
+    monkeypatch.delenv("CONDA_PREFIX", raising=False)
+    with pytest.raises(
+        NeurosymError, match=r"is not a virtual environment's Python that may write"
+    ):
+        setup_prolog.run(argparse.Namespace(swipl=None))
