@@ -68,10 +68,11 @@ def _fresh_venv(root: Path, wheel: Path, janus: bool) -> Path:
                        check=True, capture_output=True, text=True).stdout.strip()
     )  # fmt: skip
     (site / "reuse-dependencies.pth").write_text("\n".join(lines) + "\n")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}  # no other neurosym's
     proc = subprocess.run(
         [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-index",
          str(wheel)],
-        capture_output=True, text=True, timeout=300,
+        capture_output=True, text=True, timeout=300, env=env,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     return env_dir
