@@ -1,6 +1,6 @@
 # neurosym: `make test` and `make demo` set everything up on a fresh machine
-# (virtual environment, torch CPU build, SWI-Prolog >= 9.1.12, janus-swi) and
-# are quick once it is there.
+# (virtual environment, torch CPU build, neurosym, then `neurosym setup-prolog`: SWI-Prolog
+# >= 9.1.12 and janus-swi) and are quick once it is there.
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.neurosym-setup
@@ -12,16 +12,16 @@ export PYTHONHASHSEED := 0
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml setup.py scripts/setup_swipl.sh Makefile
+$(STAMP): pyproject.toml setup.py neurosym/setup_swipl.sh neurosym/setup_prolog.py Makefile
 	@test -x $(PY) || python3 -m venv $(VENV)
 	@# torch first, pinned, so that the package's range never pulls the CUDA wheels.
 	@$(PY) -m pip show torch >/dev/null 2>&1 || $(PY) -m pip install -q "$(TORCH_SPEC)"
-	@bash scripts/setup_swipl.sh $(VENV) > $(SWIPL_PATH_FILE).tmp && mv $(SWIPL_PATH_FILE).tmp $(SWIPL_PATH_FILE)
-	@# janus-swi compiles against the swipl found on PATH: put ours first, and never
-	@# reuse a cached wheel (it would link the libswipl of another checkout).
-	@$(PY) -c "import janus_swi" 2>/dev/null || \
-	  PATH="$$(dirname "$$(cat $(SWIPL_PATH_FILE))"):$$PATH" $(PY) -m pip install -q --no-cache-dir --no-binary janus-swi "janus-swi>=1.5.3"
 	@$(PY) -m pip install -q -e ".[dev]"
+	@# The pip route's own step: SWI-Prolog >= 9.1.12 (found, or built into $(VENV)/swipl),
+	@# linked as $(VENV)/bin/swipl, and janus-swi built against it.
+	@$(VENV)/bin/neurosym setup-prolog
+	@$(PY) -c "from neurosym.prolog.locate import swipl_executable; print(swipl_executable())" > $(SWIPL_PATH_FILE).tmp
+	@mv $(SWIPL_PATH_FILE).tmp $(SWIPL_PATH_FILE)
 	@touch $@
 	@echo "neurosym: set up in $(VENV) (swipl: $$(cat $(SWIPL_PATH_FILE)))"
 

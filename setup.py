@@ -16,6 +16,7 @@ setup(
     ],
     package_dir={"neurosym.rules": "rules", "neurosym.checkpoints": "checkpoints"},
     package_data={
+        "neurosym": ["setup_swipl.sh"],  # `neurosym setup-prolog` builds SWI-Prolog with it
         "neurosym.envs": ["maps/*.txt"],
         "neurosym.webreport": ["templates/*"],
         "neurosym.rules": ["*.pl"],

@@ -1,4 +1,4 @@
-"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | induce | play | plot | report | envs | agents.
+"""The `neurosym` command: train | eval | compact | extract | probe | intervene | query | induce | play | plot | report | envs | agents | setup-prolog.
 
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
@@ -219,6 +219,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "agents": (
         "neurosym.cli_agents",
         "List the shipped agents: env, module, learner, held-out success, what each is for.",
+    ),
+    "setup-prolog": (
+        "neurosym.setup_prolog",
+        "Find or build SWI-Prolog >= 9.1.12, link it into the venv, build janus-swi against it.",
     ),
 }
 

@@ -5,8 +5,11 @@ janus can pick up the wrong home and die with "incompatible VM-signature", so
 neurosym decides which Prolog to use, in this order:
 
 1. ``NEUROSYM_SWIPL``: the path of a ``swipl`` binary (must be >= 9.1.12);
-2. ``<sys.prefix>/swipl/bin/swipl``: the one ``make setup`` builds into the venv;
+2. ``<sys.prefix>/bin/swipl``: the link ``neurosym setup-prolog`` puts into the venv, then
+   ``<sys.prefix>/swipl/bin/swipl``: the Prolog it builds there when none is found;
 3. ``swipl`` on ``PATH``, when it is >= 9.1.12.
+
+Without one, or without janus-swi, the one-line error says to run ``neurosym setup-prolog``.
 
 :func:`import_janus` sets ``SWI_HOME_DIR`` to that Prolog's home before the
 first ``import janus_swi``; every neurosym module gets janus from there.
@@ -64,26 +67,35 @@ def _probe(executable: Path) -> SwiProlog | None:
         return None
 
 
+SETUP_HINT = "run `neurosym setup-prolog`"
+"""what every "no Prolog" and "no janus" error tells the user to run"""
+
+
+def check_swipl(executable: Path, name: str) -> SwiProlog:
+    """The SWI-Prolog at ``executable``, which the user named as ``name`` (``NEUROSYM_SWIPL=...``,
+    ``--swipl ...``); a one-line NeurosymError when it does not run or is older than 9.1.12."""
+    found = _probe(executable)
+    if found is None:
+        raise NeurosymError(
+            f"{name} is not a runnable swipl; point it at a SWI-Prolog >= 9.1.12 binary"
+        )
+    if found.version < MIN_VERSION:
+        raise NeurosymError(f"{name} is SWI-Prolog {found.version_text}; janus-swi needs >= 9.1.12")
+    return found
+
+
 @functools.cache
 def find_swipl() -> SwiProlog:
     """Locate the SWI-Prolog neurosym uses (see the module docstring for the order)."""
     explicit = os.environ.get(ENV_VAR)
     if explicit:
-        found = _probe(Path(explicit))
-        if found is None:
-            raise NeurosymError(
-                f"{ENV_VAR}={explicit} is not a runnable swipl; point it at a SWI-Prolog >= 9.1.12 binary"
-            )
-        if found.version < MIN_VERSION:
-            raise NeurosymError(
-                f"{ENV_VAR}={explicit} is SWI-Prolog {found.version_text}; janus-swi needs >= 9.1.12"
-            )
-        return found
-    venv_swipl = Path(sys.prefix) / "swipl" / "bin" / "swipl"
-    if venv_swipl.is_file():
-        found = _probe(venv_swipl)
-        if found is not None and found.version >= MIN_VERSION:
-            return found
+        return check_swipl(Path(explicit), f"{ENV_VAR}={explicit}")
+    prefix = Path(sys.prefix)
+    for venv_swipl in (prefix / "bin" / "swipl", prefix / "swipl" / "bin" / "swipl"):
+        if venv_swipl.is_file():
+            found = _probe(venv_swipl)
+            if found is not None and found.version >= MIN_VERSION:
+                return found
     on_path = shutil.which("swipl")
     if on_path:
         found = _probe(Path(on_path))
@@ -92,10 +104,10 @@ def find_swipl() -> SwiProlog:
         version = found.version_text if found else "unknown"
         raise NeurosymError(
             f"swipl on PATH ({on_path}) is version {version}; neurosym needs SWI-Prolog >= 9.1.12: "
-            f"run `make setup` (builds one into the venv) or set {ENV_VAR}"
+            f"{SETUP_HINT} (builds one into the venv) or set {ENV_VAR}"
         )
     raise NeurosymError(
-        f"no SWI-Prolog found: run `make setup` (builds one into the venv) or set {ENV_VAR} to a swipl >= 9.1.12"
+        f"no SWI-Prolog found: {SETUP_HINT} (builds one into the venv) or set {ENV_VAR} to a swipl >= 9.1.12"
     )
 
 
@@ -114,7 +126,8 @@ def import_janus() -> ModuleType:
         import janus_swi
     except ImportError as exc:
         raise NeurosymError(
-            f"janus-swi is not installed ({exc}); run `make setup`, which builds it against {find_swipl().executable}"
+            f"janus-swi is not installed ({exc}): {SETUP_HINT}, which builds it against "
+            f"{find_swipl().executable}"
         ) from exc
     return janus_swi
 

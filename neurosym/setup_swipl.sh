@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Make sure a SWI-Prolog >= 9.1.12 (what janus-swi needs) is available to the
 # virtual environment given as $1, and print the path of its `swipl` binary.
+# `neurosym setup-prolog` runs it (the wheel ships it) when it finds no such Prolog.
 #
 # 1. A `swipl` on PATH that is new enough is used as it is.
 # 2. Otherwise SWI-Prolog 9.2.9 is built from the Debian source tarball into
