@@ -87,6 +87,7 @@ def test_report_shows_data_as_text(
 ) -> None:
     """Markup, hyperlinks and escape codes from a recording print as the characters they are."""
     rec = scripted_recording()
+    rec = Recording(**rec.tables, meta=rec.meta)  # a copy: the fixture is shared
     link = "[link=https://evil.example]click[/link]"
     rec.meta["checkpoint"] = link + "\x1b[31m"
     rec.meta["seed"] = "[bold]7[/bold]"

@@ -16,6 +16,7 @@ import pytest
 from test_recorder_scripted import explorer_recording, scripted_recording
 
 from neurosym.export.facts import FactSet, extract_facts
+from neurosym.export.recording import Recording
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.terms import Term
 
@@ -211,6 +212,7 @@ def test_kb_meta_names_the_env_options(tmp_path: Path, run_neurosym) -> None:  #
     """The options the env was made with (the checkpoint's and --env-option's) are in kb_meta,
     after the other keys, and read back through the fact reader and `neurosym query`."""
     rec = scripted_recording()
+    rec = Recording(**rec.tables, meta=rec.meta)  # a copy: the fixture is shared
     rec.meta["env_kwargs"] = {"num_mountains": 12, "map": "my map.txt", "max_steps": None,
                               "classic": False, "scale": 0.5}  # fmt: skip
     facts = extract_facts(rec)
