@@ -47,19 +47,13 @@ def rules_dir() -> Path | None:
     return shipped_rules()
 
 
+_WITH_DISTRACTOR = (
+    "episode(E, _, _, _), once(distractor_box(E, _, _))",
+    "episodes with a distractor",
+    "no distractor on these levels",
+)
 SCOPES: dict[str, dict[str, tuple[str, str, str]]] = {
-    "boxworld": {
-        "distractor taken": (
-            "episode(E, _, _, _), once(distractor_box(E, _, _))",
-            "episodes with a distractor",
-            "no distractor on these levels",
-        ),
-        "distractor avoided": (
-            "episode(E, _, _, _), once(distractor_box(E, _, _))",
-            "episodes with a distractor",
-            "no distractor on these levels",
-        ),
-    },
+    "boxworld": {"distractor taken": _WITH_DISTRACTOR, "distractor avoided": _WITH_DISTRACTOR},
 }
 """family -> title -> (goal over E naming the episodes the question is about, what they
 are, what to say when there are none): questions that only some levels can answer"""
