@@ -183,8 +183,10 @@ class Recording:
         """Write one Parquet file per table and ``meta.json`` into ``directory``.
 
         Each file is written to a temporary name and renamed into place, so a
-        reader never sees a half-written table.
+        reader never sees a half-written table. A NaN or infinity is refused
+        first (:func:`check_finite`): :meth:`load` would refuse the recording.
         """
+        check_finite(self.tables)
         out = make_folder(directory)
         for name, df in self.tables.items():
             atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))

@@ -200,14 +200,18 @@ def test_load_refuses_numbers_that_are_not_finite(
     rec = small_recording()
     df = getattr(rec, table).copy()
     df.loc[len(df) - 1, column] = value
-    Recording(**{**rec.tables, table: df}, meta=rec.meta).save(tmp_path / "rec")
+    rec.save(tmp_path / "rec")
+    df.to_parquet(tmp_path / "rec" / f"{table}.parquet")
+    message = (
+        f"recording table {table!r} has {value!r} in column {column!r} (row {len(df) - 1}); "
+        "a recording holds finite numbers only (NaN and inf have no JSON or Prolog form)"
+    )
     with pytest.raises(ConfigError) as err:
         Recording.load(tmp_path / "rec")
-    assert str(err.value) == (
-        f"{tmp_path / 'rec'}: recording table {table!r} has {value!r} in column {column!r} "
-        f"(row {len(df) - 1}); a recording holds finite numbers only (NaN and inf have no JSON "
-        "or Prolog form)"
-    )
+    assert str(err.value) == f"{tmp_path / 'rec'}: {message}"
+    with pytest.raises(ConfigError) as err:  # nor is one written
+        Recording(**{**rec.tables, table: df}, meta=rec.meta).save(tmp_path / "bad")
+    assert str(err.value) == message and not (tmp_path / "bad").exists()
 
 
 @pytest.mark.parametrize("heads", ["four", 2.5, True, -1, 10**9])
