@@ -271,8 +271,8 @@ def _adopt(out: Path, old: Path, names: Iterable[str]) -> None:
     """
     for name in names:
         target = out / name
-        if target.is_symlink() or not target.is_file():
-            continue
+        if target.is_symlink() or not target.is_file() or (old / name).is_dir():
+            continue  # a folder there: removed after the rename, as before
         kept = old / f".adopt-{os.getpid()}-{name}"
         kept.unlink(missing_ok=True)
         _link_or_copy(target, kept)
