@@ -137,8 +137,9 @@ def publish(
 
     ``owned``: the names this command writes; one of them the run did not
     write (kb.qlf without --qlf) is dropped, so no product of an earlier run
-    stays beside the new ones. Other products of the previous run are
-    carried over. Default: the names written. Returns name -> path in ``out``.
+    stays beside the new ones; nor does one written into ``out`` as a
+    regular file by another command (:func:`_adopt`: removed by the same
+    rename that publishes). Other products of the previous run are carried over. Default: the names written. Returns name -> path in ``out``.
     ``folders`` and ``prefix`` are accepted from callers written for the
     older layout (a staging folder per run) and no longer needed.
     """
@@ -157,6 +158,7 @@ def publish(
             _check_names(out, run, produced)
             if previous is not None:
                 _carry(store / previous, run, mine)
+                _adopt(out, store / previous, mine - set(produced))
             _switch(store, run.name)  # the one rename that publishes the run
         except BaseException:
             shutil.rmtree(run, ignore_errors=True)
@@ -256,6 +258,29 @@ def _carry(old: Path, run: Path, mine: set[str]) -> None:
             shutil.copytree(entry, run / entry.name, symlinks=True, copy_function=_link_or_copy)
         else:
             _link_or_copy(entry, run / entry.name)
+
+
+def _adopt(out: Path, old: Path, names: Iterable[str]) -> None:
+    """Make each regular file ``out/NAME`` this run drops a link into ``current`` first.
+
+    Such a file was written into ``out`` outside :func:`publish` (the page
+    ``neurosym report --recording`` writes beside extract's products). Kept
+    in the previous run's folder and linked like a product, it still reads
+    the same until the rename that publishes the run, which removes it in
+    the same step: no reader sees it beside the new run's products.
+    """
+    for name in names:
+        target = out / name
+        if target.is_symlink() or not target.is_file() or (old / name).is_dir():
+            continue  # a folder there: removed after the rename, as before
+        kept = old / f".adopt-{os.getpid()}-{name}"
+        kept.unlink(missing_ok=True)
+        _link_or_copy(target, kept)
+        os.replace(kept, old / name)
+        link = out / STORE / f".link-{os.getpid()}-{name}"
+        link.unlink(missing_ok=True)
+        os.symlink(f"{STORE}/{CURRENT}/{name}", link)
+        os.replace(link, target)
 
 
 def _link_or_copy(src: str | Path, dst: str | Path) -> None:

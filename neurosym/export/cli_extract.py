@@ -16,7 +16,8 @@ by one rename (:mod:`neurosym.publish`), so a failed or killed run writes
 nothing, a reader never sees half a KB or a KB beside another run's
 recording, and a second run into the same ``--out`` is refused while one
 is writing. A product the run does not make (``kb.qlf`` without ``--qlf``)
-is removed with the previous run's others. A checkpoint that cannot be read, or that cannot play
+is removed with the previous run's others, and so is a page ``neurosym report``
+wrote into ``--out`` (``index.html``: it describes the previous run). A checkpoint that cannot be read, or that cannot play
 ``--env`` (another env family or observation shape), is refused before
 anything is recorded; any env of its family with its shape is fine.
 """
@@ -34,6 +35,12 @@ from neurosym.seeds import check_seed
 FORMATS = ("pl", "parquet")
 PRODUCTS = ("kb.pl", "kb.qlf", "kb.qlf.sig", "facts", "recording")
 """what an extract run writes into --out; one run's set replaces the previous run's"""
+
+REPORT_PAGE = "index.html"
+"""the page ``neurosym report`` writes into --out: it describes the run it was built from, so
+a new run removes it in the step that publishes the new products"""
+
+_PAGE_MARK = b"<title>neurosym report: "
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -184,4 +191,24 @@ def write_outputs(
             facts.to_parquet(stage / "facts")
         rec.save(stage / "recording")
 
-    return publish(out, write, owned=PRODUCTS)
+    stale = (REPORT_PAGE,) if is_report_page(out / REPORT_PAGE) else ()
+    return publish(out, write, owned=PRODUCTS + stale)
+
+
+def is_report_page(path: Path) -> bool:
+    """Whether ``path`` is a page ``neurosym report`` wrote: its published link, or a regular
+    file whose head has the page's title (another tool's index.html is left alone)."""
+    import os
+
+    from neurosym.atomic import file_kind
+    from neurosym.publish import CURRENT, STORE
+
+    if path.is_symlink():
+        return os.readlink(path) == f"{STORE}/{CURRENT}/{path.name}"
+    if file_kind(path) is not None or not path.is_file():
+        return False
+    try:
+        with open(path, "rb") as page:
+            return _PAGE_MARK in page.read(4096)
+    except OSError:
+        return False

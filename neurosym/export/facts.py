@@ -21,7 +21,10 @@ Choices the schema leaves open, fixed here:
   (sword, enemy) becomes ``holds(E, T, r(J), enemy, sword)``. Heads that attend the
   same oriented pair at one step give one fact (holds/5 has no head argument).
 * The ``holds`` table keeps J as an int column ``j``; it is written as ``r(J)``.
-* ``kb_meta`` has the recording's meta keys plus ``threshold`` (the spec used).
+* ``kb_meta`` has the recording's meta keys plus ``threshold`` (the spec used), then
+  one ``kb_meta(env_option(Name), Value)`` per option the env was made with
+  (``kb_meta(env_option(num_mountains), 12)``; ``none`` for None), so a KB says
+  which levels it recorded.
 * Entity, event, item and type columns hold Prolog text (``key(red)``,
   ``picked(sword)``) and are written as terms; everything else textual is an atom.
 """
@@ -29,6 +32,7 @@ Choices the schema leaves open, fixed here:
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -42,6 +46,7 @@ from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 from neurosym.export.recording import META_KEYS, Recording
 from neurosym.export.thresholds import Threshold, parse_threshold
+from neurosym.terms import Term
 
 # predicate -> argument columns, in argument order.
 PREDICATES: dict[str, tuple[str, ...]] = {
@@ -222,8 +227,8 @@ class FactSet:
         """Write one Parquet file per predicate and ``meta.json``, each file atomically."""
         out = make_folder(directory)
         for name, df in self.tables.items():
-            if name == "kb_meta":  # atoms and numbers: Parquet needs one type per column
-                df = df.assign(value=df["value"].map(str))
+            if name == "kb_meta":  # atoms, terms and numbers: Parquet needs one type per column
+                df = df.assign(key=df["key"].map(str), value=df["value"].map(str))
             atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
         text = (
             json.dumps({"meta": self.meta, "threshold": str(self.threshold)}, indent=2, default=str)
@@ -268,11 +273,30 @@ def _objects(positions: pd.DataFrame) -> pd.DataFrame:
 
 
 def _meta_table(meta: Mapping[str, Any], threshold: Threshold) -> pd.DataFrame:
-    keys: list[str] = [k for k in META_KEYS if k in meta and meta[k] is not None]
+    keys: list[str | Term] = [k for k in META_KEYS if k in meta and meta[k] is not None]
     values: list[Any] = [meta[k] for k in keys]
     keys.append("threshold")
     values.append(str(threshold))
-    return pd.DataFrame({"key": keys, "value": pd.Series(values, dtype=object)})
+    options = meta.get("env_kwargs")
+    if isinstance(options, Mapping):
+        for name in sorted(options, key=str):
+            keys.append(Term("env_option", (str(name),)))
+            values.append(option_value(options[name]))
+    return pd.DataFrame(
+        {"key": pd.Series(keys, dtype=object), "value": pd.Series(values, dtype=object)}
+    )
+
+
+def option_value(value: Any) -> str | int | float:
+    """An env option's value as kb_meta/2 holds it: numbers as they are, None as ``none``,
+    ``true``/``false`` for booleans, anything else (a map path) as the atom of its text."""
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int) or (isinstance(value, float) and math.isfinite(value)):
+        return value
+    return os.fspath(value) if isinstance(value, os.PathLike) else str(value)
 
 
 def holds_table(relations: pd.DataFrame, threshold: Threshold, per_j: pd.Series) -> pd.DataFrame:

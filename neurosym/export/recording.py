@@ -21,9 +21,10 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
-from neurosym.atomic import atomic_write, make_folder
+from neurosym.atomic import atomic_write, file_kind, make_folder
 from neurosym.errors import ConfigError
 
 # table -> ordered (column, dtype); "str" columns hold Prolog text (atoms or terms).
@@ -94,6 +95,9 @@ META_KEYS = (
 
 OPTIONAL_TABLES = ("terrain", "grids")
 """tables that recordings of older versions lack: they load as empty tables"""
+
+MAX_COUNT = 4096
+"""the most heads or relations a recording's meta may give (they size the tables readers draw)"""
 
 _FORMAT = "neurosym-recording"
 _FORMAT_VERSION = 1
@@ -179,8 +183,10 @@ class Recording:
         """Write one Parquet file per table and ``meta.json`` into ``directory``.
 
         Each file is written to a temporary name and renamed into place, so a
-        reader never sees a half-written table.
+        reader never sees a half-written table. A NaN or infinity is refused
+        first (:func:`check_finite`): :meth:`load` would refuse the recording.
         """
+        check_finite(self.tables)
         out = make_folder(directory)
         for name, df in self.tables.items():
             atomic_write(out / f"{name}.parquet", lambda p, df=df: df.to_parquet(p, index=False))
@@ -191,42 +197,37 @@ class Recording:
 
     @classmethod
     def load(cls, directory: str | os.PathLike[str]) -> Recording:
-        """Read a recording written by :meth:`save`; ConfigError if it is not one.
+        """Read a recording written by :meth:`save`; ConfigError (one line) if it is not one.
 
         A folder published by ``neurosym extract`` is a link that the next run
         re-points; it is resolved once, so every table comes from the same run.
+        Refused, naming what is wrong: a table file that is missing or not a
+        regular file, a non-finite number (NaN or inf: JSON, the page's data,
+        and Prolog facts have none), ``heads`` or ``relations`` in meta.json
+        that are not whole numbers within :data:`MAX_COUNT`.
         """
         src = Path(directory)
         meta_path = src.resolve() / "meta.json"
-        try:
-            head = json.loads(meta_path.read_text())
-        except (OSError, ValueError) as exc:
-            raise ConfigError(
-                f"{src} is not a neurosym recording (cannot read {meta_path.name}: {exc})"
-            ) from None
-        if not isinstance(head, dict) or head.get("format") != _FORMAT:
-            raise ConfigError(
-                f"{src} is not a neurosym recording ({meta_path.name} has no format tag {_FORMAT!r})"
-            )
-        tables: dict[str, pd.DataFrame] = {}
-        for name in SCHEMA:
-            path = meta_path.parent / f"{name}.parquet"
-            if name in OPTIONAL_TABLES and not path.exists():
-                tables[name] = empty_table(name)
-                continue
-            try:
-                tables[name] = pd.read_parquet(path)
-            except (OSError, ValueError) as exc:
-                raise ConfigError(f"cannot read {src / path.name}: {exc}") from None
+        head = _read_meta(src, meta_path)
         meta = head.get("meta", {})
         if not isinstance(meta, dict):
             raise ConfigError(
                 f"{src} is not a neurosym recording (its meta.json 'meta' is not an object)"
             )
+        check_meta(meta, f"{src}/meta.json")
+        tables: dict[str, pd.DataFrame] = {}
+        for name in SCHEMA:
+            path = meta_path.parent / f"{name}.parquet"
+            if name in OPTIONAL_TABLES and not os.path.lexists(path):
+                tables[name] = empty_table(name)
+                continue
+            tables[name] = _read_table(src, path)
         try:
-            return cls(**tables, meta=meta)
+            rec = cls(**tables, meta=meta)
+            check_finite(rec.tables)
         except ConfigError as exc:
             raise ConfigError(f"{src}: {exc}") from None
+        return rec
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Recording):
@@ -238,3 +239,92 @@ class Recording:
             for f in fields(self)
             if f.name in SCHEMA
         )
+
+
+_WRITTEN_BY = "a recording folder written by `neurosym extract` (its recording/ folder, or --out)"
+
+
+def _read_meta(src: Path, meta_path: Path) -> dict[str, Any]:
+    """meta.json's object, checked to be a recording's; ConfigError naming what is wrong."""
+    kind = file_kind(meta_path)
+    if kind is not None:
+        raise ConfigError(
+            f"{src} is not a neurosym recording: its meta.json is {kind}, not a regular file; "
+            f"pass {_WRITTEN_BY}"
+        )
+    if not meta_path.exists():
+        raise ConfigError(
+            f"{src} is not a neurosym recording: it has no meta.json; pass {_WRITTEN_BY}"
+        )
+    try:
+        head = json.loads(meta_path.read_text())
+    except (OSError, ValueError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise ConfigError(
+            f"{src} is not a neurosym recording (cannot read {meta_path.name}: {why})"
+        ) from None
+    if not isinstance(head, dict) or head.get("format") != _FORMAT:
+        raise ConfigError(
+            f"{src} is not a neurosym recording ({meta_path.name} has no format tag {_FORMAT!r})"
+        )
+    return head
+
+
+def _read_table(src: Path, path: Path) -> pd.DataFrame:
+    """One table's Parquet file; ConfigError saying what is wrong (missing, not a file, damaged)."""
+    shown = src / path.name
+    kind = file_kind(path)
+    if kind is not None:
+        raise ConfigError(
+            f"{shown} is {kind}, not a regular file: a recording holds each table as a Parquet "
+            f"file; pass {_WRITTEN_BY}"
+        )
+    if not path.exists():
+        raise ConfigError(
+            f"{src} is not a complete recording: its table {path.name} is missing; "
+            f"pass {_WRITTEN_BY}"
+        )
+    try:
+        return pd.read_parquet(path)
+    except (OSError, ValueError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise ConfigError(
+            f"cannot read {shown}: {why} (not a Parquet table written by neurosym)"
+        ) from None
+
+
+def check_meta(meta: dict[str, Any], where: str) -> None:
+    """Refuse ``heads`` or ``relations`` that are not whole numbers from 0 to MAX_COUNT.
+
+    Readers size their work by them (a range of heads to draw); ``where``
+    names the file they came from in the one-line ConfigError.
+    """
+    for key in ("heads", "relations"):
+        value = meta.get(key)
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_COUNT:
+            raise ConfigError(
+                f"{where} gives {key} {value!r}; expected a whole number from 0 to {MAX_COUNT} "
+                f"(the checkpoint's {key} count)"
+            )
+
+
+def check_finite(tables: dict[str, pd.DataFrame]) -> None:
+    """Refuse a NaN or infinity in any float column, naming the table, column and first row.
+
+    A recording's numbers come from the env and the network and are finite;
+    NaN/inf have no JSON (the report page's data) or Prolog fact spelling.
+    """
+    for name, df in tables.items():
+        for column, dtype in SCHEMA[name]:
+            if dtype != "float64" or df.empty:
+                continue
+            values = df[column].to_numpy()
+            bad = ~np.isfinite(values)
+            if bad.any():
+                row = int(np.flatnonzero(bad)[0])
+                raise ConfigError(
+                    f"recording table {name!r} has {float(values[row])!r} in column {column!r} (row {row}); "
+                    "a recording holds finite numbers only (NaN and inf have no JSON or Prolog form)"
+                )

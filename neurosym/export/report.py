@@ -9,6 +9,7 @@ what is printed is what a user gets by querying the file by hand.
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -46,8 +47,36 @@ def rules_dir() -> Path | None:
     return shipped_rules()
 
 
-def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]:
-    """(title, goal, answers as Prolog text) for the family's queries over the KB at ``kb_path``."""
+_WITH_DISTRACTOR = (
+    "episode(E, _, _, _), once(distractor_box(E, _, _))",
+    "episodes with a distractor",
+    "no distractor on these levels",
+)
+SCOPES: dict[str, dict[str, tuple[str, str, str]]] = {
+    "boxworld": {"distractor taken": _WITH_DISTRACTOR, "distractor avoided": _WITH_DISTRACTOR},
+}
+"""family -> title -> (goal over E naming the episodes the question is about, what they
+are, what to say when there are none): questions that only some levels can answer"""
+
+
+@dataclass
+class Answer:
+    """One question's answers, and what a count of them is out of."""
+
+    title: str
+    goal: str
+    values: list[str]
+    """the answers as Prolog text (visit orders: ``[sword,enemy] x3``, most common first)"""
+    of: int | None = None
+    """the episodes asked about (goals over episodes) or the distinct visit orders"""
+    unit: str = ""
+    """what ``of`` counts: ``episodes``, ``episodes with a distractor``, ``distinct orders``"""
+    empty: str | None = None
+    """said instead of a count when ``of`` is 0 (no distractor on these levels)"""
+
+
+def answers(kb_path: Path, family: str) -> list[Answer]:
+    """The family's questions answered over the KB at ``kb_path``, with what each counts."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
     folder = rules_dir()
@@ -57,49 +86,69 @@ def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]
     out = []
     kb = KnowledgeBase(kb_path, rules=rules)
     try:
+        episodes = kb.count("episode(_, _, _, _)")
+        scopes = SCOPES.get(family, {})
         for title, goal, var in QUERIES[family]:
             text_goal = f"{goal}, format(atom(Text__), '~q', [{var}])"
-            answers = [str(row["Text__"]) for row in kb.query(text_goal)]
-            out.append((title, goal, answers))
-        visits = (
-            [
-                str(r["Text__"])
-                for r in kb.query("visit_order(_, O), format(atom(Text__), '~q', [O])")
-            ]
-            if family == "rgw"
-            else []
-        )
-        if visits:
-            common = Counter(visits).most_common(3)
-            out.append(
-                (
-                    "visit orders (most common)",
-                    "visit_order(_, Order)",
-                    [f"{o} x{n}" for o, n in common],
-                )
-            )
+            found = [str(row["Text__"]) for row in kb.query(text_goal)]
+            if title in scopes:
+                scope, unit, empty = scopes[title]
+                out.append(Answer(title, goal, found, kb.count(scope), unit, empty))
+            elif goal.endswith("(E)"):
+                out.append(Answer(title, goal, found, episodes, "episodes"))
+            else:
+                out.append(Answer(title, goal, found))
+        if family == "rgw":
+            visits = kb.query("visit_order(_, O), format(atom(Text__), '~q', [O])")
+            orders = Counter(str(r["Text__"]) for r in visits)
+            if orders:
+                common = [f"{o} x{n}" for o, n in orders.most_common(3)]
+                title, goal = "visit orders (most common)", "visit_order(_, Order)"
+                out.append(Answer(title, goal, common, len(orders), "distinct orders"))
     finally:
-        close = getattr(kb, "close", None)
-        if close is not None:
-            close()
+        kb.close()
     return out
 
 
-def _short(values: list[str], of: int | None = None, limit: int = 20) -> str:
-    """Answers on one line; ``of``: the episode count, for goals that answer episodes."""
+def rule_answers(kb_path: Path, family: str) -> list[tuple[str, str, list[str]]]:
+    """(title, goal, answers as Prolog text) for the family's queries over the KB at ``kb_path``."""
+    return [(a.title, a.goal, a.values) for a in answers(kb_path, family)]
+
+
+def _count(answer: Answer, shown: int) -> str:
+    """What the answers are out of: ``3 of 20 episodes``, ``3 of 7 distinct orders``."""
+    n = len(answer.values)
+    if answer.unit == "distinct orders":
+        of = answer.of or n
+        if shown >= of:
+            return f"{of} distinct orders"
+        return f"{shown} most common of {of} distinct orders"
+    if answer.of is not None:
+        return f"{n} of {answer.of} {answer.unit}"
+    return f"{n} answers"
+
+
+def _short(answer: Answer, limit: int = 20) -> str:
+    """Answers on one line, then what they count (the verbose report)."""
+    if answer.of == 0 and answer.empty:
+        return answer.empty
+    values = answer.values
     if not values:
         return "none"
-    head = ", ".join(values[:limit]) + (", ..." if len(values) > limit else "")
-    if of is not None:
-        return f"{head}  ({len(values)} of {of} episodes)"
-    return head if len(values) == 1 else f"{head}  ({len(values)})"
+    shown = values[:limit]
+    head = ", ".join(shown) + (", ..." if len(values) > limit else "")
+    if len(values) == 1 and (answer.of is None or answer.unit == "distinct orders"):
+        return head
+    return f"{head}  ({_count(answer, len(shown))})"
 
 
-def _brief(values: list[str], of: int | None) -> str:
+def _brief(answer: Answer) -> str:
     """The short report's answer cell: episode answers as a count, others the first three."""
-    if of is not None:
-        return f"{len(values)} of {of} episodes"
-    return _short(values, limit=3)
+    if answer.of == 0 and answer.empty:
+        return answer.empty
+    if answer.unit.startswith("episodes"):
+        return _count(answer, len(answer.values))
+    return _short(answer, limit=3)
 
 
 def add_rows(table: Any, rows: list[tuple[str, ...]], whole: tuple[int, ...]) -> None:
@@ -183,35 +232,71 @@ def _print_heads(rec: Any, say: Any, table_type: Any, verbose: bool = True) -> N
     say("  (the same, with an argument beside an object counted as on it)")
 
 
-def _print_summary(rec: Any, facts: Any, say: Any, table_type: Any, verbose: bool) -> None:
+def say_phrases(console: Any, phrases: list[str], indent: str = "  ") -> None:
+    """Print ``phrases`` (rich markup) joined by spaces, breaking lines only between phrases.
+
+    Rich would wrap a long line at the console's width (80 columns when output
+    is not a terminal) wherever a space falls, splitting ``4 heads`` or
+    ``event 140``; here a line ends before a phrase that does not fit, and the
+    next one starts indented. A phrase wider than the console is not broken.
+    """
+    from rich.text import Text
+
+    width = console.width
+    lines: list[list[str]] = []
+    used = 0
+    for phrase in phrases:
+        size = Text.from_markup(phrase).cell_len
+        if lines and used + 1 + size <= width:
+            lines[-1].append(phrase)
+            used += 1 + size
+        else:
+            lines.append([phrase])
+            used = size + (len(indent) if len(lines) > 1 else 0)
+    for i, line in enumerate(lines):
+        console.print((indent if i else "") + " ".join(line), soft_wrap=True)
+
+
+def _print_summary(rec: Any, facts: Any, console: Any, table_type: Any, verbose: bool) -> None:
     """The run in a line, its episodes (verbose), returns, fact counts and thresholds."""
     meta = rec.meta
     ep = rec.episodes
+    say = console.print
     mode = "greedy" if meta.get("greedy", True) else "sampled"
-    say(
-        f"[bold]{show(meta.get('env'))}[/]: {len(ep)} episodes ({mode}, seed {show(meta.get('seed'))}) "
-        f"of {show(meta.get('checkpoint'))} ({show(meta.get('module'))}, "
-        f"{show(meta.get('heads'))} heads, {show(meta.get('relations'))} relations)"
+    say_phrases(
+        console,
+        [
+            f"[bold]{show(meta.get('env'))}[/]: {len(ep)} episodes",
+            f"({mode}, seed {show(meta.get('seed'))})",
+            f"of {show(meta.get('checkpoint'))}",
+            f"({show(meta.get('module'))}, {show(meta.get('heads'))} heads, "
+            f"{show(meta.get('relations'))} relations)",
+        ],
     )
     if verbose:
         _print_episodes(ep, say, table_type)
     if len(ep):
-        outcomes = ", ".join(
-            f"{k} {v}" for k, v in ep["outcome"].value_counts().sort_index().items()
-        )
+        outcomes = [show(f"{k} {v}") for k, v in ep["outcome"].value_counts().sort_index().items()]
         r = ep["return"]
-        say(f"return: mean {r.mean():.3f}, min {r.min():.3f}, max {r.max():.3f}; {show(outcomes)}")
+        say_phrases(
+            console,
+            [f"return: mean {r.mean():.3f},", f"min {r.min():.3f},", f"max {r.max():.3f};"]
+            + _commas(outcomes),
+        )
     if not verbose:
         say(f"facts: {facts.n_facts} (--verbose: by predicate, and the relation tables)")
         return
-    counts = ", ".join(f"{k} {v}" for k, v in facts.counts().items() if v)
-    say(f"facts: {show(counts)}  ({facts.n_facts} in all)")
+    counts = [f"{k} {v}" for k, v in facts.counts().items() if v]
+    say_phrases(console, ["facts:", *_commas(counts), f"({facts.n_facts} in all)"])
     thr = facts.thresholds()
     if len(thr):
-        say(
-            f"thresholds ({show(facts.threshold)}): "
-            + show(", ".join(f"r({j}) {v:.4g}" for j, v in thr.items()))
-        )
+        values = [f"r({j}) {v:.4g}" for j, v in thr.items()]
+        say_phrases(console, [f"thresholds ({show(facts.threshold)}):", *_commas(values)])
+
+
+def _commas(items: list[str]) -> list[str]:
+    """``items`` as phrases of a comma-separated list: every one but the last ends in a comma."""
+    return [f"{item}," for item in items[:-1]] + items[-1:]
 
 
 def _print_relations(facts: Any, say: Any, table_type: Any, verbose: bool) -> None:
@@ -234,25 +319,20 @@ def _print_relations(facts: Any, say: Any, table_type: Any, verbose: bool) -> No
         say("strongest relations between object types: none held above threshold")
 
 
-def _print_answers(rec: Any, kb: Path | None, say: Any, table_type: Any, verbose: bool) -> None:
+def _print_answers(kb: Path | None, family: str, say: Any, table_type: Any, verbose: bool) -> None:
     """The rule files' answers from the written KB (episode lists as counts unless verbose)."""
-    from neurosym.envs import env_family
-
     if kb is None:
         say("rule answers: none (they need the Prolog KB: --format pl)")
         return
-    family = env_family(str(rec.meta.get("env")))
-    answers = rule_answers(kb, family)
-    if not answers:
+    found = answers(kb, family)
+    if not found:
         say("rule answers: none (neurosym's rule files are missing: no rules/ folder found)")
         return
     qt = table_type(title=f"rules/{RULE_FILES[family][0]}", show_edge=False)
     qt.add_column("question")
     qt.add_column("answers")
-    for title, goal, values in answers:
-        of = len(rec.episodes) if goal.endswith("(E)") else None
-        text = _short(values, of=of) if verbose else _brief(values, of)
-        qt.add_row(show(title), show(text))
+    for answer in found:
+        qt.add_row(show(answer.title), show(_short(answer) if verbose else _brief(answer)))
     say(qt)
     say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
 
@@ -273,10 +353,13 @@ def print_report(
     from rich.console import Console
     from rich.table import Table
 
-    say = Console(highlight=False).print
-    _print_summary(rec, facts, say, Table, verbose)
+    from neurosym.envs import env_family
+
+    console = Console(highlight=False)
+    say = console.print
+    _print_summary(rec, facts, console, Table, verbose)
     _print_heads(rec, say, Table, verbose)
     _print_relations(facts, say, Table, verbose)
-    _print_answers(rec, kb, say, Table, verbose)
+    _print_answers(kb, env_family(str(rec.meta.get("env"))), say, Table, verbose)
     for path in written.values():
-        say(f"wrote {show(path)}")
+        say(f"wrote {show(path)}", soft_wrap=True)  # a path is never broken over two lines

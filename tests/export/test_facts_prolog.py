@@ -16,6 +16,7 @@ import pytest
 from test_recorder_scripted import explorer_recording, scripted_recording
 
 from neurosym.export.facts import FactSet, extract_facts
+from neurosym.export.recording import Recording
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.terms import Term
 
@@ -205,3 +206,32 @@ def test_boxworld_solution_chain_is_consistent_with_the_gem_episodes(boxworld: t
         assert all(str(c[-1]) == "gem" for c in chains)
     for row in kb.query("followed_solution(E)"):
         assert kb.once("gem_chain(E, C), solution_chain(E, C)", E=row["E"]) is not None
+
+
+def test_kb_meta_names_the_env_options(tmp_path: Path, run_neurosym) -> None:  # noqa: ANN001
+    """The options the env was made with (the checkpoint's and --env-option's) are in kb_meta,
+    after the other keys, and read back through the fact reader and `neurosym query`."""
+    rec = scripted_recording()
+    rec = Recording(**rec.tables, meta=rec.meta)  # a copy: the fixture is shared
+    rec.meta["env_kwargs"] = {"num_mountains": 12, "map": "my map.txt", "max_steps": None,
+                              "classic": False, "scale": 0.5}  # fmt: skip
+    facts = extract_facts(rec)
+    path = facts.to_prolog(tmp_path / "kb.pl")
+    text = path.read_text()
+    assert text.split("kb_meta(threshold,'quantile:0.9').\n")[1].startswith(
+        "kb_meta(env_option(classic),false).\n"
+        "kb_meta(env_option(map),'my map.txt').\n"
+        "kb_meta(env_option(max_steps),none).\n"
+        "kb_meta(env_option(num_mountains),12).\n"
+        "kb_meta(env_option(scale),0.5).\n"
+    )
+    with KnowledgeBase(path) as kb:
+        got = {str(r["K"]): r["V"] for r in kb.query("kb_meta(env_option(K), V)")}
+    assert got == {"classic": "false", "map": "my map.txt", "max_steps": "none",
+                   "num_mountains": 12, "scale": 0.5}  # fmt: skip
+    proc = run_neurosym("query", "--kb", path, "--format", "json", "kb_meta(env_option(map), V)")
+    assert (proc.returncode, proc.stdout.strip()) == (0, '[{"V": "my map.txt"}]'), proc.stderr
+    table = pd.read_parquet(facts.to_parquet(tmp_path / "facts") / "kb_meta.parquet")
+    assert dict(zip(table["key"], table["value"], strict=True))["env_option(map)"] == "my map.txt"
+    rec.meta["env_kwargs"] = {}  # an env's defaults: no option facts, the rest unchanged
+    assert "env_option" not in extract_facts(rec).to_prolog(tmp_path / "kb2.pl").read_text()

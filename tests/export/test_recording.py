@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -151,4 +153,74 @@ def test_load_names_the_folder_of_a_damaged_table_or_meta(tmp_path: Path) -> Non
     assert (
         str(err.value)
         == f"{rec} is not a neurosym recording (its meta.json 'meta' is not an object)"
+    )
+
+
+WRITTEN_BY = (
+    "pass a recording folder written by `neurosym extract` (its recording/ folder, or --out)"
+)
+
+
+def test_load_says_what_is_wrong_with_a_table_file(tmp_path: Path) -> None:
+    """A table that is missing or not a regular file (a FIFO would block the reader) is named."""
+    rec = tmp_path / "rec"
+    small_recording().save(rec)
+    (rec / "steps.parquet").unlink()
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert str(err.value) == (
+        f"{rec} is not a complete recording: its table steps.parquet is missing; {WRITTEN_BY}"
+    )
+    os.mkfifo(rec / "steps.parquet")
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert str(err.value) == (
+        f"{rec / 'steps.parquet'} is a FIFO, not a regular file: a recording holds each table "
+        f"as a Parquet file; {WRITTEN_BY}"
+    )
+    (rec / "steps.parquet").unlink()
+    (rec / "meta.json").unlink()
+    os.mkfifo(rec / "meta.json")
+    with pytest.raises(ConfigError) as err:
+        Recording.load(rec)
+    assert str(err.value) == (
+        f"{rec} is not a neurosym recording: its meta.json is a FIFO, not a regular file; "
+        f"{WRITTEN_BY}"
+    )
+
+
+@pytest.mark.parametrize(
+    ("table", "column", "value"),
+    [("relations", "value", math.nan), ("steps", "reward", -math.inf)],
+)
+def test_load_refuses_numbers_that_are_not_finite(
+    tmp_path: Path, table: str, column: str, value: float
+) -> None:
+    """NaN/inf would reach the report page's JSON ("Out of range float values") or the KB."""
+    rec = small_recording()
+    df = getattr(rec, table).copy()
+    df.loc[len(df) - 1, column] = value
+    rec.save(tmp_path / "rec")
+    df.to_parquet(tmp_path / "rec" / f"{table}.parquet")
+    message = (
+        f"recording table {table!r} has {value!r} in column {column!r} (row {len(df) - 1}); "
+        "a recording holds finite numbers only (NaN and inf have no JSON or Prolog form)"
+    )
+    with pytest.raises(ConfigError) as err:
+        Recording.load(tmp_path / "rec")
+    assert str(err.value) == f"{tmp_path / 'rec'}: {message}"
+    with pytest.raises(ConfigError) as err:  # nor is one written
+        Recording(**{**rec.tables, table: df}, meta=rec.meta).save(tmp_path / "bad")
+    assert str(err.value) == message and not (tmp_path / "bad").exists()
+
+
+@pytest.mark.parametrize("heads", ["four", 2.5, True, -1, 10**9])
+def test_load_refuses_heads_that_are_not_a_count(tmp_path: Path, heads: object) -> None:
+    rec = small_recording()
+    Recording(**rec.tables, meta={**rec.meta, "heads": heads}).save(tmp_path / "rec")
+    with pytest.raises(ConfigError) as err:
+        Recording.load(tmp_path / "rec")
+    assert str(err.value) == (
+        f"{tmp_path / 'rec'}/meta.json gives heads {heads!r}; expected a whole number from 0 "
+        "to 4096 (the checkpoint's heads count)"
     )
