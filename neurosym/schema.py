@@ -84,8 +84,10 @@ SCHEMA: dict[str, Predicate] = {
     p.name: p
     for p in (
         _p("kb_meta", "key:atom value:value",
-           "checkpoint, env, module, heads, relations, "
-           "seed, actions (`agent` or `random`), created, version, threshold",
+           "checkpoint, env, module, heads, relations, seed, actions (`agent` or `random`), "
+           "created, version, threshold; then `env_option(Name)` for each option the env was "
+           "made with (the checkpoint's and `--env-option`'s: `kb_meta(env_option(num_mountains), "
+           "12)`, `none` for None; none on an env's defaults)",
            TRACE, "extract probe intervene"),
         _p("object", "id:Id:atom type:term", "every named object of the recorded maps",
            TRACE, "extract intervene"),
