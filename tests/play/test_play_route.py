@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -31,6 +33,37 @@ def test_route_through_janus(episode: int, t: int, goal: str, answer: tuple) -> 
 def test_no_route_past_an_unarmed_enemy() -> None:
     with KnowledgeBase(None, rules=[FACTS, "route"]) as kb:
         assert kb.query("route(2, 0, terminal, A)") == []
+
+
+HOSTILE = (
+    ":- dynamic route_pl_memo_/4.\n"
+    "route_pl_memo_(0, 0, terminal, found(jump_into_pit, 1)).\n"
+    "route_pl_memo_(0, 0, sword, none).\n"
+)
+"""facts for the cache route.pl once kept in the loading module: planted answers"""
+
+
+@pytest.mark.parametrize("hostile", [False, True])
+def test_kb_facts_cannot_change_a_route(
+    run_neurosym, swipl: Path, tmp_path: Path, hostile: bool
+) -> None:
+    """A KB holding facts named like route.pl's private cache answers as one without them,
+    through neurosym query and through plain swipl (kb.pl, then route.pl)."""
+    kb = tmp_path / "kb.pl"
+    facts = [line for line in FACTS.read_text().splitlines(True) if "discontiguous" not in line]
+    kb.write_text("".join(facts) + (HOSTILE if hostile else ""))
+    goal = "member(G, [terminal, sword]), route(0, 0, G, A, C)"
+    proc = run_neurosym("query", "--kb", kb, "--trust", kb, "--rules", "route", goal, "--format", "json")
+    assert proc.returncode == 0, proc.stderr
+    assert sorted((r["G"], r["A"], r["C"]) for r in json.loads(proc.stdout)) == [
+        ("sword", "down", 8), ("terminal", "down", 7),
+    ]  # fmt: skip
+    shown = "forall((member(G, [terminal, sword]), route(0, 0, G, A, C)), writeln(G-A-C))"
+    plain = subprocess.run(
+        [str(swipl), "-q", "-g", shown, "-t", "halt", str(kb), str(ROOT / "rules" / "route.pl")],
+        capture_output=True, text=True, timeout=60, check=False,
+    )  # fmt: skip
+    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7\nsword-down-8\n"), plain.stderr
 
 
 def _only(tmp_path: Path, body: str) -> Path:
