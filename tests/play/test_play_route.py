@@ -53,7 +53,9 @@ def test_kb_facts_cannot_change_a_route(
     facts = [line for line in FACTS.read_text().splitlines(True) if "discontiguous" not in line]
     kb.write_text("".join(facts) + (HOSTILE if hostile else ""))
     goal = "member(G, [terminal, sword]), route(0, 0, G, A, C)"
-    proc = run_neurosym("query", "--kb", kb, "--trust", kb, "--rules", "route", goal, "--format", "json")
+    proc = run_neurosym(
+        "query", "--kb", kb, "--trust", kb, "--rules", "route", goal, "--format", "json"
+    )
     assert proc.returncode == 0, proc.stderr
     assert sorted((r["G"], r["A"], r["C"]) for r in json.loads(proc.stdout)) == [
         ("sword", "down", 8), ("terminal", "down", 7),
