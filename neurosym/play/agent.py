@@ -214,7 +214,8 @@ class PrologAgent:
 
     def close(self) -> None:
         """Unload the strategy and its facts."""
-        self.kb.close()
+        with interruptible():
+            self.kb.close()
 
     def __enter__(self) -> PrologAgent:
         return self

@@ -48,6 +48,7 @@ def play_policy(
     from neurosym.envs import canonical_name
     from neurosym.play.agent import PrologAgent
     from neurosym.play.policy import read_policy
+    from neurosym.prolog.interrupt import sigint_region
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
@@ -66,7 +67,8 @@ def play_policy(
     env = canonical_name(env)
     kwargs = dict(env_kwargs or {})
     thresholds = kb_thresholds(kb) if kb is not None else None
-    with PrologAgent(spec, network, thresholds=thresholds) as agent:
+    # One SIGINT handler for the whole play: each Prolog call only marks itself (interrupt.py).
+    with sigint_region(), PrologAgent(spec, network, thresholds=thresholds) as agent:
         start = time.perf_counter()
         done = play_scored(
             agent.act,

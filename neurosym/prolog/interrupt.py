@@ -22,11 +22,20 @@ How, inside ``with interruptible():`` (main thread only; elsewhere it does nothi
 * when the block ends after a Ctrl-C, whatever it raised or returned,
   KeyboardInterrupt is raised (the CLI's one line, exit 130).
 
+Installing the handler and the pipe takes system calls (tens of microseconds
+here); a loop of many short calls opens :func:`sigint_region` once around the
+loop, inside which ``interruptible()`` only marks the call and Ctrl-C outside
+a marked call raises KeyboardInterrupt at once, as Python's own handler does.
+
 A call that stays inside one foreign function (a huge ``X is 7^20000000``)
 stops when that function returns.
 
     >>> with interruptible():
     ...     janus.query_once("sleep(1000)")   # Ctrl-C: KeyboardInterrupt
+    >>> with sigint_region():                 # many calls: the handler installed once
+    ...     for goal in goals:
+    ...         with interruptible():
+    ...             janus.query_once(goal)
 """
 
 from __future__ import annotations
@@ -69,6 +78,7 @@ class _State:
         self.posted = 0  # the block the watcher signalled Prolog for
         self.read_fd = -1
         self.write_fd = -1
+        self.region = False  # a sigint_region is open
         self.prolog_thread: Any = None
         self.main_ident = threading.main_thread().ident
 
@@ -127,40 +137,74 @@ def _watch() -> None:
             signal.pthread_kill(_state.main_ident, signal.SIGINT)  # EINTR for a blocking call
 
 
-def _noted(signum: int, frame: Any) -> None:
-    """SIGINT handler inside a block: note it; the block raises KeyboardInterrupt when it ends."""
-    _state.requested = True
+def _handler(signum: int, frame: Any) -> None:
+    """SIGINT inside a region: noted during a marked call (raised when it ends), raised otherwise."""
+    if _state.block:
+        _state.requested = True
+    else:
+        raise KeyboardInterrupt
 
 
 @contextmanager
-def interruptible() -> Iterator[None]:
-    """Run janus calls so that Ctrl-C stops them with KeyboardInterrupt (see the module docstring).
+def sigint_region() -> Iterator[None]:
+    """Install the SIGINT handler and the wakeup pipe for the ``interruptible()`` calls inside.
 
-    Nested blocks and blocks outside the main thread, or while SIGINT is
-    ignored, run as they are.
+    Outside the main thread, while SIGINT is ignored, or inside another
+    region, it does nothing.
     """
     if (
-        threading.current_thread() is not threading.main_thread()
-        or _state.block != 0
+        _state.region
+        or threading.current_thread() is not threading.main_thread()
         or signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, None)
     ):
         yield
         return
     _start_watcher()
-    previous = signal.signal(signal.SIGINT, _noted)
+    previous = signal.signal(signal.SIGINT, _handler)
     old_fd = signal.set_wakeup_fd(_state.write_fd, warn_on_full_buffer=False)
-    _state.blocks += 1
-    _state.requested = False
-    _state.block = _state.blocks
+    _state.region = True
     try:
         yield
-    except BaseException:
-        if not _state.requested:
-            raise
     finally:
-        _state.block = 0
+        _state.region = False
         signal.set_wakeup_fd(old_fd)
         signal.signal(signal.SIGINT, previous)
-    if _state.requested:
+
+
+class interruptible:  # noqa: N801 - used like a function: ``with interruptible():``
+    """Run janus calls so that Ctrl-C stops them with KeyboardInterrupt (see the module docstring).
+
+    Opens a :func:`sigint_region` of its own when none is open. Nested
+    blocks, and blocks outside the main thread, run as they are. A class,
+    not a generator: inside a region it costs a few attribute writes.
+    """
+
+    __slots__ = ("_marks", "_region")
+
+    def __enter__(self) -> None:
+        self._marks = False
+        self._region: Any = None
+        if _state.block or threading.get_ident() != _state.main_ident:
+            return
+        if not _state.region:
+            self._region = sigint_region()
+            self._region.__enter__()
+            if not _state.region:  # SIGINT ignored
+                return
+        self._marks = True
+        _state.blocks += 1
         _state.requested = False
-        raise KeyboardInterrupt
+        _state.block = _state.blocks
+
+    def __exit__(self, kind: Any, exc: Any, tb: Any) -> bool:
+        if not self._marks:
+            return self._close(kind, exc, tb)
+        _state.block = 0
+        requested, _state.requested = _state.requested, False
+        self._close(None, None, None)
+        if requested:
+            raise KeyboardInterrupt
+        return False
+
+    def _close(self, kind: Any, exc: Any, tb: Any) -> bool:
+        return bool(self._region is not None and self._region.__exit__(kind, exc, tb))
