@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import subprocess
 from pathlib import Path
 
@@ -43,26 +42,32 @@ HOSTILE = (
 """facts for the cache route.pl once kept in the loading module: planted answers"""
 
 
+DATA_KB = (
+    ":- dynamic object/2, at/5, grid/3.\n"
+    "object(terminal, terminal).\n"
+    "grid(0, 1, 3).\n"
+    "at(0, 0, agent, 0, 0).\n"
+    "at(0, 0, terminal, 0, 2).\n"
+)
+"""a KB as neurosym extract writes one: the agent, then an empty cell, then the terminal"""
+
+
 @pytest.mark.parametrize("hostile", [False, True])
 def test_kb_facts_cannot_change_a_route(
     run_neurosym, swipl: Path, tmp_path: Path, hostile: bool
 ) -> None:
-    """A KB holding facts named like route.pl's private cache answers as one without them,
-    through neurosym query and through plain swipl (kb.pl, then route.pl)."""
+    """A KB holding facts named like route.pl's private cache answers as one without them:
+    a fact KB through neurosym query, and route.plt's states in plain swipl (kb.pl, route.pl)."""
     kb = tmp_path / "kb.pl"
-    facts = [line for line in FACTS.read_text().splitlines(True) if "discontiguous" not in line]
-    kb.write_text("".join(facts) + (HOSTILE if hostile else ""))
-    goal = "member(G, [terminal, sword]), route(0, 0, G, A, C)"
-    proc = run_neurosym(
-        "query", "--kb", kb, "--trust", kb, "--rules", "route", goal, "--format", "json"
-    )
-    assert proc.returncode == 0, proc.stderr
-    assert sorted((r["G"], r["A"], r["C"]) for r in json.loads(proc.stdout)) == [
-        ("sword", "down", 8), ("terminal", "down", 7),
-    ]  # fmt: skip
+    kb.write_text(DATA_KB + (HOSTILE if hostile else ""))
+    goal = "route(0, 0, terminal, A, C)"
+    proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--format", "csv")
+    assert (proc.returncode, proc.stdout.split()) == (0, ["A,C", "right,2"]), proc.stderr
+    code = tmp_path / "states.pl"
+    code.write_text(FACTS.read_text() + (HOSTILE if hostile else ""))
     shown = "forall((member(G, [terminal, sword]), route(0, 0, G, A, C)), writeln(G-A-C))"
     plain = subprocess.run(
-        [str(swipl), "-q", "-g", shown, "-t", "halt", str(kb), str(ROOT / "rules" / "route.pl")],
+        [str(swipl), "-q", "-g", shown, "-t", "halt", str(code), str(ROOT / "rules" / "route.pl")],
         capture_output=True, text=True, timeout=60, check=False,
     )  # fmt: skip
     assert (plain.returncode, plain.stdout) == (0, "terminal-down-7\nsword-down-8\n"), plain.stderr
