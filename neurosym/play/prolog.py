@@ -198,11 +198,18 @@ guard(M) :-
 
 guard_(M, N, A) :-
     functor(H, N, A),
-    (   predicate_property(system:H, defined)
-    ->  redefine_system_predicate(M:H)
-    ;   true
-    ),
-    assertz(M:(H :- neurosym_play:refused_(N/A))).
+    catch(( (   built_in_(N, A)
+            ->  redefine_system_predicate(M:H)
+            ;   true
+            ),
+            assertz(M:(H :- neurosym_play:refused_(N/A))) ),
+          _, true).  % imported by the strategy: its body was checked for the name
+
+%   A predicate of the system itself, asked without autoloading anything.
+built_in_(N, A) :-
+    current_predicate(system:N/A),
+    functor(H, N, A),
+    predicate_property(system:H, built_in).
 
 refused_(PI) :-
     throw(error(permission_error(call, procedure, PI),
@@ -310,9 +317,9 @@ head_problem_(M, H, Text) :-
     functor(G, N, A),
     (   hook_(N, A)
     ->  format(string(Text), "a clause for ~q/~w, which SWI-Prolog calls while it loads files; a strategy may not define it", [N, A])
-    ;   predicate_property(system:G, defined)
+    ;   built_in_(N, A)
     ->  format(string(Text), "a clause for the built-in predicate ~q/~w", [N, A])
-    ;   predicate_property(M:G, defined),
+    ;   current_predicate(M:N/A),  % asked first: predicate_property/2 could autoload
         \+ predicate_property(M:G, dynamic),
         \+ predicate_property(M:G, imported_from(_))
     ->  format(string(Text), "a clause for ~q/~w, which rules/route.pl defines; a strategy uses route.pl's predicates and may not redefine them", [N, A])

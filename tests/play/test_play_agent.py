@@ -246,3 +246,16 @@ def test_a_file_name_that_is_not_utf8_is_refused(tmp_path: Path) -> None:
     assert str(info.value) == (
         f"--policy {name!r}: the file name is not UTF-8, which SWI-Prolog needs; rename the file"
     )
+
+
+def test_a_strategy_may_define_library_predicate_names(tmp_path: Path) -> None:
+    """As learned strategies do (reachable/3 is also library(ugraphs)'s): checking the file
+    autoloads nothing that would then clash with its clauses."""
+    policy = _policy(
+        tmp_path,
+        ":- use_module(library(lists)).\n"
+        "reachable(E, T, O) :- route_exists(E, T, O).\n"
+        "goal(E, T, O) :- member(O, [sword, terminal]), reachable(E, T, O).\n",
+    )
+    report = play_policy(policy, "rgw2", 1)
+    assert report["fallback_steps"] == 0 and report["outcomes"] == {"terminal": 1}
