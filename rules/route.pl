@@ -39,6 +39,12 @@
     terms with one argument per cell, read with arg/3.
     Helpers start with route_pl_, so this file loads beside the other rule
     files and beside a learned strategy (whose own helpers start with route_).
+
+    The routes route/5 remembers live in module route (route:memo_/5, keyed
+    by the module that loaded this file), out of reach of the facts: a KB,
+    which holds facts for predicates without a module, cannot plant answers
+    there. The file itself is plain Prolog (no module header), so that it
+    loads into a KB module, into user, and beside other rule files alike.
 */
 
 :- use_module(library(heaps)).
@@ -47,7 +53,6 @@
 :- use_module(library(apply)).
 
 :- dynamic at/5, object/2, holding/3, terrain/4, grid/3.
-:- dynamic route_pl_memo_/4.
 
 %!  route(+E, +T, +Goal, -Action) is semidet.
 %
@@ -69,13 +74,15 @@ route(E, T, Goal, Action) :-
 route(E, T, Goal, Action, Cost) :-
     ground(E-T-Goal),
     !,
-    (   route_pl_memo_(E, T, Goal, Found)
+    context_module(M),
+    route_pl_memo_ready_,
+    (   route:memo_(M, E, T, Goal, Found)
     ->  true
     ;   (   route_pl_(E, T, Goal, A, C)
         ->  Found = found(A, C)
         ;   Found = none
         ),
-        assertz(route_pl_memo_(E, T, Goal, Found))
+        assertz(route:memo_(M, E, T, Goal, Found))
     ),
     Found = found(Action, Cost).
 route(E, T, Goal, Action, Cost) :-
@@ -90,7 +97,18 @@ route(E, T, Goal, Action, Cost) :-
 %   about.
 
 route_forget(E) :-
-    retractall(route_pl_memo_(E, _, _, _)).
+    context_module(M),
+    route_pl_memo_ready_,
+    retractall(route:memo_(M, E, _, _, _)).
+
+%   The memo is declared when first used, not by a directive: a directive
+%   would tie it to this file, and unloading one copy of the file (a closed
+%   KB) would take the other copies' memo with it.
+route_pl_memo_ready_ :-
+    (   current_predicate(route:memo_/5)
+    ->  true
+    ;   dynamic(route:memo_/5)
+    ).
 
 route_pl_(E, T, Goal, Action, Cost) :-
     at(E, T, agent, R0, C0),

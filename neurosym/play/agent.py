@@ -25,7 +25,9 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from collections import Counter
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -35,6 +37,7 @@ from neurosym.errors import ConfigError, PrologError
 from neurosym.play import live
 from neurosym.play import prolog as play_prolog
 from neurosym.play.policy import Policy, read_policy
+from neurosym.prolog.interrupt import interruptible
 from neurosym.terms import Term
 
 INFERENCE_LIMIT = 10_000_000
@@ -47,6 +50,10 @@ SCHEMA = (
 """every predicate of the KB schema, declared dynamic in the agent's module"""
 
 _ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
+
+_C_STACK_BASE = 16 << 20
+_C_STACK_PER_LEVEL = 768
+"""C stack of the thread that reads a strategy file: as neurosym.prolog.knowledge_base sizes it"""
 
 
 def _janus() -> Any:
@@ -95,25 +102,31 @@ class PrologAgent:
         self.inference_limit = int(inference_limit)
         self.kb = KnowledgeBase(None)
         try:
-            self.kb.query("forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA])
-            self.kb.load_rules(rule_file("route"))
-            self.kb.load_rules(self.policy.path)
-            if not self.kb.query("current_predicate(goal/3)"):
-                raise ConfigError(
-                    f"{self.policy.path} defines no goal/3; a strategy file defines "
-                    "goal(E, T, Object), the object to go for next in state T of episode E"
+            with interruptible():
+                self.kb.query(
+                    "forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA]
                 )
-            self.relations = None
-            if self.policy.needs_network:
-                from neurosym.play.relations import RelationFacts
+                self.kb.load_rules(rule_file("route"))
+                _load_policy(self.kb, self.policy.path)
+                if not self.kb.query("current_predicate(goal/3)"):
+                    raise ConfigError(
+                        f"{self.policy.path} defines no goal/3; a strategy file defines "
+                        "goal(E, T, Object), the object to go for next in state T of episode E"
+                    )
+                self.relations = None
+                if self.policy.needs_network:
+                    from neurosym.play.relations import RelationFacts
 
-                self.relations = RelationFacts(network, self.kb, self.policy, thresholds)
+                    self.relations = RelationFacts(network, self.kb, self.policy, thresholds)
+                _janus().query_once(f"{play_prolog.MODULE}:guard(M)", {"M": self.kb.module})
         except BaseException:
             self.kb.close()
             raise
         self.module = self.kb.module
         self.fallbacks: Counter[str] = Counter()
         self.decisions = 0
+        self.chosen = 0
+        """decisions whose object the strategy chose (status ok)"""
         self.decide_seconds = 0.0
         self.goals: Counter[str] = Counter()
         self.last: tuple[str, str, str] | None = None
@@ -147,7 +160,7 @@ class PrologAgent:
         seen = key in venv.visited[i]
         venv.visited[i].add(key)
         start = time.perf_counter()
-        out = _janus().query_once(
+        out = self._query(
             f"{play_prolog.MODULE}:decide(M, E, T, S, P, X, L, Seen, Out)",
             {
                 "M": self.module, "E": e, "T": t,
@@ -160,13 +173,30 @@ class PrologAgent:
         self.decisions += 1
         venv.prev[i] = []
         if out[0] == "error":
-            raise PrologError(f"{self.policy.path}: {out[1]}")
+            raise PrologError(f"{self.policy.path}: {' '.join(str(out[1]).split())}")
         (status, goal), action = out
+        if action not in _ACTION_INDEX:
+            raise PrologError(
+                f"{self.policy.path}: route/4 answered {_shown(action)} for {_shown(goal)} in "
+                f"state {t} of episode {e}; an action is one of {', '.join(ACTION_NAMES)} "
+                "(a strategy may not redefine route.pl's predicates)"
+            )
         self.last = (status, str(goal), action)
-        if status != "ok":
+        if status == "ok":
+            self.chosen += 1
+        else:
             self.fallbacks[status] += 1
         self.goals[str(goal)] += 1
         return _ACTION_INDEX[action]
+
+    def _query(self, goal: str, inputs: dict[str, Any]) -> Any:
+        """One janus call of the agent's Prolog side; Ctrl-C stops it, a Prolog error is one line."""
+        janus = _janus()
+        try:
+            with interruptible():
+                return janus.query_once(goal, inputs)
+        except janus.PrologError as exc:  # decide/9 catches the strategy's errors: this is abort/0
+            raise PrologError(f"{self.policy.path}: {' '.join(str(exc).split())}") from None
 
     def state_facts(self, episode: int, t: int) -> dict[str, list[tuple[Any, ...]]]:
         """The at/5, holding/3, step/4 and event/3 facts of (episode, t) now in the agent's KB, as text rows."""
@@ -184,7 +214,8 @@ class PrologAgent:
 
     def close(self) -> None:
         """Unload the strategy and its facts."""
-        self.kb.close()
+        with interruptible():
+            self.kb.close()
 
     def __enter__(self) -> PrologAgent:
         return self
@@ -195,7 +226,7 @@ class PrologAgent:
     # -- episodes (called by _Watched) -------------------------------------
 
     def begin(self, episode: int, facts: live.EpisodeFacts) -> None:
-        _janus().query_once(
+        self._query(
             f"{play_prolog.MODULE}:begin_episode(M, E, O, X, G)",
             {
                 "M": self.module, "E": episode,
@@ -206,9 +237,50 @@ class PrologAgent:
         )  # fmt: skip
 
     def end(self, episode: int) -> None:
-        _janus().query_once(
-            f"{play_prolog.MODULE}:end_episode(M, E)", {"M": self.module, "E": episode}
+        self._query(f"{play_prolog.MODULE}:end_episode(M, E)", {"M": self.module, "E": episode})
+
+
+def _load_policy(kb: Any, path: Path) -> None:
+    """Load a strategy file into ``kb`` as code, once :func:`check_policy` found nothing it may not hold.
+
+    The file is read once, into a private copy, which is checked and loaded:
+    what is checked is what runs. Messages name the file, not the copy.
+    """
+    from neurosym.prolog.snapshot import snapshot
+
+    with snapshot(path) as copy:
+        check_policy(kb.module, copy.path, path, copy.nesting)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                kb.load_rules(copy.path)
+            except PrologError as exc:
+                raise PrologError(str(exc).replace(str(copy.path), str(path))) from None
+    for w in caught:
+        warnings.warn_explicit(
+            str(w.message).replace(str(copy.path), str(path)), w.category, str(path), 0
         )
+
+
+def check_policy(module: str, file: Path, shown: Path, nesting: int) -> None:
+    """ConfigError (one line, naming ``shown`` and the line) for the first term of a strategy
+    file it may not hold: a directive that would run, a clause for another module, an
+    expansion hook, a built-in or route.pl's predicates, a process-level predicate
+    (:mod:`neurosym.play.prolog`, ``check_policy/4``)."""
+    problem = _janus().query_once(
+        f"{play_prolog.MODULE}:check_policy(M, F, C, P)",
+        {"M": module, "F": str(file), "C": _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting},
+    )["P"]
+    if problem != "none":
+        line, text = problem
+        where = f"{shown}:{line}" if line else str(shown)
+        text = " ".join(str(text).replace(str(file), str(shown)).split())
+        raise ConfigError(f"{where}: {text}")
+
+
+def _shown(value: Any) -> str:
+    text = str(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _indicator(text: str) -> Term:

@@ -13,6 +13,16 @@ the network's relation facts of the live state: give the agent they came
 from with ``--checkpoint`` (its env is then the default ``--env``) and, when
 the strategy file has no ``threshold/2``, the KB it was learned from with
 ``--kb`` (its thresholds decide which relations hold).
+
+A strategy file is read term by term before it loads and refused with one
+line naming file and line when it holds what would run code as it loads or
+end the process (a directive other than ``dynamic``, ``discontiguous`` or
+``use_module(library(Name))``, a load hook, clauses for another module or for
+route.pl's predicates, a call of halt, abort, shell, ...); halt or abort
+reached at run time is an error. A run in which the strategy chose no
+object in any step (every action a fallback: a strategy for another env) is
+refused with one line. Ctrl-C stops the run even while the strategy sits in
+a blocking call (exit 130).
 """
 
 from __future__ import annotations

@@ -48,13 +48,16 @@ def play_policy(
     from neurosym.envs import canonical_name
     from neurosym.play.agent import PrologAgent
     from neurosym.play.policy import read_policy
+    from neurosym.prolog.interrupt import sigint_region
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
     check_seed(seed, episodes)
+    check_file_name(policy, "--policy")
     spec = read_policy(policy)
     network = None
     if checkpoint is not None:
+        check_file_name(checkpoint, "--checkpoint")
         from neurosym.agent.checkpoint import env_for, load_agent
 
         network = load_agent(checkpoint)
@@ -64,7 +67,8 @@ def play_policy(
     env = canonical_name(env)
     kwargs = dict(env_kwargs or {})
     thresholds = kb_thresholds(kb) if kb is not None else None
-    with PrologAgent(spec, network, thresholds=thresholds) as agent:
+    # One SIGINT handler for the whole play: each Prolog call only marks itself (interrupt.py).
+    with sigint_region(), PrologAgent(spec, network, thresholds=thresholds) as agent:
         start = time.perf_counter()
         done = play_scored(
             agent.act,
@@ -74,6 +78,7 @@ def play_policy(
             batch,
         )
         seconds = time.perf_counter() - start
+        check_decided(agent, env)
         steps = int(sum(done.lengths))
         return {
             "policy": str(spec.path),
@@ -92,14 +97,65 @@ def play_policy(
         }
 
 
+MAX_RELATIONS = 1 << 16
+"""the largest relation index a KB's threshold/2 may name"""
+
+
 def kb_thresholds(kb: str | os.PathLike[str]) -> dict[int, float]:
-    """Relation j -> threshold of a KB's ``threshold/2`` facts; ConfigError when it has none."""
+    """Relation j -> threshold of a KB's ``threshold/2`` facts; ConfigError (one line) when it
+    has none, or one that is not ``threshold(J, V)`` with J a relation index and V a number >= 0."""
+    import math
+
+    from neurosym.prolog.interrupt import interruptible
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
-    with KnowledgeBase(kb) as base:
-        rows = base.query("threshold(J, V)")
+    check_file_name(kb, "--kb")
+    with interruptible(), KnowledgeBase(kb) as base:
+        rows = base.query("current_predicate(threshold/2), threshold(J, V)")
     if not rows:
         raise ConfigError(
-            f"{kb} has no threshold/2 facts; give the KB the strategy was learned from"
+            f"{kb} holds no threshold/2 facts, which say when a relation holds: --kb must be "
+            "the KB the strategy was learned from, as neurosym extract writes it"
         )
-    return {int(r["J"]): float(r["V"]) for r in rows}
+    out: dict[int, float] = {}
+    for r in rows:
+        j, v = r["J"], r["V"]
+        if not (
+            isinstance(j, int) and 0 <= j < MAX_RELATIONS
+            and isinstance(v, int | float) and math.isfinite(v) and v >= 0
+        ):  # fmt: skip
+            raise ConfigError(
+                f"{kb}: threshold({_short(j)}, {_short(v)}) is not threshold(J, V) with J a "
+                f"relation index (0 to {MAX_RELATIONS - 1}) and V a number >= 0, as neurosym "
+                "extract writes it"
+            )
+        out[j] = float(v)
+    return out
+
+
+def _short(value: Any) -> str:
+    text = str(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def check_file_name(path: str | os.PathLike[str], option: str) -> None:
+    """ConfigError (one line) for a file name that is not UTF-8: SWI-Prolog cannot take it."""
+    try:
+        os.fsencode(path).decode("utf-8")
+    except UnicodeDecodeError:
+        raise ConfigError(
+            f"{option} {os.fsdecode(path)!r}: the file name is not UTF-8, which SWI-Prolog "
+            "needs; rename the file"
+        ) from None
+
+
+def check_decided(agent: Any, env: str) -> None:
+    """ConfigError (one line) when the strategy chose no object in any step: every action was
+    a fallback, so the figures would be route.pl's default strategy, not the strategy's."""
+    if agent.decisions and not agent.chosen:
+        causes = ", ".join(f"{k} {v}" for k, v in sorted(agent.fallbacks.items()))
+        raise ConfigError(
+            f"{agent.policy.path} chose no object it could reach in any of the "
+            f"{agent.decisions} steps on {env} (fallbacks: {causes}); is it a strategy for "
+            "another env (its goal/3 names objects this env's levels do not hold)?"
+        )

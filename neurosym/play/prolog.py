@@ -19,7 +19,20 @@ rule files, route.pl and the strategy, as code):
   inferences;
 * ``end_episode(M, E)`` retracts every fact of episode E (not object/2,
   which, as in a KB, lists the ids of every episode) and the routes
-  route.pl remembered for it (``route_forget/1``).
+  route.pl remembered for it (``route_forget/1``);
+* ``check_policy(M, File, CStack, Problem)`` reads a strategy file term by
+  term, running nothing (in a thread whose C stack is CStack bytes), and
+  gives ``none`` or ``Line-Text`` for the first term a strategy may not hold:
+  a directive other than ``dynamic``, ``discontiguous`` and
+  ``use_module(library(Name))`` (directives run when a file loads), a
+  clause for another module, for an expansion hook, for a built-in or for a
+  predicate route.pl defines (static in M), or a clause that names a
+  process-level predicate (:data:`FORBIDDEN`: halt, abort, shell, ...);
+* ``guard(M)`` defines those process-level predicates in M as ones that
+  raise a permission error, so a strategy that builds such a call at run
+  time gets an error, not a process that ends; a ``halt/0,1`` that still
+  reaches SWI-Prolog while a strategy chooses is cancelled (``at_halt/1``)
+  and reported as an error.
 
 Values arrive from janus as atoms, numbers and lists; a compound term arrives
 as the tuple ``('$t', Functor, Args)`` and is rebuilt with
@@ -32,9 +45,11 @@ from __future__ import annotations
 MODULE = "neurosym_play"
 
 SOURCE = r"""
-:- module(neurosym_play, [begin_episode/5, decide/9, end_episode/2]).
+:- module(neurosym_play, [begin_episode/5, decide/9, end_episode/2, check_policy/4, guard/1]).
 :- use_module(library(apply), [maplist/2, maplist/3]).
 :- use_module(library(lists), [member/2]).
+
+:- thread_local choosing_/0, halted_/1.
 
 term_(X, X) :- atomic(X), !.
 term_(-('$t', F, As0), T) :- !, maplist(term_, As0, As), compound_name_arguments(T, F, As).
@@ -77,8 +92,15 @@ assert_state_(M, E, T, [Ats, Held], Prev, Extra) :-
 
 decide(M, E, T, State, Prev, Extra, Limit, Seen, Out) :-
     assert_state_(M, E, T, State, Prev, Extra),
-    catch(call_with_inference_limit(choose_(M, E, T, Seen, Out0), Limit, Result), Err, true),
-    (   nonvar(Err)
+    retractall(halted_(_)),
+    setup_call_cleanup(
+        assertz(choosing_),
+        catch(call_with_inference_limit(choose_(M, E, T, Seen, Out0), Limit, Result), Err, true),
+        retractall(choosing_)),
+    (   retract(halted_(Goal))
+    ->  format(string(Text), "the strategy called ~q while choosing in state ~w of episode ~w: a strategy may not end the process", [Goal, T, E]),
+        Out = error-Text
+    ;   nonvar(Err)
     ->  message_to_codes_(Err, Text), Out = error-Text
     ;   Result == inference_limit_exceeded
     ->  format(string(Text), "the strategy took more than ~D inferences to choose in state ~w of episode ~w", [Limit, T, E]),
@@ -115,6 +137,206 @@ message_to_codes_(E, Text) :-
     split_string(Text0, "\n", " \t", Parts),
     atomic_list_concat(Parts, ' ', A),
     atom_string(A, Text).
+
+% -- a strategy may not end the process ------------------------------------
+
+%   A halt that reaches SWI-Prolog while a strategy chooses is cancelled
+%   (halt/0,1 then fail) and decide/9 reports it.
+:- at_halt(cancel_strategy_halt_).
+
+cancel_strategy_halt_ :-
+    (   choosing_
+    ->  assertz(halted_(halt)),
+        cancel_halt(neurosym_play)
+    ;   true
+    ).
+
+:- multifile user:message_hook/3.
+user:message_hook(cancel_halt(neurosym_play), _, _).
+
+forbidden_(halt, 0).
+forbidden_(halt, 1).
+forbidden_(abort, 0).
+forbidden_(break, 0).
+forbidden_(prolog, 0).
+forbidden_(shell, 0).
+forbidden_(shell, 1).
+forbidden_(shell, 2).
+forbidden_(process_create, 3).
+forbidden_(process_kill, 1).
+forbidden_(process_kill, 2).
+forbidden_(thread_signal, 2).
+forbidden_(thread_exit, 1).
+forbidden_(on_signal, 3).
+forbidden_(at_halt, 1).
+forbidden_(cancel_halt, 1).
+forbidden_(set_prolog_flag, 2).
+forbidden_(create_prolog_flag, 3).
+forbidden_(consult, 1).
+forbidden_(load_files, 1).
+forbidden_(load_files, 2).
+forbidden_(ensure_loaded, 1).
+forbidden_(use_module, 1).
+forbidden_(use_module, 2).
+forbidden_(unload_file, 1).
+forbidden_(make, 0).
+forbidden_(qsave_program, 1).
+forbidden_(qsave_program, 2).
+forbidden_(redefine_system_predicate, 1).
+forbidden_(abolish, 1).
+forbidden_(abolish, 2).
+forbidden_(delete_file, 1).
+forbidden_(rename_file, 2).
+forbidden_(setenv, 2).
+forbidden_(unsetenv, 1).
+forbidden_(chdir, 1).
+forbidden_(working_directory, 2).
+
+%!  guard(+M) is det.
+guard(M) :-
+    forall(forbidden_(N, A), guard_(M, N, A)).
+
+guard_(M, N, A) :-
+    functor(H, N, A),
+    catch(( (   built_in_(N, A)
+            ->  redefine_system_predicate(M:H)
+            ;   true
+            ),
+            assertz(M:(H :- neurosym_play:refused_(N/A))) ),
+          _, true).  % imported by the strategy: its body was checked for the name
+
+%   A predicate of the system itself, asked without autoloading anything.
+built_in_(N, A) :-
+    current_predicate(system:N/A),
+    functor(H, N, A),
+    predicate_property(system:H, built_in).
+
+refused_(PI) :-
+    throw(error(permission_error(call, procedure, PI),
+                context(_, 'a strategy may not end the process, run programs, load code or change files'))).
+
+%!  check_policy(+M, +File, +CStack, -Problem) is det.
+check_policy(M, File, CStack, Problem) :-
+    thread_create(check_file_(M, File), T, [c_stack(CStack)]),
+    thread_join(T, Exit),
+    (   Exit = exited(Problem)
+    ->  true
+    ;   format(string(Text), "reading stopped: ~q", [Exit]),
+        Problem = 0-Text
+    ).
+
+check_file_(M, File) :-
+    catch(setup_call_cleanup(open(File, read, S, [encoding(utf8)]),
+                             check_terms_(M, S, Problem),
+                             close(S)),
+          E,
+          ( message_to_codes_(E, Text), Problem = 0-Text )),
+    thread_exit(Problem).
+
+check_terms_(M, S, Problem) :-
+    catch(read_term(S, T, [term_position(Pos)]), E, true),
+    (   nonvar(E)
+    ->  read_error_(E, Line, Text),
+        Problem = Line-Text
+    ;   T == end_of_file
+    ->  Problem = none
+    ;   stream_position_data(line_count, Pos, Line),
+        (   term_problem_(M, T, Text)
+        ->  Problem = Line-Text
+        ;   check_terms_(M, S, Problem)
+        )
+    ).
+
+read_error_(error(Formal, Context), Line, Text) :-
+    (   ( Context = stream(_, Line, _, _) ; Context = file(_, Line, _, _) )
+    ->  message_to_codes_(error(Formal, _), Text)
+    ;   Line = 0,
+        message_to_codes_(error(Formal, Context), Text)
+    ),
+    !.
+read_error_(E, 0, Text) :-
+    message_to_codes_(E, Text).
+
+term_problem_(_, T, "a variable is not a clause") :-
+    var(T),
+    !.
+term_problem_(_, (:- D), Text) :-
+    !,
+    directive_problem_(D, Text).
+term_problem_(_, (?- D), Text) :-
+    !,
+    directive_problem_(D, Text).
+term_problem_(M, Clause, Text) :-
+    clause_parts_(Clause, H, B),
+    (   head_problem_(M, H, Text)
+    ->  true
+    ;   body_problem_(B, Text)
+    ).
+
+directive_problem_(D, Text) :-
+    \+ allowed_directive_(D),
+    format(string(Text), "the directive :- ~q would run when the strategy loads; a strategy file holds goal/3 and its helpers as clauses, and its directives may only be dynamic, discontiguous or use_module(library(Name))", [D]).
+
+allowed_directive_(D) :-
+    var(D),
+    !,
+    fail.
+allowed_directive_(dynamic(Specs)) :- plain_specs_(Specs).
+allowed_directive_(discontiguous(Specs)) :- plain_specs_(Specs).
+allowed_directive_(use_module(library(L))) :- library_name_(L).
+allowed_directive_(use_module(library(L), _)) :- library_name_(L).
+allowed_directive_(ensure_loaded(library(L))) :- library_name_(L).
+
+plain_specs_(S) :- var(S), !, fail.
+plain_specs_((A, B)) :- !, plain_specs_(A), plain_specs_(B).
+plain_specs_([]) :- !.
+plain_specs_([S|Ss]) :- !, plain_specs_(S), plain_specs_(Ss).
+plain_specs_(N/A) :- atom(N), integer(A).
+
+library_name_(L) :-
+    atom(L),
+    atom_codes(L, [C|Cs]),
+    code_type(C, lower),
+    forall(member(X, Cs), code_type(X, csym)).
+
+clause_parts_((H0 :- B), H, B) :- !, H = H0.
+clause_parts_(((H0, G) => B), H, (G, B)) :- !, H = H0.
+clause_parts_((H0 => B), H, B) :- !, H = H0.
+clause_parts_((H0 --> B), H, B) :- !, ( nonvar(H0), H0 = (H1, _) -> H = H1 ; H = H0 ).
+clause_parts_(H, H, true).
+
+head_problem_(_, H, "a clause whose head is not a predicate") :-
+    \+ callable(H),
+    !.
+head_problem_(_, Q:H, Text) :-
+    !,
+    (   callable(H) -> functor(H, N, A) ; N = H, A = 0 ),
+    format(string(Text), "a clause for ~q:~q/~w; a strategy defines its predicates where it is loaded, not in another module", [Q, N, A]).
+head_problem_(M, H, Text) :-
+    functor(H, N, A),
+    functor(G, N, A),
+    (   hook_(N, A)
+    ->  format(string(Text), "a clause for ~q/~w, which SWI-Prolog calls while it loads files; a strategy may not define it", [N, A])
+    ;   built_in_(N, A)
+    ->  format(string(Text), "a clause for the built-in predicate ~q/~w", [N, A])
+    ;   current_predicate(M:N/A),  % asked first: predicate_property/2 could autoload
+        \+ predicate_property(M:G, dynamic),
+        \+ predicate_property(M:G, imported_from(_))
+    ->  format(string(Text), "a clause for ~q/~w, which rules/route.pl defines; a strategy uses route.pl's predicates and may not redefine them", [N, A])
+    ).
+
+hook_(term_expansion, 2).
+hook_(term_expansion, 4).
+hook_(goal_expansion, 2).
+hook_(goal_expansion, 4).
+
+body_problem_(B, Text) :-
+    sub_term(S, B),
+    callable(S),
+    functor(S, N, A),
+    forbidden_(N, A),
+    !,
+    format(string(Text), "it names ~q/~w; a strategy may not end the process, run programs, load code or change files", [N, A]).
 
 message_to_codes(E, _, Codes) :-
     '$messages':translate_message(E, Lines, []),

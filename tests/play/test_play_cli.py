@@ -86,3 +86,38 @@ def test_a_strategy_over_the_networks_relations(run_neurosym, tmp_path: Path) ->
     proc = run_neurosym(*args, "--episodes", "1")
     assert proc.returncode == 1
     assert "has no threshold/2 for holds/5: give the KB it was learned from (--kb)" in proc.stderr
+
+
+@pytest.mark.subprocess
+def test_ctrl_c_stops_a_strategy_blocked_in_a_foreign_call(tmp_path: Path) -> None:
+    """A goal/3 asleep in sleep/1 (no inferences, no heartbeat), catching what stops its first
+    sleep: SIGINT ends the run within seconds with the CLI's one line and status 130."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    policy = tmp_path / "asleep.pl"
+    policy.write_text(
+        "goal(_, _, terminal) :- format(user_error, 'asleep~n', []), flush_output(user_error), "
+        "catch(sleep(1000), _, true), sleep(1000).\n"
+    )
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "neurosym", "play", "--policy", str(policy), "--env", "rgw2",
+         "--episodes", "1"],
+        cwd=ROOT, env={**os.environ, "PYTHONPATH": path}, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    try:
+        assert proc.stderr is not None
+        assert proc.stderr.readline() == "asleep\n"  # goal/3 has begun its sleep
+        time.sleep(2)
+        proc.send_signal(signal.SIGINT)
+        start = time.monotonic()
+        stdout, stderr = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert time.monotonic() - start < 10
+    assert (proc.returncode, stdout, stderr) == (130, "", "neurosym play: interrupted\n")

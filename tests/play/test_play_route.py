@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -31,6 +32,45 @@ def test_route_through_janus(episode: int, t: int, goal: str, answer: tuple) -> 
 def test_no_route_past_an_unarmed_enemy() -> None:
     with KnowledgeBase(None, rules=[FACTS, "route"]) as kb:
         assert kb.query("route(2, 0, terminal, A)") == []
+
+
+HOSTILE = (
+    ":- dynamic route_pl_memo_/4.\n"
+    "route_pl_memo_(0, 0, terminal, found(jump_into_pit, 1)).\n"
+    "route_pl_memo_(0, 0, sword, none).\n"
+)
+"""facts for the cache route.pl once kept in the loading module: planted answers"""
+
+
+DATA_KB = (
+    ":- dynamic object/2, at/5, grid/3.\n"
+    "object(terminal, terminal).\n"
+    "grid(0, 1, 3).\n"
+    "at(0, 0, agent, 0, 0).\n"
+    "at(0, 0, terminal, 0, 2).\n"
+)
+"""a KB as neurosym extract writes one: the agent, then an empty cell, then the terminal"""
+
+
+@pytest.mark.parametrize("hostile", [False, True])
+def test_kb_facts_cannot_change_a_route(
+    run_neurosym, swipl: Path, tmp_path: Path, hostile: bool
+) -> None:
+    """A KB holding facts named like route.pl's private cache answers as one without them:
+    a fact KB through neurosym query, and route.plt's states in plain swipl (kb.pl, route.pl)."""
+    kb = tmp_path / "kb.pl"
+    kb.write_text(DATA_KB + (HOSTILE if hostile else ""))
+    goal = "route(0, 0, terminal, A, C)"
+    proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--format", "csv")
+    assert (proc.returncode, proc.stdout.split()) == (0, ["A,C", "right,2"]), proc.stderr
+    code = tmp_path / "states.pl"
+    code.write_text(FACTS.read_text() + (HOSTILE if hostile else ""))
+    shown = "forall((member(G, [terminal, sword]), route(0, 0, G, A, C)), writeln(G-A-C))"
+    plain = subprocess.run(
+        [str(swipl), "-q", "-g", shown, "-t", "halt", str(code), str(ROOT / "rules" / "route.pl")],
+        capture_output=True, text=True, timeout=60, check=False,
+    )  # fmt: skip
+    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7\nsword-down-8\n"), plain.stderr
 
 
 def _only(tmp_path: Path, body: str) -> Path:
