@@ -128,6 +128,14 @@ def _trust(trusted: bool | PathArg | Sequence[PathArg]) -> Any:
     return lambda path: Path(path).resolve() in chosen
 
 
+def _sha256(path: Path) -> str:
+    """The SHA-256 of ``path``'s bytes; a file that cannot be read is one line."""
+    try:
+        return signature.sha256(path)
+    except OSError as exc:
+        raise PrologError(f"cannot read {path}: {exc.strerror or type(exc).__name__}") from None
+
+
 def _janus() -> Any:
     """janus with the bridge module and the fact reader loaded (once per process)."""
     return janus_with(bridge, fact_reader)
@@ -311,7 +319,7 @@ class KnowledgeBase:
                     f"compiled by neurosym on this account ({reason}); load its .pl source "
                     f"instead, or trust the file (--trust {path.name} / trusted=True)"
                 )
-            self._finish(path, *self._load_file(path, "qlf", data=copy.path))
+            self._finish(path, *self._load_file(path, "qlf", data=copy.path, nesting=copy.nesting))
 
     def load_rules(self, path: PathArg) -> None:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
@@ -344,9 +352,11 @@ class KnowledgeBase:
             if not errors:
                 self._finish(path, errors, notes)
                 return
+        # The source is only hashed to find a .qlf signed for it; it is
+        # copied (hashed again) only when it has to be checked and compiled.
+        if not trusted and self._load_qlf_if_signed(path, target, _sha256(path)):
+            return
         with snapshot(path) as source:
-            if not trusted and self._load_qlf_if_signed(path, target, source.sha256):
-                return
             if not trusted:
                 self._read_facts(path, "check", source)  # nothing of an unchecked source is compiled
             try:
@@ -363,7 +373,7 @@ class KnowledgeBase:
         with snapshot(target) as copy:
             if signature.check_digests(target, copy.sha256, source_sha, path.name) is not None:
                 return False
-            errors, notes = self._load_file(path, "qlf", data=copy.path)
+            errors, notes = self._load_file(path, "qlf", data=copy.path, nesting=copy.nesting)
         if errors:  # e.g. a .qlf of another SWI-Prolog version: compiled again
             return False
         self._finish(path, errors, notes)
@@ -404,11 +414,16 @@ class KnowledgeBase:
         self.files.append(path)
 
     def _load_file(
-        self, path: Path, fmt: str, data: Path | None = None
+        self, path: Path, fmt: str, data: Path | None = None, nesting: int | None = None
     ) -> tuple[list[str], list[str]]:
         """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error.
 
-        ``data``: the file to read the bytes from (a private copy), when not ``path`` itself.
+        ``data``: the file to read the bytes from (a private copy), when not
+        ``path`` itself. ``nesting``: the nesting bound that sizes the loading
+        thread's C stack, when known: a signed ``.qlf`` is sized by the
+        brackets counted as it was copied (its terms come from a source
+        checked as data, at most MAX_DEPTH deep, or from trusted code), other
+        files by :func:`~neurosym.prolog.snapshot.nesting_bound`.
         """
         if fmt == "qlf":
             load_file = data or qlf_path(path)
@@ -421,7 +436,9 @@ class KnowledgeBase:
             load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
-        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting_bound(load_file)
+        if nesting is None:
+            nesting = nesting_bound(load_file)
+        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting
         answer = _call_once(
             f"{bridge.MODULE}:load(M, Id, File, Format, CStack, Messages)",
             {
