@@ -27,8 +27,10 @@ UTF-8, or not valid in the encoding it declares) is refused too. Files are
 read in a thread of their own whose C stack holds a level of nesting for
 every opening bracket of the file: embedded in Python, SWI-Prolog has no
 guard against C-stack overflow, and a term nested 50,000 deep killed the
-process. (Each level of nesting takes an opening bracket or a prefix
-operator, so their count bounds the depth.)
+process. (The parser recurses on opening brackets only, operators are
+parsed in a loop, so the file's count of opening brackets bounds the depth
+a parse reaches; a term nested deeper than the limit is refused right after
+it is read, before anything else walks it.)
 
 Anything else stops the load with ``error-Text``, one line naming file, line
 and what was found. Clauses are added with ``assertz/1`` as they are read;
@@ -36,17 +38,21 @@ a refusal further down erases what this file added, so a refused file
 leaves the KB as it was. With mode ``check`` nothing is asserted (used
 before compiling a source to ``.qlf``). The caller passes a private copy of
 the file (:mod:`neurosym.prolog.snapshot`), so the bytes checked are the
-bytes loaded or compiled. Reading is the cost (``read_term``
-takes about 1.5 us a fact here, consult about 10), so on a machine with 4
-cores or more, files of 8 MB and more are cut at line starts and read by one
-helper thread per core (up to 4 threads in all) in small checked batches,
-added in file order; a cut is used only when the chunk before it ends exactly
-there, so results, order and error lines are those of a front-to-back read.
-On 2 cores the chunked read was slower than one thread (1 M facts: 2.5-2.6 s
-against 2.1-2.2 s, bench/kb.py on quiet cores: the main thread still adds
-every fact and copies each helper's batches out of its queue), so there a
-file is read front to back; ``set_reader_threads/1`` overrides the choice
-(tests use it to run the chunked path on any machine).
+bytes loaded or compiled.
+
+Reading is the cost: ``read_term/3`` is about 4/5 of a load, ``assertz/1``
+most of the rest (no read option made reading measurably cheaper, and
+loading the same text with ``load_files/2`` from a stream, read and compiled,
+took 6 times as long as reading it and adding the terms with ``assertz/1``). So files of 8 MB and more are
+cut at line starts into one chunk per core (up to 4): helper threads read
+and check chunks 1.. into lists on their own stacks while the loading thread
+reads and adds chunk 0 (the smaller one), then each helper adds its own list
+in turn, so clauses are added in file order and never copied between
+threads. A cut is used only when the chunk before it ends exactly there, and
+a helper's chunk only when all of it is plain facts read without a warning;
+otherwise the loading thread reads that part itself, so results, order and
+error lines are those of a front-to-back read. ``set_reader_threads/1``
+overrides the choice (tests use it to run the chunked path on any machine).
 """
 
 from __future__ import annotations
@@ -68,7 +74,7 @@ chunk_bytes_(8388608).
 :- dynamic reader_threads_/1. % set: threads that read a large file (1: front to back)
 
 %!  set_reader_threads(+Threads) is det.
-%   Threads reading a large file, 1 to 4; auto: the cores if 4 or more, else 1.
+%   Threads reading a large file, 1 to 4; auto: the cores, up to 4.
 set_reader_threads(Threads) :-
     (   Threads == auto
     ->  retractall(reader_threads_(_))
@@ -103,8 +109,8 @@ set_chunk_bytes(Bytes) :-
 %   these are what turn a C-stack overflow into an error: parsing a term
 %   nested deeper than the C stack holds would kill the process. So File is
 %   read in a thread of its own whose C stack holds more levels than any term
-%   in File can have (the caller bounds them, counting opening brackets and
-%   prefix operators in a copy nobody else writes).
+%   in File can reach while it is parsed (the caller counts the opening
+%   brackets of a copy nobody else writes).
 load_facts(M, File, Mode, RuleFiles, CStack, Count, Status) :-
     catch(thread_create(load_facts_(M, File, Mode, RuleFiles, CStack), Id, [c_stack(CStack)]),
           E, true),

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import hashlib
+import os
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -34,13 +35,16 @@ class Snapshot:
 
     path: Path
     source: Path
-    sha256: str
+    sha256: str  # "" when not asked for
     nesting: int
 
 
 @contextlib.contextmanager
-def snapshot(source: Path) -> Iterator[Snapshot]:
+def snapshot(source: Path, digest: bool = True) -> Iterator[Snapshot]:
     """Copy ``source`` into a private temporary folder (0700), removed on exit.
+
+    ``digest=False`` leaves the SHA-256 out (a fact file read as data needs
+    none; a signature does).
 
     Raises :class:`PrologError` (one line) when ``source`` cannot be read or
     the temporary folder cannot be written.
@@ -50,7 +54,15 @@ def snapshot(source: Path) -> Iterator[Snapshot]:
     except OSError as exc:
         raise PrologError(f"cannot copy {source} to a private temporary folder: {exc.strerror}") from None
     try:
-        yield _copy(source, folder / source.name)
+        try:
+            str(folder).encode("utf-8")
+        except UnicodeEncodeError:
+            shown = os.fsencode(folder).decode("utf-8", "backslashreplace")
+            raise PrologError(
+                f"cannot load {source}: the temporary folder {shown} has a name that is not valid "
+                "UTF-8, which SWI-Prolog cannot open; set TMPDIR to another folder"
+            ) from None
+        yield _copy(source, folder / source.name, digest)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
@@ -112,13 +124,13 @@ def nesting_bound(path: Path) -> int:
     return nesting.count
 
 
-def _copy(source: Path, copy: Path) -> Snapshot:
+def _copy(source: Path, copy: Path, hashed: bool) -> Snapshot:
     """Copy ``source`` to ``copy``, hashing it and counting its brackets on the way.
 
     A failure to read names the source; a failure to write (a full disk, a
     file-size limit) names the private copy, so neither is mistaken for the other.
     """
-    digest = hashlib.sha256()
+    digest = hashlib.sha256() if hashed else None
     nesting = _Nesting(full=False)
     try:
         src = source.open("rb")
@@ -137,13 +149,14 @@ def _copy(source: Path, copy: Path) -> Snapshot:
                     raise PrologError(f"cannot read {source}: {_why(exc)}") from None
                 if not chunk:
                     break
-                digest.update(chunk)
+                if digest is not None:
+                    digest.update(chunk)
                 nesting.add(chunk)
                 try:
                     dst.write(chunk)
                 except OSError as exc:
                     raise PrologError(_write_error(source, copy, exc)) from None
-    return Snapshot(copy, source, digest.hexdigest(), nesting.count)
+    return Snapshot(copy, source, digest.hexdigest() if digest else "", nesting.count)
 
 
 def _why(exc: OSError) -> str:
