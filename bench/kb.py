@@ -159,9 +159,9 @@ def side_by_side(path: Path, baseline: Path, repeat: int) -> dict[str, object]:
         for _ in range(repeat):
             for label, tree in (("baseline", baseline), ("this", this)):
                 best[label].append(child_load(tree, path, how))
-        out[how] = {
-            label: round(min(t[0] for t in times), 3) for label, times in best.items()
-        } | {f"{label}_cpu": round(min(t[1] for t in times), 3) for label, times in best.items()}
+        out[how] = {label: round(min(t[0] for t in times), 3) for label, times in best.items()} | {
+            f"{label}_cpu": round(min(t[1] for t in times), 3) for label, times in best.items()
+        }
     return out
 
 
@@ -256,7 +256,10 @@ def main() -> None:
     print(json.dumps(machine), flush=True)
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:
         for n in (int(float(s)) for s in args.sizes.split(",")):
-            print(json.dumps(bench(n, Path(tmp), args.baseline, args.repeat, args.only_loads)), flush=True)
+            print(
+                json.dumps(bench(n, Path(tmp), args.baseline, args.repeat, args.only_loads)),
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

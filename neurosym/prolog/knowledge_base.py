@@ -121,7 +121,11 @@ _python_formatwarning = warnings.formatwarning
 
 
 def _formatwarning(
-    message: Warning | str, category: type[Warning], filename: str, lineno: int, line: str | None = None
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    line: str | None = None,
 ) -> str:
     """One plain line for a :class:`PrologWarning`; Python's format for every other warning."""
     if issubclass(category, PrologWarning):

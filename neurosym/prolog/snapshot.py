@@ -77,10 +77,11 @@ def snapshot(source: Path, digest: bool = True) -> Iterator[Snapshot]:
 # add operators.
 _BRACKETS = b"([{"
 _NESTING_BYTES = b"([{$+-:?\\"
+# (thread_initialization holds initialization: counted by that.)
 _PREFIX_WORDS = (
     b"discontiguous", b"dynamic", b"initialization", b"meta_predicate", b"module_transparent",
     b"multifile", b"public", b"table", b"thread_local", b"volatile",
-)  # fmt: skip  (thread_initialization holds initialization: counted by that)
+)  # fmt: skip
 _TAIL = 24  # longer than any word above: a word cut between two chunks is still counted
 
 

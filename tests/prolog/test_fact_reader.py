@@ -60,7 +60,9 @@ def test_chunks_read_what_a_front_to_back_read_reads(tmp_path: Path, chunk_bytes
 
 def test_helpers_add_the_chunks_they_read(tmp_path: Path, chunk_bytes: str) -> None:
     path = tmp_path / "kb.pl"
-    path.write_text(":- encoding(utf8).\n" + "".join(f"p({i}, f(x, [{i}]))." + "\n" for i in range(3000)))
+    path.write_text(
+        ":- encoding(utf8).\n" + "".join(f"p({i}, f(x, [{i}]))." + "\n" for i in range(3000))
+    )
     with KnowledgeBase(path) as kb:
         assert kb.count("p(_, _)") == 3000
         assert [a["I"] for a in kb.query("p(I, _)")] == list(range(3000))
