@@ -236,17 +236,21 @@ stop_helpers_(Helpers) :-
 % mode check, only checks it), then sends ready(End, Count, Preds, Lines-Col),
 % End the byte after its last term (eof at the end of the file), Preds the
 % Name/Arity it holds, Lines-Col the new lines it read and the column it
-% stopped at (the stream's position counts), or failed: at anything but plain facts, or a warning,
-% the main thread reads that part itself. Then it waits for add, adds its
-% list, and sends added.
+% stopped at (the stream's position counts), or failed: at anything but
+% plain facts, or a warning, the main thread reads that part itself. Then it
+% waits for add, adds its list, and sends added. stop_helpers_/1 stops it
+% with neurosym_stop at any point.
 read_chunk_(File, M, Mode, RuleFiles, Q, From, To) :-
+    catch(chunk_(File, M, Mode, RuleFiles, Q, From, To), neurosym_stop, true).
+
+chunk_(File, M, Mode, RuleFiles, Q, From, To) :-
     thread_self(Me),
     assertz(reading_(Me)),
     b_setval(neurosym_rule_files, RuleFiles),
     (   catch(setup_call_cleanup(
                   ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
                   ( line_count(S, L0), line_position(S, P0),
-                    chunk_terms_(S, M, Mode, To, -, -1, [], Terms, 0, K, Preds, End),
+                    chunk_terms_(S, M, Mode, To, -, -1, From, [], Terms, 0, K, Preds, End),
                     line_count(S, L1), line_position(S, P1) ),
                   close(S)),
               _, fail),
@@ -261,11 +265,11 @@ read_chunk_(File, M, Mode, RuleFiles, Q, From, To) :-
         thread_send_message(Q, failed)
     ).
 
-% chunk_terms_(+S, +M, +Mode, +To, +PName, +PArity, +Preds0, -Terms, +K0, -K, -Preds, -End):
+% chunk_terms_(+S, +M, +Mode, +To, +PName, +PArity, +B0, +Preds0, -Terms, +K0, -K, -Preds, -End):
 % the terms up to the one that reaches byte To (all of them in mode assert,
 % none in mode check), K counting them; fails at anything but a plain fact.
-chunk_terms_(S, M, Mode, To, PName, PArity, Preds0, Terms, K0, K, Preds, End) :-
-    read_(S, 0, T, QQ),
+chunk_terms_(S, M, Mode, To, PName, PArity, B0, Preds0, Terms, K0, K, Preds, End) :-
+    read_(S, 0, B0, T, QQ, B1),
     (   T == end_of_file
     ->  Terms = [], K = K0, Preds = Preds0, End = eof
     ;   QQ == [],
@@ -277,9 +281,9 @@ chunk_terms_(S, M, Mode, To, PName, PArity, Preds0, Terms, K0, K, Preds, End) :-
         ),
         ( Mode == assert -> Terms = [T|Terms1] ; Terms = Terms1 ),
         K1 is K0 + 1,
-        (   To \== eof, at_stop_(S, To, B), B >= To
+        (   To \== eof, at_stop_(S, To, B1, B), B >= To
         ->  Terms1 = [], K = K1, Preds = Preds1, End = B
-        ;   chunk_terms_(S, M, Mode, To, Name, Arity, Preds1, Terms1, K1, K, Preds, End)
+        ;   chunk_terms_(S, M, Mode, To, Name, Arity, B1, Preds1, Terms1, K1, K, Preds, End)
         )
     ).
 
@@ -344,8 +348,12 @@ helper_message_(Id, Q, Msg) :-
 % Like read_loop_, stopping after the term that reaches byte Stop: End is
 % that byte position, or eof.
 read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
+    byte_count(S, B0),
+    read_until_(S, M, Mode, Stop, PName, PArity, B0, N0, N, LName, LArity, End).
+
+read_until_(S, M, Mode, Stop, PName, PArity, B0, N0, N, LName, LArity, End) :-
     N1 is N0 + 1,
-    read_(S, N1, T, QQ),
+    read_(S, N1, B0, T, QQ, B1),
     (   T == end_of_file
     ->  N = N0, LName = PName, LArity = PArity, End = eof
     ;
@@ -365,31 +373,35 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
             Name2 = Name, Arity2 = Arity
         ),
         ( var(Stop1) -> Stop1 = Stop ; true ),
-        (   Stop1 \== never, at_stop_(S, Stop1, B), B >= Stop1
+        (   Stop1 \== never, at_stop_(S, Stop1, B1, B), B >= Stop1
         ->  N = N1, LName = Name2, LArity = Arity2, End = B
-        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, N1, N, LName, LArity, End)
+        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, B1, N1, N, LName, LArity, End)
         )
     ).
 
-%   at_stop_(+S, +Stop, -B): B is the byte position after the term just read,
-%   and after the white space that follows it when that reaches byte Stop:
-%   read_term/3 leaves the new line after a full stop unread, and a cut is a
-%   line start.
-at_stop_(S, Stop, B) :-
-    byte_count(S, B0),
+%   at_stop_(+S, +Stop, +B0, -B): B is B0, the byte position after the term
+%   just read, or the position after the white space that follows it when
+%   that reaches byte Stop: read_term/3 leaves the new line after a full stop
+%   unread, and a cut is a line start.
+at_stop_(S, Stop, B0, B) :-
     (   ( B0 >= Stop ; B0 + 4 < Stop )
     ->  B = B0
     ;   peek_code(S, C), C >= 0, code_type(C, space)
     ->  get_code(S, _),
-        at_stop_(S, Stop, B)
+        byte_count(S, B1),
+        at_stop_(S, Stop, B1, B)
     ;   B = B0
     ).
 
 % The tight loop: a fact of the same predicate as the previous one needs no
 % check beyond its functor and groundness; a new functor goes through check_/7 once.
 read_loop_(S, M, Mode, PName, PArity, N0, N) :-
+    byte_count(S, B0),
+    read_loop_(S, M, Mode, PName, PArity, B0, N0, N).
+
+read_loop_(S, M, Mode, PName, PArity, B0, N0, N) :-
     N1 is N0 + 1,
-    read_(S, N1, T, QQ),
+    read_(S, N1, B0, T, QQ, B),
     (   T == end_of_file
     ->  N = N0
     ;
@@ -400,19 +412,20 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
         ;   check_(T, S, M, Mode, N1, Name, Arity)
         ),
         (   Name == (:-)
-        ->  read_loop_(S, M, Mode, PName, PArity, N1, N)  % an accepted header
+        ->  read_loop_(S, M, Mode, PName, PArity, B, N1, N)  % an accepted header
         ;   ( Mode == assert -> assertz(M:T) ; true ),
-            read_loop_(S, M, Mode, Name, Arity, N1, N)
+            read_loop_(S, M, Mode, Name, Arity, B, N1, N)
         )
     ).
 
-%   read_(+S, +N, -T, -QQ): the N-th term of S (end_of_file at the end), refused
-%   when nested more than max_depth_/1 levels deep. Each level takes at least
-%   one opening bracket, so only a term whose text is longer than that limit
-%   is measured. The parse itself is safe: the reading thread's C stack holds
-%   as many levels as the file could nest (load_facts/7).
-read_(S, N, T, QQ) :-
-    byte_count(S, B0),
+%   read_(+S, +N, +B0, -T, -QQ, -B): the N-th term of S (end_of_file at the
+%   end), refused when nested more than max_depth_/1 levels deep; B0 and B:
+%   the byte positions before and after it. Each level takes at least one
+%   byte of text (an opening bracket or an operator), so only a term whose
+%   text is longer than that limit is measured (B - B0 counts the layout
+%   before it too: a bound, still). The parse itself is safe: the reading
+%   thread's C stack holds as many levels as the file's brackets (load_facts/7).
+read_(S, N, B0, T, QQ, B) :-
     read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
     byte_count(S, B),
     max_depth_(D),

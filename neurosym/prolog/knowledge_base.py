@@ -416,10 +416,11 @@ class KnowledgeBase:
     def _load_through_qlf(self, path: Path, trusted: bool) -> None:
         """Load ``path`` through its ``.qlf``, compiled first when that one will not do.
 
-        The source is read once, into a private copy: that copy is hashed,
-        checked as data and compiled, so the ``.qlf`` comes from the very
-        bytes that were checked; a signed ``.qlf`` is loaded from a private
-        copy of the bytes whose signature was checked.
+        The source is hashed to find a ``.qlf`` signed for those bytes, which
+        is loaded from a private copy of the bytes whose signature was
+        checked. Otherwise the source is read into a private copy that is
+        hashed, checked as data and compiled, so the ``.qlf`` comes from the
+        very bytes that were checked.
         """
         target = qlf_path(path)
         if trusted and is_fresh(path):
@@ -427,8 +428,6 @@ class KnowledgeBase:
             if not errors:
                 self._finish(path, errors, notes)
                 return
-        # The source is only hashed to find a .qlf signed for it; it is
-        # copied (hashed again) only when it has to be checked and compiled.
         if not trusted and self._load_qlf_if_signed(path, target, _sha256(path)):
             return
         with snapshot(path) as source:
