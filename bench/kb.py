@@ -11,7 +11,7 @@ episode: 16 steps x 4 heads x 8 relations, entity atoms including
   inside Prolog (CPU and wall), i.e. without process start-up;
 * ``janus_facts_s``: ``KnowledgeBase(path)`` in this process (wall), the
   default and safe path: the file is read as data (facts only, nothing runs),
-  front to back, or in parallel chunks on a machine with 4 cores or more
+  in parallel chunks, one per core (up to 4; front to back on one core)
   (``*_cpu_s``: CPU seconds of all threads, the steadier figure on a shared
   machine); ``janus_facts_1thread_s`` the same read forced into one thread,
   ``janus_facts_Nthreads_s`` forced into N = 2..4 chunk-reading threads;
@@ -31,7 +31,9 @@ main neurosym | tar -x -C /tmp/base``) the safe load and the signed-``.qlf``
 load are also timed side by side, each in a fresh process per try, this
 tree's code and the baseline's alternately, ``--repeat`` times (best of):
 ``side_by_side`` holds ``{"facts": {"baseline": s, "this": s}, "qlf": ...}``
-with the CPU seconds of all threads beside them.
+with the CPU seconds of all threads beside them. ``--only-loads`` keeps
+only the write, the compile, ``qlf_load_s`` (best of ``--repeat``) and the
+side-by-side loads: quicker on a busy machine.
 
 The first line describes the machine, its load average included: the figures
 are wall times on a machine that may be shared.
