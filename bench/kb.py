@@ -11,7 +11,7 @@ episode: 16 steps x 4 heads x 8 relations, entity atoms including
   inside Prolog (CPU and wall), i.e. without process start-up;
 * ``janus_facts_s``: ``KnowledgeBase(path)`` in this process (wall), the
   default and safe path: the file is read as data (facts only, nothing runs),
-  front to back, or in parallel chunks on a machine with 4 cores or more
+  in parallel chunks, one per core (up to 4; front to back on one core)
   (``*_cpu_s``: CPU seconds of all threads, the steadier figure on a shared
   machine); ``janus_facts_1thread_s`` the same read forced into one thread,
   ``janus_facts_Nthreads_s`` forced into N = 2..4 chunk-reading threads;
@@ -26,11 +26,21 @@ episode: 16 steps x 4 heads x 8 relations, entity atoms including
   builds its just-in-time index then), the other figures are medians of
   later calls with other bindings.
 
+With ``--baseline DIR`` (another neurosym source tree, e.g. ``git archive
+main neurosym | tar -x -C /tmp/base``) the safe load and the signed-``.qlf``
+load are also timed side by side, each in a fresh process per try, this
+tree's code and the baseline's alternately, ``--repeat`` times (best of):
+``side_by_side`` holds ``{"facts": {"baseline": s, "this": s}, "qlf": ...}``
+with the CPU seconds of all threads beside them. ``--only-loads`` keeps
+only the write, the compile, ``qlf_load_s`` (best of ``--repeat``) and the
+side-by-side loads: quicker on a busy machine.
+
 The first line describes the machine, its load average included: the figures
 are wall times on a machine that may be shared.
 
     python bench/kb.py                    # N = 1e4, 1e5, 1e6
     python bench/kb.py --sizes 10000      # quick
+    python bench/kb.py --sizes 1000000 --baseline /tmp/base --repeat 3
 """
 
 from __future__ import annotations
@@ -116,7 +126,50 @@ def query_ms(fn: Callable[[int], object], keys: list[int]) -> tuple[float, float
     return times[0], statistics.median(times[1:])
 
 
-def bench(n: int, directory: Path) -> dict[str, object]:
+_CHILD = """
+import json, sys, time
+from pathlib import Path
+from neurosym.prolog.knowledge_base import KnowledgeBase, _janus
+_janus()
+path, qlf = Path(sys.argv[1]), sys.argv[2] == "qlf"
+wall, cpu = time.perf_counter(), time.process_time()
+kb = KnowledgeBase(path, qlf=qlf)
+wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+kb.close()
+print(json.dumps([wall, cpu]))
+"""
+
+
+def child_load(tree: Path, path: Path, how: str) -> tuple[float, float]:
+    """(wall s, cpu s) of ``KnowledgeBase(path)`` (how: facts or qlf) in a fresh process
+    running the neurosym of ``tree``, timed inside it (start-up and Prolog's own start left out)."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(path), how],
+        capture_output=True, text=True, check=True, env=env, cwd=tree,
+    )  # fmt: skip
+    wall, cpu = json.loads(proc.stdout.splitlines()[-1])
+    return wall, cpu
+
+
+def side_by_side(path: Path, baseline: Path, repeat: int) -> dict[str, object]:
+    """Best-of-``repeat`` safe and signed-.qlf loads of ``path``, baseline and this tree alternately."""
+    this = Path(__file__).resolve().parent.parent
+    out: dict[str, object] = {}
+    for how in ("facts", "qlf"):
+        best: dict[str, list[float]] = {"baseline": [], "this": []}
+        for _ in range(repeat):
+            for label, tree in (("baseline", baseline), ("this", this)):
+                best[label].append(child_load(tree, path, how))
+        out[how] = {label: round(min(t[0] for t in times), 3) for label, times in best.items()} | {
+            f"{label}_cpu": round(min(t[1] for t in times), 3) for label, times in best.items()
+        }
+    return out
+
+
+def bench(
+    n: int, directory: Path, baseline: Path | None = None, repeat: int = 3, only_loads: bool = False
+) -> dict[str, object]:
     df = relation_table(n)
     path = directory / f"relation_{n}.pl"
     out: dict[str, object] = {"bench": "kb", "n": n, "predicate": "relation/7"}
@@ -126,10 +179,16 @@ def bench(n: int, directory: Path) -> dict[str, object]:
     )
     wall, _, qlf = timed(lambda: qcompile(path))
     out.update(qcompile_s=round(wall, 3), qlf_mb=round(Path(qlf).stat().st_size / 1e6, 1))
-    cpu, wall = swipl_load(path, qlf=False)
-    out.update(consult_s=round(wall, 3), consult_cpu_s=round(cpu, 3))
-    cpu, wall = swipl_load(Path(qlf), qlf=True)
+    if not only_loads:
+        cpu, wall = swipl_load(path, qlf=False)
+        out.update(consult_s=round(wall, 3), consult_cpu_s=round(cpu, 3))
+    walls = [swipl_load(Path(qlf), qlf=True) for _ in range(repeat if only_loads else 1)]
+    cpu, wall = min(walls, key=lambda t: t[1])
     out.update(qlf_load_s=round(wall, 3), qlf_load_cpu_s=round(cpu, 3))
+    if only_loads:
+        if baseline is not None:
+            out["side_by_side"] = side_by_side(path, baseline, repeat)
+        return out
 
     wall, cpu, kb = timed(lambda: KnowledgeBase(path))
     out.update(janus_facts_s=round(wall, 3), janus_facts_cpu_s=round(cpu, 3))
@@ -162,6 +221,8 @@ def bench(n: int, directory: Path) -> dict[str, object]:
         out.update(third_arg_once_first_ms=round(first, 3), third_arg_once_ms=round(median, 3))
         first, median = query_ms(lambda h: kb.count(goal, H=h), heads[:9])
         out.update(third_arg_count_ms=round(median, 3), third_arg_count_rows=kb.count(goal, H=0))
+    if baseline is not None:
+        out["side_by_side"] = side_by_side(path, baseline, repeat)
     return out
 
 
@@ -173,6 +234,17 @@ def main() -> None:
     parser.add_argument(
         "--dir", default=None, help="Where to write the KB files (default: a temporary directory)."
     )
+    parser.add_argument(
+        "--baseline", type=Path, default=None,
+        help="Another neurosym source tree: time its safe and .qlf loads beside this one's.",
+    )  # fmt: skip
+    parser.add_argument(
+        "--repeat", type=int, default=3, help="Tries per side-by-side figure, best of (default: 3)."
+    )
+    parser.add_argument(
+        "--only-loads", action="store_true",
+        help="Skip consult, the other janus loads and the queries (quicker on a busy machine).",
+    )  # fmt: skip
     args = parser.parse_args()
     swipl = find_swipl()
     machine = {
@@ -186,7 +258,10 @@ def main() -> None:
     print(json.dumps(machine), flush=True)
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:
         for n in (int(float(s)) for s in args.sizes.split(",")):
-            print(json.dumps(bench(n, Path(tmp))), flush=True)
+            print(
+                json.dumps(bench(n, Path(tmp), args.baseline, args.repeat, args.only_loads)),
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -54,10 +54,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--kb", action="append", required=True, metavar="FILE",
         help="Fact file (.pl or .qlf) to load as data (facts only, nothing runs); repeatable.",
     )  # fmt: skip
+    from neurosym.shipped import shipped_rule_names
+
+    shipped = ", ".join(shipped_rule_names()) or "none found"
     parser.add_argument(
         "--rules", action="append", default=[], metavar="FILE",
-        help="Rule file to load as code, before the facts, or a shipped one by name "
-        "(rgw, boxworld, relations, causal, meaning); repeatable.",
+        help=f"Rule file to load as code, before the facts, or a shipped one by name ({shipped}); "
+        "repeatable.",
     )  # fmt: skip
     parser.add_argument(
         "--trust", action="append", default=[], metavar="FILE",
@@ -139,7 +142,7 @@ def _bindings(specs: list[str]) -> dict[str, Any]:
 def _plain(value: Any) -> Any:
     """JSON-friendly value: compound terms become their Prolog text, as do
     infinities and NaN (JSON has no number for them)."""
-    if isinstance(value, list):
+    if isinstance(value, tuple):  # a Prolog list
         return [_plain(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
         return str(value)
@@ -149,7 +152,7 @@ def _plain(value: Any) -> Any:
 
 
 def _text(value: Any) -> str:
-    if isinstance(value, list):
+    if isinstance(value, tuple):  # a Prolog list
         from neurosym.terms import format_value
 
         return format_value(value)
@@ -240,7 +243,14 @@ def _solve(args: argparse.Namespace, bounds: dict[str, Any], inputs: dict[str, A
         kb = KnowledgeBase(args.kb, rules=rules, qlf=args.qlf, trusted=args.trust)
     with kb:
         names, rows = kb.solve(args.goal, limit=args.limit, **bounds, **inputs)
-    return names, rows, [str(w.message) for w in caught]
+    return names, rows, [_warning_text(w) for w in caught]
+
+
+def _warning_text(caught: warnings.WarningMessage) -> str:
+    """A load warning as one line that names the user's file and line when it has one."""
+    if caught.lineno:
+        return f"{caught.filename}:{caught.lineno}: {caught.message}"
+    return str(caught.message)
 
 
 def run(args: argparse.Namespace) -> int:

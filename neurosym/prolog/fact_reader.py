@@ -27,8 +27,10 @@ UTF-8, or not valid in the encoding it declares) is refused too. Files are
 read in a thread of their own whose C stack holds a level of nesting for
 every opening bracket of the file: embedded in Python, SWI-Prolog has no
 guard against C-stack overflow, and a term nested 50,000 deep killed the
-process. (Each level of nesting takes an opening bracket or a prefix
-operator, so their count bounds the depth.)
+process. (The parser recurses on opening brackets only, operators are
+parsed in a loop, so the file's count of opening brackets bounds the depth
+a parse reaches; a term nested deeper than the limit is refused right after
+it is read, before anything else walks it.)
 
 Anything else stops the load with ``error-Text``, one line naming file, line
 and what was found. Clauses are added with ``assertz/1`` as they are read;
@@ -36,17 +38,22 @@ a refusal further down erases what this file added, so a refused file
 leaves the KB as it was. With mode ``check`` nothing is asserted (used
 before compiling a source to ``.qlf``). The caller passes a private copy of
 the file (:mod:`neurosym.prolog.snapshot`), so the bytes checked are the
-bytes loaded or compiled. Reading is the cost (``read_term``
-takes about 1.5 us a fact here, consult about 10), so on a machine with 4
-cores or more, files of 8 MB and more are cut at line starts and read by one
-helper thread per core (up to 4 threads in all) in small checked batches,
-added in file order; a cut is used only when the chunk before it ends exactly
-there, so results, order and error lines are those of a front-to-back read.
-On 2 cores the chunked read was slower than one thread (1 M facts: 2.5-2.6 s
-against 2.1-2.2 s, bench/kb.py on quiet cores: the main thread still adds
-every fact and copies each helper's batches out of its queue), so there a
-file is read front to back; ``set_reader_threads/1`` overrides the choice
-(tests use it to run the chunked path on any machine).
+bytes loaded or compiled.
+
+Reading is the cost: ``read_term/3`` is about 3/5 of a load, checking 1/5,
+``assertz/1`` 1/5 (SWI-Prolog's profiler, 200,000 relation/7 facts; no read
+option made reading measurably cheaper, and
+loading the same text with ``load_files/2`` from a stream, read and compiled,
+took 6 times as long as reading it and adding the terms with ``assertz/1``). So files of 8 MB and more are
+cut at line starts into one chunk per core (up to 4): helper threads read
+and check chunks 1.. into lists on their own stacks while the loading thread
+reads and adds chunk 0 (the smaller one), then each helper adds its own list
+in turn, so clauses are added in file order and never copied between
+threads. A cut is used only when the chunk before it ends exactly there, and
+a helper's chunk only when all of it is plain facts read without a warning;
+otherwise the loading thread reads that part itself, so results, order and
+error lines are those of a front-to-back read. ``set_reader_threads/1``
+overrides the choice (tests use it to run the chunked path on any machine).
 """
 
 from __future__ import annotations
@@ -56,7 +63,8 @@ from neurosym.terms import MAX_DEPTH
 MODULE = "neurosym_facts"
 
 _SOURCE = r"""
-:- module(neurosym_facts, [load_facts/7, set_chunk_bytes/1, set_reader_threads/1]).
+:- module(neurosym_facts, [load_facts/7, set_chunk_bytes/1, set_reader_threads/1,
+                            chunks_taken/1]).
 :- use_module(library(lists), [member/2, append/3]).
 :- use_module(library(apply), [exclude/3]).
 :- use_module(library(error), [must_be/2]).
@@ -67,7 +75,7 @@ chunk_bytes_(8388608).
 :- dynamic reader_threads_/1. % set: threads that read a large file (1: front to back)
 
 %!  set_reader_threads(+Threads) is det.
-%   Threads reading a large file, 1 to 4; auto: the cores if 4 or more, else 1.
+%   Threads reading a large file, 1 to 4; auto: the cores, up to 4.
 set_reader_threads(Threads) :-
     (   Threads == auto
     ->  retractall(reader_threads_(_))
@@ -80,8 +88,12 @@ reader_threads(Threads) :-
     (   reader_threads_(Threads)
     ->  true
     ;   current_prolog_flag(cpu_count, Cores),
-        ( Cores >= 4 -> Threads is min(Cores, 4) ; Threads = 1 )
+        Threads is max(1, min(Cores, 4))
     ).
+
+%!  chunks_taken(-Count) is det.
+%   How many helper chunks the last chunked load added as read (tests ask).
+chunks_taken(Count) :- flag(neurosym_chunks_taken, Count, Count).
 
 %!  set_chunk_bytes(+Bytes) is det.
 %   Tests read small files in chunks with this.
@@ -98,8 +110,8 @@ set_chunk_bytes(Bytes) :-
 %   these are what turn a C-stack overflow into an error: parsing a term
 %   nested deeper than the C stack holds would kill the process. So File is
 %   read in a thread of its own whose C stack holds more levels than any term
-%   in File can have (the caller bounds them, counting opening brackets and
-%   prefix operators in a copy nobody else writes).
+%   in File can reach while it is parsed (the caller counts the opening
+%   brackets of a copy nobody else writes).
 load_facts(M, File, Mode, RuleFiles, CStack, Count, Status) :-
     catch(thread_create(load_facts_(M, File, Mode, RuleFiles, CStack), Id, [c_stack(CStack)]),
           E, true),
@@ -155,18 +167,21 @@ no_warnings_(Owner) :-
     ;   true
     ).
 
-% A large file is cut at line starts into one chunk per core; helper threads
-% read and check chunks 1.. into lists while this thread reads chunk 0 and
-% adds it, then adds each helper's list in order. A cut is used only once the
-% chunk before it is known to end exactly there (so a cut inside a quoted
-% atom or comment is detected); otherwise, and on any helper trouble, this
-% thread simply reads on, so results, order and error lines never depend on
-% the cuts.
+% A large file is cut at line starts into one chunk per thread. Helper
+% threads read and check chunks 1.. into lists on their own stacks while this
+% thread reads chunk 0 and adds it; then each helper in turn, when told to,
+% adds its own list (nothing is copied between threads), so clauses are added
+% in file order. A helper's chunk is used only once the chunk before it is
+% known to end exactly at its first byte (so a cut inside a quoted atom or a
+% comment is detected), and only when the helper read all of it as plain
+% facts without a warning; otherwise this thread reads that part itself, so
+% results, order and error lines never depend on the cuts.
 load_(M, File, Mode, RuleFiles, Count) :-
     cuts_(File, Cuts),
+    flag(neurosym_chunks_taken, _, 0),
     setup_call_cleanup(
         ( open(File, read, S, [encoding(utf8)]),
-          start_helpers_(Cuts, File, M, RuleFiles, Helpers) ),
+          start_helpers_(Cuts, File, M, Mode, RuleFiles, Helpers) ),
         read_chunks_(Helpers, S, M, Mode, Count),
         ( close(S), stop_helpers_(Helpers) )).
 
@@ -177,12 +192,22 @@ cuts_(File, Cuts) :-
     (   Size >= Min, Threads >= 2, current_prolog_flag(threads, true)
     ->  setup_call_cleanup(open(File, read, S, [type(binary)]),
                            findall(Cut, ( between(1, Threads, I), I < Threads,
-                                          Guess is I * Size // Threads,
+                                          cut_guess_(I, Threads, Size, Guess),
                                           line_start_(S, Guess, Cut) ), Cuts0),
                            close(S)),
         sort(Cuts0, Cuts)
     ;   Cuts = []
     ).
+
+% This thread reads and adds chunk 0 while the helpers only read theirs, and
+% they add theirs after it, so chunk 0 is the smaller one: reading and
+% checking are about 4/5 of the work, and with 2 threads both finish reading
+% at about the same time when chunk 0 is 0.45 of the file (1 M facts: the
+% loading thread 2.6 s, the helper 2.6 s reading and 0.4 s adding, CPU
+% seconds on a busy machine).
+cut_guess_(I, Threads, Size, Guess) :-
+    First is 0.9 / Threads,
+    Guess is truncate(Size * (First + (I - 1) * (1 - First) / (Threads - 1))).
 
 line_start_(S, Guess, Cut) :-
     seek(S, Guess, bof, _),
@@ -191,71 +216,82 @@ line_start_(S, Guess, Cut) :-
     byte_count(S, Cut).
 
 % helper(Thread, Queue, From, To): the chunk [From, To), To = eof for the last one.
-start_helpers_(Cuts, File, M, RuleFiles, Helpers) :-
+start_helpers_(Cuts, File, M, Mode, RuleFiles, Helpers) :-
     append(Cuts, [eof], Ends),
-    start_helpers_(Cuts, Ends, File, M, RuleFiles, Helpers).
+    start_helpers_(Cuts, Ends, File, M, Mode, RuleFiles, Helpers).
 
-start_helpers_([], _, _, _, _, []).
-start_helpers_([From|Fs], [_, To|Ts], File, M, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
-    message_queue_create(Q, [max_size(64)]),
+start_helpers_([], _, _, _, _, _, []).
+start_helpers_([From|Fs], [_, To|Ts], File, M, Mode, RuleFiles, [helper(Id, Q, From, To)|Hs]) :-
+    message_queue_create(Q),
     b_getval(neurosym_c_stack, CStack),
-    thread_self(Owner),
-    thread_create(read_chunk_(Owner, File, M, RuleFiles, Q, From, To), Id, [c_stack(CStack)]),
-    start_helpers_(Fs, [To|Ts], File, M, RuleFiles, Hs).
+    thread_create(read_chunk_(File, M, Mode, RuleFiles, Q, From, To), Id, [c_stack(CStack)]),
+    start_helpers_(Fs, [To|Ts], File, M, Mode, RuleFiles, Hs).
 
-% A helper blocked on its full queue is woken by the queue's destruction.
+% A helper waiting for add is woken by the signal.
 stop_helpers_(Helpers) :-
     forall(member(helper(Id, Q, _, _), Helpers),
            (   catch(thread_signal(Id, throw(neurosym_stop)), _, true),
-               catch(message_queue_destroy(Q), _, true),
-               catch(thread_join(Id, _), _, true)
+               catch(thread_join(Id, _), _, true),
+               catch(message_queue_destroy(Q), _, true)
            )).
 
-% In a helper thread: sends batch(Terms, Pos) messages, then done(End), End
-% the byte after the last term (eof at the end of the file); it stops at
-% anything but plain facts, so the main thread reads that part itself.
-% Small batches keep the helper's stacks (and its garbage collections) small.
-read_chunk_(Owner, File, M, RuleFiles, Q, From, To) :-
-    assertz(reading_(Owner)),
-    b_setval(neurosym_rule_files, RuleFiles),
-    catch(setup_call_cleanup(
-              ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
-              chunk_batches_(S, M, Q, To, -, -1),
-              close(S)),
-          _, true),
-    catch(thread_send_message(Q, stop), _, true).
+% In a helper thread: reads and checks the chunk [From, To) into a list (in
+% mode check, only checks it), then sends ready(End, Count, Preds, Lines-Col),
+% End the byte after its last term (eof at the end of the file), Preds the
+% Name/Arity it holds, Lines-Col the new lines it read and the column it
+% stopped at (the stream's position counts), or failed: at anything but
+% plain facts, or a warning, the main thread reads that part itself. Then it
+% waits for add, adds its list, and sends added. stop_helpers_/1 stops it
+% with neurosym_stop at any point.
+read_chunk_(File, M, Mode, RuleFiles, Q, From, To) :-
+    catch(chunk_(File, M, Mode, RuleFiles, Q, From, To), neurosym_stop, true).
 
-% batch(Terms, Pos): whole, checked terms, Pos the byte after them. The main
-% thread reads on by itself from the last Pos when no done(End) comes.
-chunk_batches_(S, M, Q, To, PName, PArity) :-
-    catch(chunk_terms_(S, M, To, PName, PArity, 2000, Terms, Name, Arity, End), _, fail),
-    byte_count(S, Pos),
-    thread_send_message(Q, batch(Terms, Pos)),
-    (   End == more
-    ->  chunk_batches_(S, M, Q, To, Name, Arity)
-    ;   thread_send_message(Q, done(End))
+chunk_(File, M, Mode, RuleFiles, Q, From, To) :-
+    thread_self(Me),
+    assertz(reading_(Me)),
+    b_setval(neurosym_rule_files, RuleFiles),
+    (   catch(setup_call_cleanup(
+                  ( open(File, read, S, [encoding(utf8)]), seek(S, From, bof, _) ),
+                  ( line_count(S, L0), line_position(S, P0),
+                    chunk_terms_(S, M, Mode, To, -, -1, From, [], Terms, 0, K, Preds, End),
+                    line_count(S, L1), line_position(S, P1) ),
+                  close(S)),
+              _, fail),
+        \+ warned_(Me, _)
+    ->  Lines is L1 - L0,
+        ( Lines > 0 -> Col = P1 ; Col is P1 - P0 ),
+        thread_send_message(Q, ready(End, K, Preds, Lines-Col)),
+        thread_get_message(add),
+        add_all_(Terms, M),
+        thread_send_message(Q, added)
+    ;   retractall(warned_(Me, _)),
+        thread_send_message(Q, failed)
     ).
 
-% Up to K terms; End0 is more, eof, or the byte position past To.
-chunk_terms_(_, _, _, PName, PArity, 0, [], PName, PArity, more) :- !.
-chunk_terms_(S, M, To, PName, PArity, K, Terms, LName, LArity, End) :-
-    read_(S, 0, T, QQ),
+% chunk_terms_(+S, +M, +Mode, +To, +PName, +PArity, +B0, +Preds0, -Terms, +K0, -K, -Preds, -End):
+% the terms up to the one that reaches byte To (all of them in mode assert,
+% none in mode check), K counting them; fails at anything but a plain fact.
+chunk_terms_(S, M, Mode, To, PName, PArity, B0, Preds0, Terms, K0, K, Preds, End) :-
+    read_(S, 0, B0, T, QQ, B1),
     (   T == end_of_file
-    ->  Terms = [], LName = PName, LArity = PArity, End = eof
+    ->  Terms = [], K = K0, Preds = Preds0, End = eof
     ;   QQ == [],
         (   same_(T, PName, PArity)
-        ->  Name = PName, Arity = PArity
+        ->  Name = PName, Arity = PArity, Preds1 = Preds0
         ;   T \= (:- _),
-            check_(T, S, M, check, 0, Name, Arity)
+            check_(T, S, M, check, 0, Name, Arity),
+            ( memberchk(Name/Arity, Preds0) -> Preds1 = Preds0 ; Preds1 = [Name/Arity|Preds0] )
         ),
-        Terms = [T|Terms1],
-        byte_count(S, B),
-        (   To \== eof, B >= To
-        ->  Terms1 = [], LName = Name, LArity = Arity, End = B
-        ;   K1 is K - 1,
-            chunk_terms_(S, M, To, Name, Arity, K1, Terms1, LName, LArity, End)
+        ( Mode == assert -> Terms = [T|Terms1] ; Terms = Terms1 ),
+        K1 is K0 + 1,
+        (   To \== eof, at_stop_(S, To, B1, B), B >= To
+        ->  Terms1 = [], K = K1, Preds = Preds1, End = B
+        ;   chunk_terms_(S, M, Mode, To, Name, Arity, B1, Preds1, Terms1, K1, K, Preds, End)
         )
     ).
+
+add_all_([], _).
+add_all_([T|Ts], M) :- assertz(M:T), add_all_(Ts, M).
 
 % Chunk 0 from the stream, then each helper's chunk while the cuts hold.
 read_chunks_([], S, M, Mode, N) :- !,
@@ -264,56 +300,63 @@ read_chunks_(Helpers, S, M, Mode, N) :-
     Helpers = [helper(_, _, Cut, _)|_],
     read_until_(S, M, Mode, Cut, -, -1, 0, N0, PName, PArity, End),
     (   End == Cut
-    ->  take_chunks_(Helpers, S, M, Mode, PName, PArity, N0, N)
+    ->  line_count(S, Line),
+        take_chunks_(Helpers, S, M, Mode, Line, N0, N)
     ;   End == eof
     ->  N = N0
     ;   read_loop_(S, M, Mode, PName, PArity, N0, N)
     ).
 
-take_chunks_([], _, _, _, _, _, N, N).
-take_chunks_([helper(_, Q, From, To)|Hs], S, M, Mode, PName, PArity, N0, N) :-
-    take_batches_(Q, S, M, Mode, From, PName, PArity, N0, N1, Name, Arity, End),
-    (   End == To
-    ->  take_chunks_(Hs, S, M, Mode, Name, Arity, N1, N)
-    ;   End == eof
-    ->  N = N1
-    ;   End = failed(Pos)
-    ->  seek(S, Pos, bof, _),     % the batches before Pos were added
-        read_loop_(S, M, Mode, Name, Arity, N1, N)
-    ;   seek(S, End, bof, _),
-        read_loop_(S, M, Mode, Name, Arity, N1, N)
-    ).
-
-% Batches are added as they come: each is whole and checked. Anything but
-% done(End) (a helper that stopped, or one that is too slow) means: read on
-% from the byte after the last batch.
-take_batches_(Q, S, M, Mode, Pos, PName, PArity, N0, N, Name, Arity, End) :-
-    (   thread_get_message(Q, Msg, [timeout(60)]) -> true ; Msg = timeout ),
-    (   Msg = batch(Terms, Pos1)
-    ->  add_terms_(Terms, S, M, Mode, PName, PArity, N0, N1, Name1, Arity1),
-        take_batches_(Q, S, M, Mode, Pos1, Name1, Arity1, N1, N, Name, Arity, End)
-    ;   N = N0, Name = PName, Arity = PArity,
-        (   Msg = done(End)
+% Each helper adds its chunk once this thread has noted what the chunk
+% touches (for the rollback of a refused file); a helper that failed has its
+% chunk read here, and so has the rest of a chunk that did not end at the
+% next cut. Line: the line at From, so that a syntax error read here names
+% its line (the stream is positioned with its line count).
+take_chunks_([], _, _, _, _, N, N).
+take_chunks_([helper(Id, Q, From, To)|Hs], S, M, Mode, Line, N0, N) :-
+    helper_message_(Id, Q, Msg),
+    (   Msg = ready(End, K, Preds, Lines-Col)
+    ->  forall(member(Name/Arity, Preds), note_touched_(M, Name, Arity)),
+        thread_send_message(Id, add),
+        helper_message_(Id, Q, Done),
+        (   Done == added
         ->  true
-        ;   End = failed(Pos)
+        ;   throw(error(system_error('a reading thread stopped while adding its facts'), _))
+        ),
+        flag(neurosym_chunks_taken, Taken, Taken + 1),
+        N1 is N0 + K,
+        Line1 is Line + Lines,
+        (   End == To
+        ->  take_chunks_(Hs, S, M, Mode, Line1, N1, N)
+        ;   End == eof          % an end_of_file term ends the facts
+        ->  N = N1
+        ;   set_stream_position(S, '$stream_position'(End, Line1, Col, End)),
+            read_loop_(S, M, Mode, -, -1, N1, N)
         )
+    ;   set_stream_position(S, '$stream_position'(From, Line, 0, From)),
+        read_loop_(S, M, Mode, -, -1, N0, N)
     ).
 
-add_terms_([], _, _, _, PName, PArity, N, N, PName, PArity).
-add_terms_([T|Ts], S, M, Mode, PName, PArity, N0, N, Name, Arity) :-
-    N1 is N0 + 1,
-    (   same_(T, PName, PArity)
-    ->  Name1 = PName, Arity1 = PArity
-    ;   check_(T, S, M, Mode, N1, Name1, Arity1)
-    ),
-    ( Mode == assert -> assertz(M:T) ; true ),
-    add_terms_(Ts, S, M, Mode, Name1, Arity1, N1, N, Name, Arity).
+% The helper's next message; failed when it is gone without one.
+helper_message_(Id, Q, Msg) :-
+    (   thread_get_message(Q, Msg0, [timeout(1)])
+    ->  Msg = Msg0
+    ;   catch(thread_property(Id, status(running)), _, fail)
+    ->  helper_message_(Id, Q, Msg)
+    ;   thread_get_message(Q, Msg0, [timeout(0)])
+    ->  Msg = Msg0
+    ;   Msg = failed
+    ).
 
 % Like read_loop_, stopping after the term that reaches byte Stop: End is
 % that byte position, or eof.
 read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
+    byte_count(S, B0),
+    read_until_(S, M, Mode, Stop, PName, PArity, B0, N0, N, LName, LArity, End).
+
+read_until_(S, M, Mode, Stop, PName, PArity, B0, N0, N, LName, LArity, End) :-
     N1 is N0 + 1,
-    read_(S, N1, T, QQ),
+    read_(S, N1, B0, T, QQ, B1),
     (   T == end_of_file
     ->  N = N0, LName = PName, LArity = PArity, End = eof
     ;
@@ -333,17 +376,35 @@ read_until_(S, M, Mode, Stop, PName, PArity, N0, N, LName, LArity, End) :-
             Name2 = Name, Arity2 = Arity
         ),
         ( var(Stop1) -> Stop1 = Stop ; true ),
-        (   Stop1 \== never, byte_count(S, B), B >= Stop1
+        (   Stop1 \== never, at_stop_(S, Stop1, B1, B), B >= Stop1
         ->  N = N1, LName = Name2, LArity = Arity2, End = B
-        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, N1, N, LName, LArity, End)
+        ;   read_until_(S, M, Mode, Stop1, Name2, Arity2, B1, N1, N, LName, LArity, End)
         )
+    ).
+
+%   at_stop_(+S, +Stop, +B0, -B): B is B0, the byte position after the term
+%   just read, or the position after the white space that follows it when
+%   that reaches byte Stop: read_term/3 leaves the new line after a full stop
+%   unread, and a cut is a line start.
+at_stop_(S, Stop, B0, B) :-
+    (   ( B0 >= Stop ; B0 + 4 < Stop )
+    ->  B = B0
+    ;   peek_code(S, C), C >= 0, code_type(C, space)
+    ->  get_code(S, _),
+        byte_count(S, B1),
+        at_stop_(S, Stop, B1, B)
+    ;   B = B0
     ).
 
 % The tight loop: a fact of the same predicate as the previous one needs no
 % check beyond its functor and groundness; a new functor goes through check_/7 once.
 read_loop_(S, M, Mode, PName, PArity, N0, N) :-
+    byte_count(S, B0),
+    read_loop_(S, M, Mode, PName, PArity, B0, N0, N).
+
+read_loop_(S, M, Mode, PName, PArity, B0, N0, N) :-
     N1 is N0 + 1,
-    read_(S, N1, T, QQ),
+    read_(S, N1, B0, T, QQ, B),
     (   T == end_of_file
     ->  N = N0
     ;
@@ -354,19 +415,20 @@ read_loop_(S, M, Mode, PName, PArity, N0, N) :-
         ;   check_(T, S, M, Mode, N1, Name, Arity)
         ),
         (   Name == (:-)
-        ->  read_loop_(S, M, Mode, PName, PArity, N1, N)  % an accepted header
+        ->  read_loop_(S, M, Mode, PName, PArity, B, N1, N)  % an accepted header
         ;   ( Mode == assert -> assertz(M:T) ; true ),
-            read_loop_(S, M, Mode, Name, Arity, N1, N)
+            read_loop_(S, M, Mode, Name, Arity, B, N1, N)
         )
     ).
 
-%   read_(+S, +N, -T, -QQ): the N-th term of S (end_of_file at the end), refused
-%   when nested more than max_depth_/1 levels deep. Each level takes at least
-%   one opening bracket, so only a term whose text is longer than that limit
-%   is measured. The parse itself is safe: the reading thread's C stack holds
-%   as many levels as the file could nest (load_facts/7).
-read_(S, N, T, QQ) :-
-    byte_count(S, B0),
+%   read_(+S, +N, +B0, -T, -QQ, -B): the N-th term of S (end_of_file at the
+%   end), refused when nested more than max_depth_/1 levels deep; B0 and B:
+%   the byte positions before and after it. Each level takes at least one
+%   byte of text (an opening bracket or an operator), so only a term whose
+%   text is longer than that limit is measured (B - B0 counts the layout
+%   before it too: a bound, still). The parse itself is safe: the reading
+%   thread's C stack holds as many levels as the file's brackets (load_facts/7).
+read_(S, N, B0, T, QQ, B) :-
     read_term(S, T, [syntax_errors(error), quasi_quotations(QQ), module(neurosym_facts)]),
     byte_count(S, B),
     max_depth_(D),

@@ -30,10 +30,11 @@ Values cross the boundary as data, never as goal text:
   ``int``/``float`` -> number, ``bool`` -> ``true``/``false``,
   :class:`~neurosym.terms.Term` -> compound, list/tuple -> list;
 * outputs: atoms and strings -> ``str``, numbers -> ``int``/``float``,
-  lists -> ``list``, compound terms -> :class:`~neurosym.terms.Term` (whose
-  ``str()`` is the canonical text that recordings store, e.g.
-  ``picked(sword)``; lists inside a Term are tuples), an unbound output
-  variable -> None, an unbound variable inside a value ->
+  lists -> ``tuple`` (at the top of an answer as inside a Term, which must
+  stay hashable, and as :func:`~neurosym.terms.parse_term` reads them),
+  compound terms -> :class:`~neurosym.terms.Term` (whose ``str()`` is the
+  canonical text that recordings store, e.g. ``picked(sword)``), an unbound
+  output variable -> None, an unbound variable inside a value ->
   :class:`~neurosym.terms.Var` (``_G1``, shared within one answer).
 
 Values are at most :data:`~neurosym.terms.MAX_DEPTH` levels deep each way,
@@ -60,7 +61,9 @@ the KB's module, other directives run in module ``neurosym_qlf``.
 from __future__ import annotations
 
 import itertools
+import os
 import re
+import stat
 import warnings
 import weakref
 from collections.abc import Iterable, Sequence
@@ -106,18 +109,90 @@ class Answers(NamedTuple):
 
 
 class PrologWarning(UserWarning):
-    """A warning SWI-Prolog printed while loading a file (singleton variables, discontiguous clauses)."""
+    """A warning SWI-Prolog printed while loading a file (singleton variables, discontiguous clauses).
+
+    Its location is the user's file and line (not neurosym's source), and it
+    is shown as one line, ``rules.pl:3: warning: Singleton variables: [X]``.
+    """
+
+
+_LOCATED = re.compile(r"(?P<file>.+?):(?P<line>\d+):(?:\d+:)? (?P<text>.*)")
+_python_formatwarning = warnings.formatwarning
+
+
+def _formatwarning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    line: str | None = None,
+) -> str:
+    """One plain line for a :class:`PrologWarning`; Python's format for every other warning."""
+    if issubclass(category, PrologWarning):
+        where = f"{filename}:{lineno}: " if lineno else ""
+        return f"{where}warning: {message}\n"
+    return _python_formatwarning(message, category, filename, lineno, line)
+
+
+warnings.formatwarning = _formatwarning
+
+
+def _warn(note: str) -> None:
+    """Issue a Prolog load warning located at the file and line it names."""
+    located = _LOCATED.fullmatch(note)
+    if located:
+        filename, lineno, text = located["file"], int(located["line"]), located["text"]
+    else:
+        filename, lineno, text = "prolog", 0, note
+    warnings.warn_explicit(text, PrologWarning, filename, lineno, module="neurosym.prolog")
 
 
 class KnowledgeBaseFileNotFoundError(NeurosymError, FileNotFoundError):
     """A fact or rule file that does not exist."""
 
 
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
 def _existing(path: PathArg) -> Path:
+    """``path`` resolved, when it is a regular file whose name SWI-Prolog can take; else one line."""
     path = Path(path)
-    if not path.is_file():
-        raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {path}")
-    return path.resolve()
+    shown = _shown(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise KnowledgeBaseFileNotFoundError(f"no such Prolog file: {shown}") from None
+    except OSError as exc:
+        raise PrologError(f"cannot read {shown}: {exc.strerror or type(exc).__name__}") from None
+    if not stat.S_ISREG(mode):
+        kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
+        raise ConfigError(
+            f"cannot load {shown}: it is {kind}; a Prolog file (.pl or .qlf) is a regular file"
+        )
+    return _utf8_path(path.resolve())
+
+
+def _shown(path: Path) -> str:
+    """``path`` as text, bytes that are not UTF-8 written as ``\\xNN``."""
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
+
+
+def _utf8_path(path: Path) -> Path:
+    """``path``, when its name is valid UTF-8 (janus cannot pass any other name to Prolog)."""
+    try:
+        str(path).encode("utf-8")
+    except UnicodeEncodeError:
+        raise ConfigError(
+            f"cannot load {_shown(path)}: its name is not valid UTF-8, and SWI-Prolog opens files "
+            "by UTF-8 names; rename it (or copy it to a UTF-8 name)"
+        ) from None
+    return path
 
 
 def _trust(trusted: bool | PathArg | Sequence[PathArg]) -> Any:
@@ -126,6 +201,14 @@ def _trust(trusted: bool | PathArg | Sequence[PathArg]) -> Any:
         return lambda path: trusted
     chosen = {Path(p).resolve() for p in _as_paths(trusted)}
     return lambda path: Path(path).resolve() in chosen
+
+
+def _sha256(path: Path) -> str:
+    """The SHA-256 of ``path``'s bytes; a file that cannot be read is one line."""
+    try:
+        return signature.sha256(path)
+    except OSError as exc:
+        raise PrologError(f"cannot read {path}: {exc.strerror or type(exc).__name__}") from None
 
 
 def _janus() -> Any:
@@ -182,11 +265,11 @@ def _from_prolog(value: Any) -> Any:
             if type(arg) not in _SCALARS:
                 args[i] = _from_prolog(arg)
         return Term(functor, tuple(args))
-    if isinstance(value, list):
+    if isinstance(value, list):  # a tuple, as inside a Term (which must stay hashable)
         for i, item in enumerate(value):
             if type(item) not in _SCALARS:
                 value[i] = _from_prolog(item)
-        return value
+        return tuple(value)
     if isinstance(value, dict):  # the bridge's var:N
         return Var(f"_G{value['var']}")
     return value
@@ -311,7 +394,7 @@ class KnowledgeBase:
                     f"compiled by neurosym on this account ({reason}); load its .pl source "
                     f"instead, or trust the file (--trust {path.name} / trusted=True)"
                 )
-            self._finish(path, *self._load_file(path, "qlf", data=copy.path))
+            self._finish(path, *self._load_file(path, "qlf", data=copy.path, nesting=copy.nesting))
 
     def load_rules(self, path: PathArg) -> None:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
@@ -333,10 +416,11 @@ class KnowledgeBase:
     def _load_through_qlf(self, path: Path, trusted: bool) -> None:
         """Load ``path`` through its ``.qlf``, compiled first when that one will not do.
 
-        The source is read once, into a private copy: that copy is hashed,
-        checked as data and compiled, so the ``.qlf`` comes from the very
-        bytes that were checked; a signed ``.qlf`` is loaded from a private
-        copy of the bytes whose signature was checked.
+        The source is hashed to find a ``.qlf`` signed for those bytes, which
+        is loaded from a private copy of the bytes whose signature was
+        checked. Otherwise the source is read into a private copy that is
+        hashed, checked as data and compiled, so the ``.qlf`` comes from the
+        very bytes that were checked.
         """
         target = qlf_path(path)
         if trusted and is_fresh(path):
@@ -344,9 +428,9 @@ class KnowledgeBase:
             if not errors:
                 self._finish(path, errors, notes)
                 return
+        if not trusted and self._load_qlf_if_signed(path, target, _sha256(path)):
+            return
         with snapshot(path) as source:
-            if not trusted and self._load_qlf_if_signed(path, target, source.sha256):
-                return
             if not trusted:
                 self._read_facts(path, "check", source)  # nothing of an unchecked source is compiled
             try:
@@ -363,7 +447,7 @@ class KnowledgeBase:
         with snapshot(target) as copy:
             if signature.check_digests(target, copy.sha256, source_sha, path.name) is not None:
                 return False
-            errors, notes = self._load_file(path, "qlf", data=copy.path)
+            errors, notes = self._load_file(path, "qlf", data=copy.path, nesting=copy.nesting)
         if errors:  # e.g. a .qlf of another SWI-Prolog version: compiled again
             return False
         self._finish(path, errors, notes)
@@ -376,7 +460,7 @@ class KnowledgeBase:
         that what is checked is what is loaded.
         """
         if copy is None:
-            with snapshot(path) as copy:
+            with snapshot(path, digest=False) as copy:
                 return self._read_facts(path, mode, copy)
         answer = _call_once(
             f"{fact_reader.MODULE}:load_facts(M, File, Mode, Rules, CStack, Count, Status)",
@@ -400,15 +484,20 @@ class KnowledgeBase:
             first = errors[0] if str(path) in errors[0] else f"{path}: {errors[0]}"
             raise PrologError(f"cannot load {first}{more}")
         for note in notes:
-            warnings.warn(note, PrologWarning, stacklevel=3)
+            _warn(note)
         self.files.append(path)
 
     def _load_file(
-        self, path: Path, fmt: str, data: Path | None = None
+        self, path: Path, fmt: str, data: Path | None = None, nesting: int | None = None
     ) -> tuple[list[str], list[str]]:
         """Load ``path`` (its .qlf when fmt is 'qlf'); return (errors, warnings), unloading on error.
 
-        ``data``: the file to read the bytes from (a private copy), when not ``path`` itself.
+        ``data``: the file to read the bytes from (a private copy), when not
+        ``path`` itself. ``nesting``: the nesting bound that sizes the loading
+        thread's C stack, when known: a signed ``.qlf`` is sized by the
+        brackets counted as it was copied (its terms come from a source
+        checked as data, at most MAX_DEPTH deep, or from trusted code), other
+        files by :func:`~neurosym.prolog.snapshot.nesting_bound`.
         """
         if fmt == "qlf":
             load_file = data or qlf_path(path)
@@ -421,7 +510,9 @@ class KnowledgeBase:
             load_file = data or path
             source_id = f"{path}#{self.module}"  # same directory: relative includes still resolve
             aliases = {source_id: str(path)}
-        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting_bound(load_file)
+        if nesting is None:
+            nesting = nesting_bound(load_file)
+        c_stack = _C_STACK_BASE + _C_STACK_PER_LEVEL * nesting
         answer = _call_once(
             f"{bridge.MODULE}:load(M, Id, File, Format, CStack, Messages)",
             {

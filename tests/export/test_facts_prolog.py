@@ -104,11 +104,11 @@ def test_visit_order_matches_pandas(rgw: tuple) -> None:
         ["episode", "t"], kind="stable"
     )
     expected = {
-        int(e): list(dict.fromkeys(g["event"].map(visit))) for e, g in ev.groupby("episode")
+        int(e): tuple(dict.fromkeys(g["event"].map(visit))) for e, g in ev.groupby("episode")
     }
     got = {row["E"]: row["O"] for row in kb.query("visit_order(E, O)")}
-    assert got == {e: expected.get(e, []) for e in facts["episode"]["episode"]}
-    assert got[0] == ["sword", "teleport", "enemy", "terminal"]
+    assert got == {e: expected.get(e, ()) for e in facts["episode"]["episode"]}
+    assert got[0] == ("sword", "teleport", "enemy", "terminal")
     assert values(kb, "optimal_order(E)", "E") == [0]
 
 

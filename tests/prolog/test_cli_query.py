@@ -86,6 +86,20 @@ def test_goal_without_outputs_prints_true_or_false(
         (["--kb", "{facts}", "--bind", "X", "object(X, Y)"], "expected NAME=TERM"),
         (["--kb", "{facts}", "--limit", "0", "object(X, Y)"], "--limit must be at least 1"),
         (["--kb", "{dir}/bad.pl", "p(X)"], "cannot load {dir}/bad.pl:1:"),
+        (
+            ["--kb", "{dir}", "p(X)"],
+            "cannot load {dir}: it is a folder; a Prolog file (.pl or .qlf) is a regular file",
+        ),
+        (["--kb", "{dir}/fifo.pl", "p(X)"], "cannot load {dir}/fifo.pl: it is a named pipe (FIFO);"),
+        (["--kb", "/dev/null", "p(X)"], "cannot load /dev/null: it is a character device;"),
+        (
+            ["--kb", "{dir}/k\udcff.pl", "p(X)"],
+            "cannot load {dir}/k\\xff.pl: its name is not valid UTF-8",
+        ),
+        (
+            ["--kb", "{facts}", "--rules", "{dir}/r\udcff.pl", "p(X)"],
+            "cannot load {dir}/r\\xff.pl: its name is not valid UTF-8",
+        ),
     ],
 )
 def test_errors_are_one_line_and_exit_non_zero(
@@ -93,6 +107,9 @@ def test_errors_are_one_line_and_exit_non_zero(
 ) -> None:
     facts, _ = kb_files
     (facts.parent / "bad.pl").write_text("p(.\n")
+    os.mkfifo(facts.parent / "fifo.pl")
+    for name in ("k\udcff.pl", "r\udcff.pl"):  # byte 0xff: not UTF-8
+        (facts.parent / name).write_text("p(1).\n")
     fill = {"dir": str(facts.parent), "facts": str(facts)}
     proc = run_neurosym("query", *(a.format(**fill) for a in args))
     assert proc.returncode == 1
@@ -109,7 +126,45 @@ def test_load_warnings_go_to_stderr(run_neurosym, kb_files: tuple[Path, Path]) -
     proc = run_neurosym("query", "--kb", facts, "--rules", rules, "--format", "csv", "p(1)")
     assert proc.returncode == 0
     assert proc.stdout == "\n\n"  # no output variables: an empty header, one empty row
-    assert "neurosym query: warning: " in proc.stderr and "Singleton variables: [X]" in proc.stderr
+    assert proc.stderr == f"neurosym query: warning: {rules}:1: Singleton variables: [X]\n"
+
+
+def test_help_lists_every_shipped_rule_file(run_neurosym) -> None:
+    from neurosym.shipped import rules_dir
+
+    folder = rules_dir()
+    assert folder is not None
+    names = sorted(p.stem for p in folder.glob("*.pl"))
+    assert "route" in names
+    text = " ".join(run_neurosym("query", "--help").stdout.split())
+    assert f"a shipped one by name ({', '.join(names)})" in text
+
+
+def test_a_file_size_limit_is_named_not_read_errors(tmp_path: Path) -> None:
+    """Writing the private copy past RLIMIT_FSIZE is a write error, said as one."""
+    import resource
+
+    facts = tmp_path / "kb.pl"
+    facts.write_text("".join(f"p({i}).\n" for i in range(40_000)))  # 400 KB
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
+
+    repo = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(repo), "PYTHONDONTWRITEBYTECODE": "1"}
+    proc = subprocess.run(
+        [sys.executable, "-m", "neurosym", "query", "--kb", str(facts), "p(1)"],
+        capture_output=True, text=True, env=env, cwd=repo, preexec_fn=limit, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(
+        f"neurosym query: error: cannot load {facts}: neurosym reads a private copy of every "
+        "file it loads and could not write it to "
+    )
+    assert proc.stderr.endswith(
+        ": File too large (the file-size limit, ulimit -f, is smaller than the file)\n"
+    )
 
 
 # --- output shown as text, whole or not at all -----------------------------------

@@ -58,6 +58,30 @@ def test_chunks_read_what_a_front_to_back_read_reads(tmp_path: Path, chunk_bytes
         assert kb.query("later(X)") == []
 
 
+def test_helpers_add_the_chunks_they_read(tmp_path: Path, chunk_bytes: str) -> None:
+    path = tmp_path / "kb.pl"
+    path.write_text(
+        ":- encoding(utf8).\n" + "".join(f"p({i}, f(x, [{i}]))." + "\n" for i in range(3000))
+    )
+    with KnowledgeBase(path) as kb:
+        assert kb.count("p(_, _)") == 3000
+        assert [a["I"] for a in kb.query("p(I, _)")] == list(range(3000))
+    taken = _janus().query_once("neurosym_facts:chunks_taken(N)")["N"]
+    assert taken == (2 if chunk_bytes == "chunked" else 0)
+
+
+def test_a_header_in_a_late_chunk_is_read_in_order(tmp_path: Path, chunk_bytes: str) -> None:
+    lines = [f"p({i})." for i in range(3000)]
+    lines[2500] = ":- dynamic q/1."
+    path = tmp_path / "kb.pl"
+    path.write_text("\n".join(lines) + "\n")
+    with KnowledgeBase(path) as kb:
+        assert [a["I"] for a in kb.query("p(I)")] == [i for i in range(3000) if i != 2500]
+        assert kb.query("q(X)") == []
+    taken = _janus().query_once("neurosym_facts:chunks_taken(N)")["N"]
+    assert taken == (1 if chunk_bytes == "chunked" else 0)
+
+
 def test_a_payload_in_a_late_chunk_is_found_at_its_line(tmp_path: Path, chunk_bytes: str) -> None:
     text, _ = _tricky(3000)
     marker = tmp_path / "RAN"

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import pandas as pd
@@ -73,7 +74,7 @@ def test_values_come_back_as_plain_python(kb: KnowledgeBase) -> None:
     vals = kb.query("val(I, V)")
     assert [v["V"] for v in vals] == [-0.0, 1e16, 123456789012345678901234567890]
     assert str(vals[0]["V"]) == "-0.0"
-    assert kb.query("path(1, P)") == [{"P": ["a", Term("f", ("x",)), [1, 2]]}]
+    assert kb.query("path(1, P)") == [{"P": ("a", Term("f", ("x",)), (1, 2))}]
     assert kb.query("X = Y, Z = a-b") == [{"X": None, "Y": None, "Z": Term("-", ("a", "b"))}]
 
 
@@ -84,6 +85,16 @@ def test_rules_and_libraries(kb: KnowledgeBase) -> None:
     assert kb.count("event(_, _, _)") == 3
     assert kb.query("between(1, 10, X)", limit=2) == [{"X": 1}, {"X": 2}]
     assert kb.query("object(_Id, T)", limit=1) == [{"T": "agent"}]  # _Id is not an output
+
+
+def test_a_list_is_a_tuple_at_the_top_and_inside_a_term(kb: KnowledgeBase) -> None:
+    top = kb.once("path(1, P)")["P"]
+    inside = kb.once("path(1, P), T = w(P, [P])")["T"]
+    assert top == ("a", Term("f", ("x",)), (1, 2))
+    assert type(top) is tuple and type(top[2]) is tuple
+    assert inside == Term("w", (top, (top,)))
+    assert kb.solve("path(1, P)").rows == [[top]]
+    assert inside in {inside}  # a Term holding lists stays hashable
 
 
 def test_query_df_keeps_columns_when_empty(kb: KnowledgeBase) -> None:
@@ -159,7 +170,7 @@ def test_kbs_are_isolated(tmp_path: Path) -> None:
             kb2.query("q(X)")
         kb1.close()
         # closing one KB unloads nothing the others use (files, autoloaded libraries)
-        assert kb2.query("all(L)") == [{"L": [2]}]
+        assert kb2.query("all(L)") == [{"L": (2,)}]
         assert kb3.count("p(_)") == 1
         with pytest.raises(NeurosymError, match="is closed"):
             kb1.query("p(X)")
@@ -212,10 +223,15 @@ def test_load_errors_name_the_file_and_line(tmp_path: Path) -> None:
         assert kb.files == [good.resolve()]
 
 
-def test_load_warnings_become_python_warnings(tmp_path: Path) -> None:
-    rules = _write(tmp_path / "w.pl", "p(X) :- q.\nq.\n")
-    with pytest.warns(PrologWarning, match=r"w.pl:1: Singleton variables: \[X\]"):
+def test_load_warnings_are_one_line_at_the_users_file_and_line(tmp_path: Path) -> None:
+    rules = _write(tmp_path / "w.pl", "q.\np(X) :- q.\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         KnowledgeBase(None, rules=[rules]).close()
+    [w] = caught
+    assert (w.category, w.filename, w.lineno) == (PrologWarning, str(rules), 2)
+    shown = warnings.formatwarning(w.message, w.category, w.filename, w.lineno)
+    assert shown == f"{rules}:2: warning: Singleton variables: [X]\n"
 
 
 def test_relative_includes_resolve_beside_the_rule_file(tmp_path: Path) -> None:

@@ -406,8 +406,11 @@ def _nested(depth: int) -> str:
 
 @pytest.mark.parametrize(
     "nested",
-    [_nested(101), _nested(50_000), "[" * 400_000 + "x" + "]" * 400_000, "- " * 300_000 + "x"],
-    ids=["101", "50000", "lists", "prefix-operators"],
+    [
+        _nested(101), _nested(50_000), "[" * 400_000 + "x" + "]" * 400_000, "- " * 300_000 + "x",
+        "x-" * 300_000 + "x", "(x, " * 100_000 + "x" + ")" * 100_000,
+    ],
+    ids=["101", "50000", "lists", "prefix-operators", "infix-operators", "brackets-and-commas"],
 )
 def test_a_deeply_nested_fact_is_refused_and_python_lives_on(tmp_path: Path, nested: str) -> None:
     """Parsed past the C stack, such a fact killed the process (SIGSEGV): nothing printed."""
