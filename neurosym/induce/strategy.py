@@ -100,10 +100,14 @@ class Strategy:
         return render(self)
 
     def write(self, path: str | Path) -> Path:
-        """Write the learned file atomically."""
+        """Write the learned file atomically, once it reads back as the clauses learned."""
         from neurosym.atomic import write_bytes_atomic
+        from neurosym.induce.readback import check_reads_back
+        from neurosym.induce.strategy_writer import render_parts
 
-        return write_bytes_atomic(path, self.text().encode("utf-8"))
+        text, parts = render_parts(self)
+        check_reads_back(text, parts, path)
+        return write_bytes_atomic(path, text.encode("utf-8"))
 
 
 def _learn(

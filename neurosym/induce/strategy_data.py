@@ -40,21 +40,25 @@ MOVES = {"up": (-1, 0), "right": (0, 1), "down": (1, 0), "left": (0, -1)}
 """Action -> (row, col) offset of the cell it moves into."""
 
 TABLES = {
-    "object": "object(O, Ty0), term_to_atom(Ty0, Ty)",
+    "object": "object(O, Ty0), format(atom(Ty), '~k', [Ty0])",
     "at": "at(E, T, O, R, C)",
     "step": "step(E, T, A, _)",
     "event": "event(E, T, Ev0), term_to_atom(Ev0, Ev)",
-    "holding": "holding(E, T, I0), term_to_atom(I0, I)",
+    "holding": "holding(E, T, I0), format(atom(I), '~k', [I0])",
     "attends": "attends(E, T, H, Arg, _, R, C, _)",
-    "holds": "holds(E, T, r(J), X0, Y0), term_to_atom(X0, X), term_to_atom(Y0, Y)",
-    "attention": "attention(E, T, H, Q0, K0, _), term_to_atom(Q0, Q), term_to_atom(K0, K)",
+    "holds": "holds(E, T, r(J), X0, Y0), format(atom(X), '~k', [X0]), format(atom(Y), '~k', [Y0])",
+    "attention": (
+        "attention(E, T, H, Q0, K0, _), format(atom(Q), '~k', [Q0]), format(atom(K), '~k', [K0])"
+    ),
     "meta": "kb_meta(Key, V0), term_to_atom(V0, V)",
     "terrain": (
         "catch(terrain(E, Ty0, R, C), error(existence_error(_, _), _), fail), term_to_atom(Ty0, Ty)"
     ),
     "grid": "catch(grid(E, Rows, Cols), error(existence_error(_, _), _), fail)",
 }
-"""The goal that reads each table, compound terms as their Prolog text."""
+"""The goal that reads each table, compound terms as their Prolog text: types, items and
+entities canonical (``write_canonical``: quoted, no operators), which
+:func:`neurosym.terms.parse_term` reads back, so a learned file spells them as the KB does."""
 
 
 @dataclass
