@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
@@ -106,11 +107,84 @@ def load_trace(path: str | Path) -> Trace:
         raise ConfigError(f"no knowledge base at {path}; pass a kb.pl written by neurosym extract")
     with KnowledgeBase(path) as kb:
         tables = {name: _columns(kb.query_df(goal)) for name, goal in TABLES.items()}
+        named = kb.once(NAMED)
     meta = dict(zip(tables["meta"]["Key"], tables["meta"]["V"], strict=True))
     trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
     if trace.at.empty:
         raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
+    check_grids(trace)
+    heads = max(_top(trace.attends["H"]), _top(trace.attention["H"]), int(named["H"])) + 1 if named else 0
+    relations = max(_top(trace.holds["J"]), int(named["J"])) + 1 if named else 0
+    check_count(trace, "heads", heads, "attends/8, attention/6 and relation/7 facts")
+    check_count(trace, "relations", relations, "holds/5, relation/7 and threshold/2 facts")
     return trace
+
+
+NAMED = (
+    "( aggregate_all(max(H0), catch(relation(_, _, H0, _, _, _, _), _, fail), H) -> true ; H = -1 ), "
+    "( aggregate_all(max(J0), ( catch(relation(_, _, _, J0, _, _, _), _, fail) ; "
+    "catch(threshold(J0, _), _, fail) ), J) -> true ; J = -1 )"
+)
+"""The highest head and relation number the KB's relation/7 and threshold/2 facts name (-1: none)."""
+
+GRID_SLACK = 2
+"""A grid may be at most twice the rows (columns) the KB's facts reach, plus this."""
+
+
+def _top(column: pd.Series) -> int:
+    """The highest integer in ``column``, -1 when it is empty (or holds no integer)."""
+    values = pd.to_numeric(column, errors="coerce").dropna()
+    return int(values.max()) if len(values) else -1
+
+
+def _whole(value: object) -> bool:
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
+def check_grids(trace: Trace) -> None:
+    """Refuse a ``grid/3`` fact far larger than the cells the KB's ``at/5`` and ``terrain/4`` reach.
+
+    Route features search every cell of the grid for every state, so the
+    grid's size, a value read from the KB, sizes that work (``grid(0, 3000,
+    3000)`` with a 10 x 10 map of facts would take hours): it is bounded by
+    the map the facts show before any work is done.
+    """
+    if trace.grid.empty:
+        return
+    reach = []
+    for axis in ("R", "C"):
+        cells = pd.concat([trace.at[axis], trace.terrain[axis]], ignore_index=True)
+        reach.append(_top(cells) + 1)
+    limits = [2 * r + GRID_SLACK for r in reach]
+    for e, rows, cols in trace.grid[["E", "Rows", "Cols"]].itertuples(index=False):
+        if not all(_whole(v) and 0 <= v <= lim for v, lim in zip((rows, cols), limits, strict=True)):
+            raise ConfigError(
+                f"grid({e}, {rows}, {cols}) in {trace.path}: its at/5 and terrain/4 facts reach "
+                f"{reach[0]} rows and {reach[1]} columns, so a grid may have at most {limits[0]} rows "
+                f"and {limits[1]} columns (twice what the facts reach, plus {GRID_SLACK})"
+            )
+
+
+def check_count(trace: Trace, key: str, present: int, facts: str) -> None:
+    """Refuse a ``kb_meta(key, N)`` (heads, relations) that is no count or exceeds what the facts name.
+
+    The count sizes the relation features (a column per head and argument),
+    so ``kb_meta(heads, 20000000)`` would fill the memory: it may be at most
+    the number the KB's relation facts name (at least 1).
+    """
+    text = trace.meta.get(key)
+    if text is None:
+        return
+    allowed = max(present, 1)
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 <= value <= allowed:
+        raise ConfigError(
+            f"kb_meta({key}, {text}) in {trace.path}: {key} must be a whole number from 0 to "
+            f"{allowed} (the {key} its {facts} name)"
+        )
 
 
 def _contact(events: list[str], target: str | None, types: dict[str, str]) -> bool:

@@ -85,7 +85,7 @@ def clause_term(lits: list[Term]) -> Term:
     return Term(":-", (goal_term("goal", E_, T_, O_), body_term))
 
 
-def _clauses(strategy: Strategy) -> list[tuple[str, Term]]:
+def learned_clauses(strategy: Strategy) -> list[tuple[str, Term]]:
     """Each goal/3 clause's text, a comment first (how often it was right in training), and term."""
     out = []
     for i, clause in enumerate(strategy.model.clauses, 1):
@@ -104,7 +104,7 @@ def _clauses(strategy: Strategy) -> list[tuple[str, Term]]:
 
 def clauses_text(strategy: Strategy) -> str:
     """The goal/3 clauses, each with a comment: how often it was right in training."""
-    return "\n".join(text for text, _ in _clauses(strategy))
+    return "\n".join(text for text, _ in learned_clauses(strategy))
 
 
 HEADER = """/** <module> Learned strategy: the object the agent goes for next
@@ -145,7 +145,7 @@ def render_parts(strategy: Strategy) -> tuple[str, list[Part]]:
         f"{strategy.train_fidelity:.4f} on the {strategy.train_states} training states.",
         f"Learning took {strategy.seconds:.1f} s.",
     ]
-    clauses = _clauses(strategy)
+    clauses = learned_clauses(strategy)
     text = (
         f"%! features: {strategy.features}\n"
         + HEADER
