@@ -17,6 +17,14 @@ Events the KB cannot decide are reported as undetermined, not guessed.
 (:mod:`neurosym.induce.strategy`), prints the clauses and the fidelity (share
 of held-out states whose first answer is the labelled next object) and
 writes them as a Prolog file that loads in plain swipl beside a KB.
+
+Before any learning the options are checked, each refused in one line: a
+flag of ``--what strategy`` given with ``--what world``, an empty ``--out``,
+an ``--out`` that is one of the inputs or a published folder's product
+(:func:`neurosym.atomic.refuse_overwrite`) or lies under a file, and a KB
+name that is not UTF-8. A learned file is written only when SWI-Prolog
+reads it back as exactly the clauses learned (:mod:`neurosym.induce.readback`);
+what the command prints passes through :func:`neurosym.display.plain`.
 """
 
 from __future__ import annotations

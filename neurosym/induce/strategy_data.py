@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
+from neurosym.terms import format_value
 
 CONTACTS = frozenset(
     {
@@ -40,12 +41,19 @@ CONTACTS = frozenset(
 MOVES = {"up": (-1, 0), "right": (0, 1), "down": (1, 0), "left": (0, -1)}
 """Action -> (row, col) offset of the cell it moves into."""
 
+_KIND = "( compound({x}) -> functor({x}, Kind, _) ; Kind = {x} )"
+"""binds Kind to the kind of a type or item, as the learned file's object_kind/2 derives it"""
+
+KINDS: dict[str, str] = {}
+"""A type's (or held item's) canonical text -> the canonical text of its kind (``key(red)`` ->
+``key``), from Prolog's own answer: filled by :func:`load_trace`, read by the features."""
+
 TABLES = {
-    "object": "object(O, Ty0), format(atom(Ty), '~k', [Ty0])",
+    "object": "object(O, Ty0), format(atom(Ty), '~k', [Ty0]), " + _KIND.format(x="Ty0"),
     "at": "at(E, T, O, R, C)",
     "step": "step(E, T, A, _)",
     "event": "event(E, T, Ev0), term_to_atom(Ev0, Ev)",
-    "holding": "holding(E, T, I0), format(atom(I), '~k', [I0])",
+    "holding": "holding(E, T, I0), format(atom(I), '~k', [I0]), " + _KIND.format(x="I0"),
     "attends": "attends(E, T, H, Arg, _, R, C, _)",
     "holds": "holds(E, T, r(J), X0, Y0), format(atom(X), '~k', [X0]), format(atom(Y), '~k', [Y0])",
     "attention": (
@@ -108,6 +116,12 @@ def load_trace(path: str | Path) -> Trace:
     with KnowledgeBase(path) as kb:
         tables = {name: _columns(kb.query_df(goal)) for name, goal in TABLES.items()}
         named = kb.once(NAMED)
+    for name, column in (("object", "Ty"), ("holding", "I")):
+        table = tables[name]
+        for text, kind in zip(table[column], table["Kind"], strict=True):
+            if text not in KINDS:
+                KINDS[text] = format_value(kind)
+        tables[name] = table.drop(columns="Kind")
     meta = dict(zip(tables["meta"]["Key"], tables["meta"]["V"], strict=True))
     trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
     if trace.at.empty:

@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError, FactError
-from neurosym.induce.strategy_data import Trace
+from neurosym.induce.strategy_data import KINDS, Trace
 from neurosym.induce.strategy_route import (
     PASSABLE_KINDS,
     PASSABLE_TERRAIN,
@@ -76,7 +76,13 @@ def goal_text(goal: Term) -> str:
 
 def _kv(kind: str) -> TermArg:
     """A kind's value from its canonical text (:func:`_kind`)."""
-    return parse_term(kind)  # type: ignore[return-value]
+    try:
+        return parse_term(kind)  # type: ignore[return-value]
+    except FactError:
+        raise ConfigError(
+            f"object kind {kind} is not a term neurosym induce can write (an atom, a number or "
+            "a compound of them)"
+        ) from None
 
 
 BACKGROUND = r"""
@@ -178,16 +184,14 @@ attending_queries(E, T, H, O, N) :-
 def _kind(ty: str) -> str:
     """The canonical Prolog text of a type's kind: the type itself, or a compound's functor
     (``key`` for ``key(red)``), as ``object_kind/2`` in the learned file derives it."""
-    kind = _KINDS.get(ty)
+    kind = KINDS.get(ty)
     if kind is None:
-        kind = _KINDS[ty] = _kind_of(ty)
+        kind = KINDS[ty] = _kind_of(ty)
     return kind
 
 
-_KINDS: dict[str, str] = {}
-
-
 def _kind_of(ty: str) -> str:
+    """The kind of a type's canonical text not read by :func:`load_trace` (a Trace built by hand)."""
     try:
         value = parse_term(ty)
     except FactError:

@@ -58,7 +58,7 @@ def strategy_kb(path: Path, meta: tuple[str, str] = ("", ""), type_: str = "") -
         assert meta[0] in text
         text = text.replace(*meta)
     if type_:  # keys of another type; the contact event is then `opened` (a contact by name)
-        text = re.sub(r"object\(key_(\w+),key\(\w+\)\)", rf"object(key_\1,{type_}(\1))", text)
+        text = re.sub(r"object\(key_(\w+),key\(\w+\)\)", lambda m: f"object(key_{m[1]},{type_}({m[1]}))", text)
         text = re.sub(r"event\((\d+),(\d+),got\(key\(\w+\)\)\)", r"event(\1,\2,opened)", text)
     path.write_text(text)
     return path
@@ -82,7 +82,7 @@ def hostile_world_kb(source: Path, path: Path, meta: str = "", wall: str = "") -
     if meta:
         text = text.replace("kb_meta(env,'rgw-random').", meta)
     if wall:
-        text = re.sub(r"^terrain\((\d+),wall,", rf"terrain(\1,{wall},", text, flags=re.M)
+        text = re.sub(r"^terrain\((\d+),wall,", lambda m: f"terrain({m[1]},{wall},", text, flags=re.M)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
     return path
