@@ -15,6 +15,9 @@ file under that name. Two details every writer needs and used to get wrong:
   would turn the device into a regular file. A target that exists and is not
   a regular file (a device, FIFO, socket or folder) is refused before
   anything is written (:func:`check_target`).
+* the inputs: an output that is one of the command's inputs (``--kb X --out
+  X``, or the link an extract folder publishes its KB under) would replace
+  it; :func:`refuse_overwrite` refuses that before the work starts.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ import os
 import stat
 import tempfile
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -167,3 +170,53 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     with open_atomic(path, "wb") as fh:
         fh.write(data)
     return Path(path)
+
+
+PUBLISH_STORE = ".neurosym"
+"""The hidden folder of a published output folder (:data:`neurosym.publish.STORE`): its run
+folders hold the products, and ``out/NAME`` links into it."""
+
+
+def refuse_overwrite(
+    out: str | os.PathLike[str],
+    inputs: Iterable[str | os.PathLike[str] | None],
+    flag: str = "--out",
+) -> Path:
+    """Refuse, with one OutputError line, an output that would replace an input or a published product.
+
+    ``out`` is refused when it is the same file as one of ``inputs`` (by
+    device and inode: through symbolic links, hard links and other spellings
+    of the path), when it is a product link of a published folder
+    (``out/kb.pl -> .neurosym/current/kb.pl``, :mod:`neurosym.publish`), or
+    when it lies inside such a folder's store. Inputs that do not exist (or
+    None) are skipped. Call it before the work, so nothing is lost or done in vain.
+    """
+    path = Path(out)
+    try:
+        mine = os.stat(path)
+    except (OSError, ValueError):
+        mine = None
+    for source in inputs:
+        if source is None or mine is None:
+            continue
+        try:
+            theirs = os.stat(source)
+        except (OSError, ValueError):
+            continue
+        if (mine.st_dev, mine.st_ino) == (theirs.st_dev, theirs.st_ino):
+            raise OutputError(
+                f"{flag} {os.fspath(path)} is the input {os.fspath(source)} (the same file): "
+                "writing it would replace that input; choose another output; nothing was written"
+            )
+    if path.is_symlink() and Path(os.readlink(path)).parts[:1] == (PUBLISH_STORE,):
+        raise OutputError(
+            f"{flag} {os.fspath(path)} is a product of a published folder (a link into "
+            f"{PUBLISH_STORE}/); writing it would replace that product; choose another output; "
+            "nothing was written"
+        )
+    if PUBLISH_STORE in Path(os.path.abspath(path)).parts[:-1]:
+        raise OutputError(
+            f"{flag} {os.fspath(path)} lies inside a published folder's store ({PUBLISH_STORE}/), "
+            "which only the command that published it writes; choose another output; nothing was written"
+        )
+    return path

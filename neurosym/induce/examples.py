@@ -21,6 +21,7 @@ import pandas as pd
 
 from neurosym.errors import ConfigError
 from neurosym.induce.background import BACKGROUND, CELL_PREDICATES, COLOURED, STATE_PREDICATES
+from neurosym.terms import format_value
 
 PREDICATES = CELL_PREDICATES + STATE_PREDICATES
 _COLOURED = re.compile(r"(" + "|".join(COLOURED) + r")\(([a-z][A-Za-z0-9_]*)\)")
@@ -82,7 +83,25 @@ class Grounded:
         ]
 
 
-def _family(types: list[str], env: str) -> str:
+def _canonical(column: pd.Series) -> pd.Series:
+    """Each value as its canonical Prolog text (:func:`neurosym.terms.format_value`): the atom
+    ``'Wall'`` stays quoted, so a clause written with it reads back as the atom, not a variable."""
+    cache: dict[tuple[type, object], str] = {}
+
+    def text(value: object) -> str:
+        try:
+            key = (type(value), value)
+            if key not in cache:
+                cache[key] = format_value(value)
+            return cache[key]
+        except TypeError:  # a list: not hashable
+            return format_value(value)
+
+    return column.map(text)
+
+
+def env_family(types: list[str], env: str) -> str:
+    """The env family (``rgw`` or ``boxworld``) of a KB with these object types and this env."""
     if env.startswith(("bw", "boxworld")) or any(
         _COLOURED.fullmatch(t) or t == "gem" for t in types
     ):
@@ -129,10 +148,10 @@ def _ground(kb: object, path: Path) -> Grounded:
     answers = {}
     for pred in PREDICATES:
         df = kb.query_df(f"{pred}(E, T, W), step(E, T, _, _)")  # type: ignore[attr-defined]
-        df = df.assign(W=df["W"].map(str)).merge(index, on=["E", "T"])
+        df = df.assign(W=_canonical(df["W"])).merge(index, on=["E", "T"])
         answers[pred] = df[["s", "W"]].drop_duplicates()
     values = sorted(set().union(*(set(df["W"]) for df in answers.values())))
-    ev = events.assign(X=events["X"].map(str)).merge(index, on=["E", "T"])
+    ev = events.assign(X=_canonical(events["X"])).merge(index, on=["E", "T"])
     colours = sorted({m.group(2) for v in values + list(ev["X"]) for m in _COLOURED.finditer(v)})
     vindex = {v: i for i, v in enumerate(values)}
     matrix = {}
@@ -144,7 +163,7 @@ def _ground(kb: object, path: Path) -> Grounded:
     return Grounded(
         source=str(path),
         env=env,
-        family=_family(types, env),
+        family=env_family(types, env),
         keys=keys,
         values=values,
         matrix=matrix,

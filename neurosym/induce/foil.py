@@ -34,6 +34,7 @@ import numpy as np
 
 from neurosym.induce.background import CELL_PREDICATES
 from neurosym.induce.examples import PREDICATES, Grounded
+from neurosym.terms import Term, Var, parse_term
 
 HEAD_VAR = "C"
 _TEMPLATE_VAR = re.compile(r"\b" + HEAD_VAR + r"\b")
@@ -60,9 +61,16 @@ class Literal:
     negated: bool = False
 
     def text(self) -> str:
+        """The literal as Prolog text; ``value`` is already canonical (:func:`neurosym.terms.format_value`)."""
         arg = f"{self.functor}({self.var})" if self.functor else self.value
         neg = "\\+ " if self.negated else ""
         return f"{neg}{self.pred}(E, T, {arg})"
+
+    def term(self) -> Term:
+        """The literal as the term its text must read back as."""
+        arg = Term(self.functor, (Var(self.var or "_"),)) if self.functor else parse_term(self.value)
+        goal = Term(self.pred, (Var("E"), Var("T"), arg))
+        return Term("\\+", (goal,)) if self.negated else goal
 
     @property
     def named_var(self) -> str | None:
@@ -78,6 +86,20 @@ class Clause:
 
     def text(self) -> str:
         """The clause as Prolog text; a variable that occurs once is written ``_``."""
+        goals = [g if isinstance(g, str) else g.text() for g in self._goals()]
+        return f"predicts(E, T, {self.head}) :-\n    " + ",\n    ".join(goals) + "."
+
+    def term(self) -> Term:
+        """The clause as the term its text must read back as (:mod:`neurosym.induce.readback`)."""
+        goals = [_STEP if isinstance(g, str) else g.term() for g in self._goals()]
+        body = goals[-1]
+        for goal in reversed(goals[:-1]):
+            body = Term(",", (goal, body))
+        head = Term("predicts", (Var("E"), Var("T"), template_term(self.head)))
+        return Term(":-", (head, body))
+
+    def _goals(self) -> list[Literal | str]:
+        """The body in its written order: cell literals first, negations last, step/4 when needed."""
         uses = Counter(lit.named_var for lit in self.body if lit.named_var)
         uses.update([HEAD_VAR] if head_var(self.head) else [])
         body = [
@@ -87,10 +109,24 @@ class Clause:
         positive = [lit for lit in body if not lit.negated]
         negative = [lit for lit in body if lit.negated]
         positive.sort(key=lambda lit: lit.pred not in CELL_PREDICATES)  # bind E, T through step/4
-        goals = [lit.text() for lit in positive + negative]
+        goals: list[Literal | str] = [*positive, *negative]
         if not any(lit.pred in CELL_PREDICATES for lit in positive):
             goals.insert(0, "step(E, T, _, _)")
-        return f"predicts(E, T, {self.head}) :-\n    " + ",\n    ".join(goals) + "."
+        return goals
+
+
+_STEP = Term("step", (Var("E"), Var("T"), Var("_"), Var("_")))
+_TEMPLATE = re.compile(r"([a-z][A-Za-z0-9_]*)\((.*)\)")
+
+
+def template_term(template: str) -> Term | Var | str:
+    """An event template of the vocabulary (``opened(lock(C))``) as a term, ``C`` a variable."""
+    if template == HEAD_VAR:
+        return Var(HEAD_VAR)
+    m = _TEMPLATE.fullmatch(template)
+    if m is None:
+        return template
+    return Term(m.group(1), (template_term(m.group(2)),))
 
 
 @dataclass

@@ -19,10 +19,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from neurosym.errors import ConfigError
+from neurosym.errors import ConfigError, FactError
 from neurosym.induce.strategy_data import Trace, candidates, labels, load_trace
 from neurosym.induce.strategy_features import FEATURE_SETS, Feature, features
 from neurosym.induce.strategy_tree import DecisionList
+from neurosym.terms import parse_term
 
 LEARNERS = ("best", "tree", "covering")
 
@@ -100,10 +101,15 @@ class Strategy:
         return render(self)
 
     def write(self, path: str | Path) -> Path:
-        """Write the learned file atomically."""
-        from neurosym.atomic import write_bytes_atomic
+        """Write the learned file atomically, once it reads back as the clauses learned."""
+        from neurosym.atomic import make_folder, write_bytes_atomic
+        from neurosym.induce.readback import check_reads_back
+        from neurosym.induce.strategy_writer import render_parts
 
-        return write_bytes_atomic(path, self.text().encode("utf-8"))
+        text, parts = render_parts(self)
+        check_reads_back(text, parts, path)
+        make_folder(Path(path).parent)
+        return write_bytes_atomic(path, text.encode("utf-8"))
 
 
 def _learn(
@@ -122,9 +128,27 @@ def _learn(
     return max(scored, key=lambda ms: (ms[1][0], -len(ms[0].clauses)))
 
 
+def family(trace: Trace) -> str:
+    """The env family of a trace (``rgw`` or ``boxworld``), as ``--what world`` tells it."""
+    from neurosym.induce.examples import env_family
+
+    env = trace.meta.get("env", "")
+    try:
+        name = parse_term(env)  # kb_meta values are Prolog text: 'rgw-random' is quoted
+    except FactError:
+        name = env
+    return env_family([str(t) for t in trace.object["Ty"]], str(name))
+
+
 def _split(trace: Trace, holdout: str | Path | Trace | None, share: float) -> tuple[Trace, Trace, str]:
     if holdout is not None:
         test = holdout if isinstance(holdout, Trace) else load_trace(holdout)
+        mine, theirs = family(trace), family(test)
+        if theirs != mine:
+            raise ConfigError(
+                f"held-out KB {test.path} is a {theirs} KB; the rules learned from {trace.path} are "
+                f"{mine} rules: give a held-out KB of the same env family"
+            )
         return trace, test, f"the episodes of {test.path}"
     if not 0 < share < 1:
         raise ConfigError(f"--holdout-share must be between 0 and 1 (exclusive), got {share}")

@@ -14,9 +14,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
+from neurosym.terms import format_value
 
 CONTACTS = frozenset(
     {
@@ -39,22 +41,33 @@ CONTACTS = frozenset(
 MOVES = {"up": (-1, 0), "right": (0, 1), "down": (1, 0), "left": (0, -1)}
 """Action -> (row, col) offset of the cell it moves into."""
 
+_KIND = "( compound({x}) -> functor({x}, Kind, _) ; Kind = {x} )"
+"""binds Kind to the kind of a type or item, as the learned file's object_kind/2 derives it"""
+
+KINDS: dict[str, str] = {}
+"""A type's (or held item's) canonical text -> the canonical text of its kind (``key(red)`` ->
+``key``), from Prolog's own answer: filled by :func:`load_trace`, read by the features."""
+
 TABLES = {
-    "object": "object(O, Ty0), term_to_atom(Ty0, Ty)",
+    "object": "object(O, Ty0), format(atom(Ty), '~k', [Ty0]), " + _KIND.format(x="Ty0"),
     "at": "at(E, T, O, R, C)",
     "step": "step(E, T, A, _)",
     "event": "event(E, T, Ev0), term_to_atom(Ev0, Ev)",
-    "holding": "holding(E, T, I0), term_to_atom(I0, I)",
+    "holding": "holding(E, T, I0), format(atom(I), '~k', [I0]), " + _KIND.format(x="I0"),
     "attends": "attends(E, T, H, Arg, _, R, C, _)",
-    "holds": "holds(E, T, r(J), X0, Y0), term_to_atom(X0, X), term_to_atom(Y0, Y)",
-    "attention": "attention(E, T, H, Q0, K0, _), term_to_atom(Q0, Q), term_to_atom(K0, K)",
+    "holds": "holds(E, T, r(J), X0, Y0), format(atom(X), '~k', [X0]), format(atom(Y), '~k', [Y0])",
+    "attention": (
+        "attention(E, T, H, Q0, K0, _), format(atom(Q), '~k', [Q0]), format(atom(K), '~k', [K0])"
+    ),
     "meta": "kb_meta(Key, V0), term_to_atom(V0, V)",
     "terrain": (
         "catch(terrain(E, Ty0, R, C), error(existence_error(_, _), _), fail), term_to_atom(Ty0, Ty)"
     ),
     "grid": "catch(grid(E, Rows, Cols), error(existence_error(_, _), _), fail)",
 }
-"""The goal that reads each table, compound terms as their Prolog text."""
+"""The goal that reads each table, compound terms as their Prolog text: types, items and
+entities canonical (``write_canonical``: quoted, no operators), which
+:func:`neurosym.terms.parse_term` reads back, so a learned file spells them as the KB does."""
 
 
 @dataclass
@@ -102,11 +115,90 @@ def load_trace(path: str | Path) -> Trace:
         raise ConfigError(f"no knowledge base at {path}; pass a kb.pl written by neurosym extract")
     with KnowledgeBase(path) as kb:
         tables = {name: _columns(kb.query_df(goal)) for name, goal in TABLES.items()}
+        named = kb.once(NAMED)
+    for name, column in (("object", "Ty"), ("holding", "I")):
+        table = tables[name]
+        for text, kind in zip(table[column], table["Kind"], strict=True):
+            if text not in KINDS:
+                KINDS[text] = format_value(kind)
+        tables[name] = table.drop(columns="Kind")
     meta = dict(zip(tables["meta"]["Key"], tables["meta"]["V"], strict=True))
     trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
     if trace.at.empty:
         raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
+    check_grids(trace)
+    heads = max(_top(trace.attends["H"]), _top(trace.attention["H"]), int(named["H"])) + 1 if named else 0
+    relations = max(_top(trace.holds["J"]), int(named["J"])) + 1 if named else 0
+    check_count(trace, "heads", heads, "attends/8, attention/6 and relation/7 facts")
+    check_count(trace, "relations", relations, "holds/5, relation/7 and threshold/2 facts")
     return trace
+
+
+NAMED = (
+    "( aggregate_all(max(H0), catch(relation(_, _, H0, _, _, _, _), _, fail), H) -> true ; H = -1 ), "
+    "( aggregate_all(max(J0), ( catch(relation(_, _, _, J0, _, _, _), _, fail) ; "
+    "catch(threshold(J0, _), _, fail) ), J) -> true ; J = -1 )"
+)
+"""The highest head and relation number the KB's relation/7 and threshold/2 facts name (-1: none)."""
+
+GRID_SLACK = 2
+"""A grid may be at most twice the rows (columns) the KB's facts reach, plus this."""
+
+
+def _top(column: pd.Series) -> int:
+    """The highest integer in ``column``, -1 when it is empty (or holds no integer)."""
+    values = pd.to_numeric(column, errors="coerce").dropna()
+    return int(values.max()) if len(values) else -1
+
+
+def _whole(value: object) -> bool:
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
+def check_grids(trace: Trace) -> None:
+    """Refuse a ``grid/3`` fact far larger than the cells the KB's ``at/5`` and ``terrain/4`` reach.
+
+    Route features search every cell of the grid for every state, so the
+    grid's size, a value read from the KB, sizes that work (``grid(0, 3000,
+    3000)`` with a 10 x 10 map of facts would take hours): it is bounded by
+    the map the facts show before any work is done.
+    """
+    if trace.grid.empty:
+        return
+    reach = []
+    for axis in ("R", "C"):
+        cells = pd.concat([trace.at[axis], trace.terrain[axis]], ignore_index=True)
+        reach.append(_top(cells) + 1)
+    limits = [2 * r + GRID_SLACK for r in reach]
+    for e, rows, cols in trace.grid[["E", "Rows", "Cols"]].itertuples(index=False):
+        if not all(_whole(v) and 0 <= v <= lim for v, lim in zip((rows, cols), limits, strict=True)):
+            raise ConfigError(
+                f"grid({e}, {rows}, {cols}) in {trace.path}: its at/5 and terrain/4 facts reach "
+                f"{reach[0]} rows and {reach[1]} columns, so a grid may have at most {limits[0]} rows "
+                f"and {limits[1]} columns (twice what the facts reach, plus {GRID_SLACK})"
+            )
+
+
+def check_count(trace: Trace, key: str, present: int, facts: str) -> None:
+    """Refuse a ``kb_meta(key, N)`` (heads, relations) that is no count or exceeds what the facts name.
+
+    The count sizes the relation features (a column per head and argument),
+    so ``kb_meta(heads, 20000000)`` would fill the memory: it may be at most
+    the number the KB's relation facts name (at least 1).
+    """
+    text = trace.meta.get(key)
+    if text is None:
+        return
+    allowed = max(present, 1)
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 <= value <= allowed:
+        raise ConfigError(
+            f"kb_meta({key}, {text}) in {trace.path}: {key} must be a whole number from 0 to "
+            f"{allowed} (the {key} its {facts} name)"
+        )
 
 
 def _contact(events: list[str], target: str | None, types: dict[str, str]) -> bool:

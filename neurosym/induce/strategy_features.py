@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from neurosym.induce.strategy_data import Trace
+from neurosym.errors import ConfigError, FactError
+from neurosym.induce.strategy_data import KINDS, Trace
 from neurosym.induce.strategy_route import (
     PASSABLE_KINDS,
     PASSABLE_TERRAIN,
@@ -40,6 +41,7 @@ from neurosym.induce.strategy_route import (
     route_lengths,
     shortcuts,
 )
+from neurosym.terms import Term, TermArg, Var, atom_text, format_value, parse_term
 
 FEATURE_SETS = ("world", "relations", "both")
 
@@ -49,8 +51,38 @@ class Feature:
     """One column: its name, the Prolog goal over E, T, O (binding V when numeric)."""
 
     name: str
-    goal: str
+    term: Term
     numeric: bool = False
+
+    @property
+    def goal(self) -> str:
+        """The goal as Prolog text, every constant spelled by :mod:`neurosym.terms`."""
+        return goal_text(self.term)
+
+
+E_, T_, O_, V_ = Var("E"), Var("T"), Var("O"), Var("V")
+"""The variables of a feature's goal: the state (E, T), the candidate O, a numeric value V."""
+
+
+def goal_term(pred: str, *args: TermArg) -> Term:
+    """The goal ``pred(args...)``; E, T, O, V are the clause's variables."""
+    return Term(pred, args)
+
+
+def goal_text(goal: Term) -> str:
+    """``pred(E, T, key)``: a goal's text with a space after each comma, arguments by format_value."""
+    return f"{atom_text(goal.functor)}({', '.join(format_value(a) for a in goal.args)})"
+
+
+def _kv(kind: str) -> TermArg:
+    """A kind's value from its canonical text (:func:`_kind`)."""
+    try:
+        return parse_term(kind)  # type: ignore[return-value]
+    except FactError:
+        raise ConfigError(
+            f"object kind {kind} is not a term neurosym induce can write (an atom, a number or "
+            "a compound of them)"
+        ) from None
 
 
 BACKGROUND = r"""
@@ -150,7 +182,28 @@ attending_queries(E, T, H, O, N) :-
 
 
 def _kind(ty: str) -> str:
-    return ty.split("(", 1)[0]
+    """The canonical Prolog text of a type's kind: the type itself, or a compound's functor
+    (``key`` for ``key(red)``), as ``object_kind/2`` in the learned file derives it."""
+    kind = KINDS.get(ty)
+    if kind is None:
+        kind = KINDS[ty] = _kind_of(ty)
+    return kind
+
+
+def _kind_of(ty: str) -> str:
+    """The kind of a type's canonical text not read by :func:`load_trace` (a Trace built by hand)."""
+    try:
+        value = parse_term(ty)
+    except FactError:
+        raise ConfigError(
+            f"object type {ty!r} is not a term neurosym induce can read (an atom, a number or "
+            "a compound of them)"
+        ) from None
+    if isinstance(value, Term):
+        return atom_text(value.functor)
+    if isinstance(value, tuple):  # a list: '[|]' cells, or the empty list []
+        return atom_text("[|]") if value else "[]"
+    return format_value(value)
 
 
 def _colour(ty: str) -> str | None:
@@ -170,7 +223,7 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
     cols: dict[str, list[float]] = {}
     feats: list[Feature] = []
 
-    def add(name: str, goal: str, fn: Callable[..., float], numeric: bool = False) -> None:
+    def add(name: str, goal: Term, fn: Callable[..., float], numeric: bool = False) -> None:
         feats.append(Feature(name, goal, numeric))
         cols[name] = [fn(e, t, o, r, c) for e, t, o, r, c in pairs.itertuples(index=False)]
 
@@ -198,11 +251,11 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
         return at_cell(e, t, r, c - 1) if _kind(types[o]) == "lock" else None
 
     for k in kinds:
-        add(f"kind={k}", f"object_kind(O, {k})", lambda e, t, o, r, c, k=k: float(_kind(types[o]) == k))
+        add(f"kind={k}", goal_term("object_kind", O_, _kv(k)), lambda e, t, o, r, c, k=k: float(_kind(types[o]) == k))
     for k in held:
         add(
             f"holding={k}",
-            f"holding_kind(E, T, {k})",
+            goal_term("holding_kind", E_, T_, _kv(k)),
             lambda e, t, o, r, c, k=k: float(
                 any((e, t, i) in holding for i in trace.holding["I"].unique() if _kind(i) == k)
             ),
@@ -210,12 +263,12 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
     for k in kinds:
         add(
             f"on_map={k}",
-            f"on_map(E, T, {k})",
+            goal_term("on_map", E_, T_, _kv(k)),
             lambda e, t, o, r, c, k=k: float(any(_kind(types[o2]) == k for o2, _, _ in by_state[(e, t)])),
         )
-    add("distance", "agent_distance(E, T, O, V)", lambda e, t, o, r, c: float(dist(e, t, r, c)), True)
-    add("nearest_of_kind", "nearest_of_kind(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, True))
-    add("nearest_object", "nearest_object(E, T, O)", lambda e, t, o, r, c: nearest(e, t, o, r, c, False))
+    add("distance", goal_term("agent_distance", E_, T_, O_, V_), lambda e, t, o, r, c: float(dist(e, t, r, c)), True)
+    add("nearest_of_kind", goal_term("nearest_of_kind", E_, T_, O_), lambda e, t, o, r, c: nearest(e, t, o, r, c, True))
+    add("nearest_object", goal_term("nearest_object", E_, T_, O_), lambda e, t, o, r, c: nearest(e, t, o, r, c, False))
     if not trace.grid.empty:
         _routes(trace, pairs, types, kinds, add)
     if any(_kind(types[o]) in ("key", "lock") for o in pairs["O"].unique()):
@@ -269,24 +322,24 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
             )
         )
 
-    add("route_length", "route_length(E, T, O, V)", lambda e, t, o, r, c: float(length(e, t, o)), True)
-    add("reachable", "reachable(E, T, O)", lambda e, t, o, r, c: float(length(e, t, o) < UNREACHABLE))
-    add("nearest_reachable_of_kind", "nearest_reachable_of_kind(E, T, O)", nearest)
+    add("route_length", goal_term("route_length", E_, T_, O_, V_), lambda e, t, o, r, c: float(length(e, t, o)), True)
+    add("reachable", goal_term("reachable", E_, T_, O_), lambda e, t, o, r, c: float(length(e, t, o) < UNREACHABLE))
+    add("nearest_reachable_of_kind", goal_term("nearest_reachable_of_kind", E_, T_, O_), nearest)
     for k in kinds:
         if k != "teleport" and "teleport" in kinds:
             add(
                 f"teleport_shortcut={k}",
-                f"teleport_shortcut(E, T, O, {k})",
+                goal_term("teleport_shortcut", E_, T_, O_, _kv(k)),
                 lambda e, t, o, r, c, k=k: float(k in cuts.get((e, t, o), ())),
             )
             add(
                 f"teleport_not_longer={k}",
-                f"teleport_not_longer(E, T, O, {k})",
+                goal_term("teleport_not_longer", E_, T_, O_, _kv(k)),
                 lambda e, t, o, r, c, k=k: float(k in ties.get((e, t, o), ())),
             )
             add(
                 f"teleport_shortcut_to={k}",
-                f"teleport_shortcut_to(E, T, {k})",
+                goal_term("teleport_shortcut_to", E_, T_, _kv(k)),
                 lambda e, t, o, r, c, k=k: float(
                     any(k in cuts.get((e, t, o2), ()) for o2 in by_state[(e, t)])
                 ),
@@ -294,7 +347,7 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
     for k in kinds:
         add(
             f"route_not_longer={k}",
-            f"route_not_longer(E, T, O, {k})",
+            goal_term("route_not_longer", E_, T_, O_, _kv(k)),
             lambda e, t, o, r, c, k=k: float(
                 length(e, t, o) < UNREACHABLE
                 and not any(
@@ -306,7 +359,7 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
     for k in kinds:
         add(
             f"reachable_kind={k}",
-            f"reachable_kind(E, T, {k})",
+            goal_term("reachable_kind", E_, T_, _kv(k)),
             lambda e, t, o, r, c, k=k: float(
                 any(_kind(types[o2]) == k and length(e, t, o2) < UNREACHABLE for o2 in by_state[(e, t)])
             ),
@@ -317,14 +370,14 @@ def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: i
     """Box-World's key and lock features (only where the KB has keys or locks)."""
     add(
         "lock_of_held_key",
-        "lock_of_held_key(E, T, O)",
+        goal_term("lock_of_held_key", E_, T_, O_),
         lambda e, t, o, r, c: float(
             _kind(types[o]) == "lock" and (e, t, f"key({_colour(types[o])})") in holding
         ),
     )
     add(
         "key_fits_lock",
-        "key_fits_lock(E, T, O)",
+        goal_term("key_fits_lock", E_, T_, O_),
         lambda e, t, o, r, c: float(_kind(types[o]) == "key" and locks(e, t, _colour(types[o]))),
     )
 
@@ -340,9 +393,9 @@ def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: i
         x = content(e, t, o, r, c)
         return float(x is not None and _kind(types[x]) == "key" and locks(e, t, _colour(types[x]), o))
 
-    add("loose", "loose(E, T, O)", loose)
-    add("box_holds_gem", "box_holds_gem(E, T, O)", gem_box)
-    add("box_holds_useful_key", "box_holds_useful_key(E, T, O)", useful_box)
+    add("loose", goal_term("loose", E_, T_, O_), loose)
+    add("box_holds_gem", goal_term("box_holds_gem", E_, T_, O_), gem_box)
+    add("box_holds_useful_key", goal_term("box_holds_useful_key", E_, T_, O_), useful_box)
 
 
 def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
@@ -356,13 +409,13 @@ def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature],
         cells = {(e, t, h, a, r, c) for e, t, h, a, r, c in trace.attends.itertuples(index=False)}
         for h in range(heads):
             for a in (1, 2):
-                feats.append(Feature(f"attended_by({h},{a})", f"attended_by(E, T, {h}, {a}, O)"))
+                feats.append(Feature(f"attended_by({h},{a})", goal_term("attended_by", E_, T_, h, a, O_)))
                 cols.append([float((e, t, h, a, r, c) in cells) for e, t, o, r, c in rows])
         first = {(e, t, j, x) for e, t, j, x, y in trace.holds.itertuples(index=False)}
         second = {(e, t, j, y) for e, t, j, x, y in trace.holds.itertuples(index=False)}
         for j in range(int(trace.meta.get("relations", 0))):
             for pos, table in ((1, first), (2, second)):
-                feats.append(Feature(f"related({j},{pos})", f"related(E, T, {j}, {pos}, O)"))
+                feats.append(Feature(f"related({j},{pos})", goal_term("related", E_, T_, j, pos, O_)))
                 cols.append([float((e, t, j, types[o]) in table) for e, t, o, r, c in rows])
     if not trace.attention.empty or trace.meta.get("module") == "mhdpa":
         att = trace.attention
@@ -370,12 +423,12 @@ def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature],
         to_agent = {(e, t, h, q) for e, t, h, q, k in att.itertuples(index=False) if k == "agent"}
         count = att.groupby(["E", "T", "H", "K"]).size().to_dict()
         for h in range(heads):
-            feats.append(Feature(f"agent_query_attends({h})", f"agent_query_attends(E, T, {h}, O)"))
+            feats.append(Feature(f"agent_query_attends({h})", goal_term("agent_query_attends", E_, T_, h, O_)))
             cols.append([float((e, t, h, types[o]) in from_agent) for e, t, o, r, c in rows])
-            feats.append(Feature(f"query_attends_agent({h})", f"query_attends_agent(E, T, {h}, O)"))
+            feats.append(Feature(f"query_attends_agent({h})", goal_term("query_attends_agent", E_, T_, h, O_)))
             cols.append([float((e, t, h, types[o]) in to_agent) for e, t, o, r, c in rows])
             feats.append(
-                Feature(f"attending_queries({h})", f"attending_queries(E, T, {h}, O, V)", True)
+                Feature(f"attending_queries({h})", goal_term("attending_queries", E_, T_, h, O_, V_), True)
             )
             cols.append([float(count.get((e, t, h, types[o]), 0)) for e, t, o, r, c in rows])
     matrix = np.array(cols, dtype=float).T if cols else np.zeros((len(rows), 0))

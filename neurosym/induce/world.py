@@ -25,6 +25,7 @@ from neurosym.errors import ConfigError
 from neurosym.induce.background import BACKGROUND, VOCABULARY
 from neurosym.induce.examples import Grounded, ground
 from neurosym.induce.foil import Bias, Clause, evaluate, head_var, learn, positives
+from neurosym.induce.readback import Code, Part, check_reads_back, comment
 
 
 @dataclass
@@ -74,10 +75,11 @@ class WorldRules:
         """Write the rules as a self-contained Prolog file (atomically)."""
         from neurosym.atomic import atomic_write, make_folder
 
-        text = render(self)
+        text, parts = render_parts(self)
         path = Path(path)
+        check_reads_back(text, parts, path)
         make_folder(path.parent)
-        atomic_write(path, lambda p: Path(p).write_text(text))
+        atomic_write(path, lambda p: Path(p).write_text(text, encoding="utf-8"))
         return path
 
 
@@ -157,16 +159,28 @@ def _fmt(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f}"
 
 
+HEADER = """/** <module> World rules learned from recorded facts (neurosym induce --what world)
+
+predicts(E, T, Event) holds when the step of state T of episode E has event Event.
+Load beside a KB of the same schema (step/4, at/5, object/2, holding/3, terrain/4,
+grid/3): `swipl kb.pl world.pl`. Where and how the rules were learned, and their
+scores, follow in the % lines below.
+*/
+"""
+"""The file's PlDoc header: fixed text only (data goes in one-line ``%`` comments)."""
+
+DISCONTIGUOUS = ":- discontiguous predicts/3."
+
+
 def render(rules: WorldRules) -> str:
-    """The learned file: PlDoc header, clauses, undetermined events as comments, background."""
+    """The learned file: header, clauses, undetermined events as comments, background."""
+    return render_parts(rules)[0]
+
+
+def render_parts(rules: WorldRules) -> tuple[str, list[Part]]:
+    """The learned file's text and what it must read back as (:mod:`neurosym.induce.readback`)."""
     b = rules.bias
-    lines = [
-        "/** <module> World rules learned from recorded facts (neurosym induce --what world)",
-        "",
-        "predicts(E, T, Event) holds when the step of state T of episode E has event Event.",
-        "Load beside a KB of the same schema (step/4, at/5, object/2, holding/3, terrain/4,",
-        "grid/3): `swipl kb.pl world.pl`.",
-        "",
+    notes = [
         f"Learned from: {rules.kb} (env {rules.env or '?'}, {rules.episodes} episodes, "
         f"{rules.states} acted states) in {rules.seconds:.1f} s.",
         f"Learner: FOIL-style clause search (neurosym.induce.foil), max_literals={b.max_literals}, "
@@ -174,22 +188,24 @@ def render(rules: WorldRules) -> str:
         f"body predicates {', '.join(b.predicates)} (defined at the end of this file).",
     ]
     if rules.holdout:
-        lines.append(f"Held out: {rules.holdout} ({rules.holdout_episodes} episodes).")
-    lines += ["", "Scores (train precision/recall; held-out precision/recall):", ""]
-    for sc in rules.scores.values():
-        lines.append(f"  - {sc.event}: {_describe(sc)}")
-    lines += ["*/", "", ":- discontiguous predicts/3.", ""]
+        notes.append(f"Held out: {rules.holdout} ({rules.holdout_episodes} episodes).")
+    notes += ["", "Scores (train precision/recall; held-out precision/recall):"]
+    notes += [f"  - {sc.event}: {_describe(sc)}" for sc in rules.scores.values()]
+    lines = [HEADER, *(comment(n) for n in notes), "", DISCONTIGUOUS, ""]
+    parts: list[Part] = [Code(DISCONTIGUOUS)]
     for sc in rules.scores.values():
         if sc.status == "determined":
-            lines.append(f"% {sc.event}: {sc.train_examples} training examples")
+            lines.append(comment(f"{sc.event}: {sc.train_examples} training examples"))
             lines += [c.text() for c in sc.clauses]
+            parts += [c.term() for c in sc.clauses]
         else:
-            lines.append(f"% undetermined: {sc.event}: {sc.reason}")
-            lines += ["%   " + line for c in sc.clauses for line in c.text().splitlines()]
+            lines.append(comment(f"undetermined: {sc.event}: {sc.reason}"))
+            lines += [comment("  " + line) for c in sc.clauses for line in c.text().splitlines()]
         lines.append("")
     lines.append("% ---- background predicates (neurosym.induce.background) ----")
     lines.append(BACKGROUND.strip())
-    return "\n".join(lines) + "\n"
+    parts.append(Code(BACKGROUND))
+    return "\n".join(lines) + "\n", parts
 
 
 def _describe(sc: EventScore) -> str:
