@@ -35,10 +35,10 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from neurosym.atomic import file_kind, umask
+from neurosym.atomic import PUBLISH_STORE, file_kind, umask
 from neurosym.errors import ConfigError, OutputError
 
-STORE = ".neurosym"
+STORE = PUBLISH_STORE
 """the hidden folder in ``out`` holding the lock, the run folders and the ``current`` link"""
 
 CURRENT = "current"

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from neurosym.display import plain
 from neurosym.errors import ConfigError
 from neurosym.terms import format_value
 
@@ -126,6 +127,7 @@ def load_trace(path: str | Path) -> Trace:
     trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
     if trace.at.empty:
         raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
+    check_types(trace)
     check_grids(trace)
     heads = max(_top(trace.attends["H"]), _top(trace.attention["H"]), int(named["H"])) + 1 if named else 0
     relations = max(_top(trace.holds["J"]), int(named["J"])) + 1 if named else 0
@@ -153,6 +155,16 @@ def _top(column: pd.Series) -> int:
 
 def _whole(value: object) -> bool:
     return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
+def check_types(trace: Trace) -> None:
+    """Every object placed by at/5 has a type in object/2 (the features read it)."""
+    untyped = sorted(set(trace.at["O"]) - set(trace.object["O"]), key=str)
+    if untyped:
+        raise ConfigError(
+            f"{trace.path}: object {plain(str(untyped[0]))} has at/5 facts but no object/2 fact "
+            "naming its type; a KB written by neurosym extract has one per object"
+        )
 
 
 def check_grids(trace: Trace) -> None:

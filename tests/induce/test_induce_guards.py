@@ -76,6 +76,13 @@ def test_values_read_from_the_kb_are_bounded_before_the_work(bw_kb: Path, tmp_pa
     relations.write_text(text.replace("kb_meta(relations,1).", "kb_meta(relations,many)."))
     with pytest.raises(ConfigError, match=r"kb_meta\(relations, many\) .*: relations must be a whole number from 0 to 1"):
         load_trace(relations)
+    untyped = tmp_path / "untyped.pl"
+    untyped.write_text(text.replace("object(key_red,key(red)).\n", ""))
+    with pytest.raises(ConfigError, match=re.escape(
+        f"{untyped}: object key_red has at/5 facts but no object/2 fact naming its type; a KB "
+        "written by neurosym extract has one per object"
+    )):  # fmt: skip
+        load_trace(untyped)
 
 
 def test_a_held_out_kb_of_another_family_is_refused(
