@@ -9,9 +9,10 @@ schema tables of docs/design.md are made from these declarations.
 A new predicate is one declaration here plus the code that fills its table
 (docs/design.md, "Facts", says where).
 
-Argument kinds: ``int``, ``float``, ``atom`` (a plain name), ``term`` (Prolog
-term text such as ``key(red)``, written as a term, not a quoted atom) and
-``value`` (any of these, per row).
+Argument kinds: ``int``, ``float``, ``atom`` (a plain name), ``term`` (a table
+column of Prolog term text such as ``key(red)``, written as the term, not a
+quoted atom) and ``value`` (any Python value the writer spells: a number, a
+name, a :class:`~neurosym.terms.Term`).
 """
 
 from __future__ import annotations
@@ -83,7 +84,7 @@ TRACE, PROBE, EXPERIMENT = "trace", "probe", "experiment"
 SCHEMA: dict[str, Predicate] = {
     p.name: p
     for p in (
-        _p("kb_meta", "key:atom value:value",
+        _p("kb_meta", "key:value value:value",
            "checkpoint, env, module, heads, relations, seed, actions (`agent` or `random`), "
            "created, version, threshold; then `env_option(Name)` for each option the env was "
            "made with (the checkpoint's and `--env-option`'s: `kb_meta(env_option(num_mountains), "
@@ -131,21 +132,21 @@ SCHEMA: dict[str, Predicate] = {
            "the same on an untrained network of the same shape", PROBE, "probe"),
         _p("probe_skipped", "predicate:term reason:atom",
            "predicates constant on the recorded states", PROBE, "probe"),
-        _p("experiment", "x:X:atom kind:term detail:term",
+        _p("experiment", "x:X:atom kind:value detail:value",
            "X `baseline` or e.g. `remove_sword`; Kind `baseline`, `remove(sword)`, "
            "`remove(enemy)`, `move(enemy, R, C)`, `move(sword, R, C)`, `swap(sword, enemy)`, "
            "`ablate(head(H))`, `ablate(heads)`; Detail what was changed (the cells, or "
            "`every_level(Edit)` on rgw-random)", EXPERIMENT, "intervene"),
         _p("experiment_episode", "x:X:atom episode:E:int", "episode E belongs to experiment X",
            EXPERIMENT, "intervene"),
-        _p("experiment_skipped", "kind:term reason:atom",
+        _p("experiment_skipped", "kind:value reason:atom",
            "an experiment that does not apply (moving an object on procedural levels)",
            EXPERIMENT, "intervene"),
-        _p("measure", "experiment:X:atom measure:term value:float",
+        _p("measure", "experiment:X:atom measure:value value:float",
            "Measure `return`, `success`, `steps`, `sword_picked`, `sword_before_enemy`, "
            "`enemy_met`, `enemy_unarmed`, `enemy_defeated` (means over X's episodes; RGW)",
            EXPERIMENT, "intervene"),
-        _p("effect", "experiment:X:atom measure:term value:Change:float",
+        _p("effect", "experiment:X:atom measure:value value:Change:float",
            "the measure's change against the baseline, and at the baseline's own states `kl` "
            "(of the action distributions), `relation_shift(H, J)` (PrediNet: mean absolute "
            "change of D^h_j) or `head_shift(H)` (MHDPA)", EXPERIMENT, "intervene"),
@@ -163,6 +164,11 @@ def group(name: str) -> list[Predicate]:
 def indicators(names: Iterable[str]) -> list[str]:
     """``name/arity`` of the named predicates (for ``:- dynamic``)."""
     return [SCHEMA[n].indicator for n in names]
+
+
+def term_columns(names: Iterable[str]) -> dict[str, tuple[str, ...]]:
+    """The writer's ``term_columns`` for the named predicates (those that have any)."""
+    return {n: SCHEMA[n].term_columns for n in names if SCHEMA[n].term_columns}
 
 
 def header_lines(names: Iterable[str]) -> list[str]:

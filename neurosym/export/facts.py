@@ -46,37 +46,16 @@ from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 from neurosym.export.recording import META_KEYS, Recording
 from neurosym.export.thresholds import Threshold, parse_threshold
+from neurosym.schema import TRACE, group, indicators
 from neurosym.terms import Term
 
-# predicate -> argument columns, in argument order.
-PREDICATES: dict[str, tuple[str, ...]] = {
-    "kb_meta": ("key", "value"),
-    "object": ("id", "type"),
-    "episode": ("episode", "steps", "return", "outcome"),
-    "grid": ("episode", "rows", "cols"),
-    "terrain": ("episode", "type", "row", "col"),
-    "step": ("episode", "t", "action", "reward"),
-    "at": ("episode", "t", "id", "row", "col"),
-    "holding": ("episode", "t", "item"),
-    "event": ("episode", "t", "event"),
-    "attends": ("episode", "t", "head", "arg", "entity", "row", "col", "weight"),
-    "relation": ("episode", "t", "head", "j", "a", "b", "value"),
-    "holds": ("episode", "t", "j", "a", "b"),
-    "threshold": ("j", "value"),
-    "attention": ("episode", "t", "head", "query", "key", "weight"),
-}
+PREDICATES: dict[str, tuple[str, ...]] = {p.name: p.columns for p in group(TRACE)}
+"""predicate -> argument columns, in argument order (declared in :mod:`neurosym.schema`)"""
 
-# predicate -> columns holding Prolog term text (written as terms, not quoted atoms).
 TERM_COLUMNS: dict[str, tuple[str, ...]] = {
-    "object": ("type",),
-    "terrain": ("type",),
-    "holding": ("item",),
-    "event": ("event",),
-    "attends": ("entity",),
-    "relation": ("a", "b"),
-    "holds": ("a", "b"),
-    "attention": ("query", "key"),
+    p.name: p.term_columns for p in group(TRACE) if p.term_columns
 }
+"""predicate -> columns holding Prolog term text (written as terms, not quoted atoms)"""
 
 DEFAULT_THRESHOLD = "quantile:0.9"
 
@@ -212,14 +191,13 @@ class FactSet:
         """
         from neurosym.export.prolog_writer import write_prolog
 
-        term_columns = {**TERM_COLUMNS, "holds": ("j", "a", "b")}
         written = write_prolog(
             Path(path),
             self.prolog_tables(),
             header=self._header(),
             dynamic=predicate_indicators(),
             qlf=qlf,
-            term_columns=term_columns,
+            term_columns=TERM_COLUMNS,
         )
         return Path(written)
 
@@ -361,4 +339,4 @@ def extract_facts(
 
 def predicate_indicators(names: Iterable[str] = PREDICATES) -> list[str]:
     """``name/arity`` for the given schema predicates."""
-    return [f"{n}/{len(PREDICATES[n])}" for n in names]
+    return indicators(names)

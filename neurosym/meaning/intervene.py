@@ -163,12 +163,10 @@ class InterventionReport:
 
     def to_prolog(self, path: str | os.PathLike[str]) -> Path:
         """Write the KB: trace facts of every experiment's episodes plus the experiment facts."""
-        from neurosym.export.facts import TERM_COLUMNS, predicate_indicators
         from neurosym.export.prolog_writer import write_prolog
+        from neurosym.schema import EXPERIMENT, group, indicators, term_columns
 
         tables = self.facts()
-        term_columns = {k: v for k, v in TERM_COLUMNS.items() if k in tables}
-        term_columns["relates"] = ("a", "b")
         header = (
             "neurosym experiments: the unchanged level and changed ones, same seeds"
             " (neurosym intervene).\n"
@@ -178,22 +176,11 @@ class InterventionReport:
             " B, Share),\nand the trace facts (episode/4, grid/3, terrain/4, step/4, at/5,"
             " holding/3, event/3) of every experiment."
         )
-        dynamic = predicate_indicators(
-            ["kb_meta", "object", "episode", "grid", "terrain", "step", "at", "holding", "event"]
-        ) + [
-            "experiment/3",
-            "experiment_episode/2",
-            "experiment_skipped/2",
-            "measure/3",
-            "effect/3",
-            "relates/4",
-            "holds/5",
-            "attention/6",
-            "relation/7",
-            "attends/8",
-        ]
+        behaviour = ["kb_meta", "object", "episode", "grid", "terrain", "step", "at", "holding", "event"]
+        network = ["holds", "attention", "relation", "attends"]  # none here; rules may ask
+        dynamic = indicators(behaviour + [p.name for p in group(EXPERIMENT)] + network)
         return write_prolog(
-            Path(path), tables, header=header, dynamic=dynamic, term_columns=term_columns
+            Path(path), tables, header=header, dynamic=dynamic, term_columns=term_columns(tables)
         )
 
 

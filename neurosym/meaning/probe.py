@@ -120,7 +120,9 @@ class ProbeReport:
     def to_prolog(self, path: str | os.PathLike[str]) -> Path:
         """Write the facts as a plain Prolog file (atomically, full-precision floats)."""
         from neurosym.export.prolog_writer import write_prolog
+        from neurosym.schema import PROBE, group, indicators, term_columns
 
+        names = [p.name for p in group(PROBE)]
         header = (
             "neurosym probes: what each head's relations encode (neurosym probe).\n"
             + ", ".join(f"{k}={v}" for k, v in self.meta.items())
@@ -131,12 +133,8 @@ class ProbeReport:
             Path(path),
             self.facts(),
             header=header,
-            dynamic=["kb_meta/2", "probe/5", "probe_untrained/5", "probe_skipped/2"],
-            term_columns={
-                "probe": ["predicate"],
-                "probe_untrained": ["predicate"],
-                "probe_skipped": ["predicate"],
-            },
+            dynamic=indicators(["kb_meta", *names]),
+            term_columns=term_columns(names),
         )
 
 
