@@ -38,16 +38,14 @@ from neurosym.play import live
 from neurosym.play import prolog as play_prolog
 from neurosym.play.policy import Policy, read_policy
 from neurosym.prolog.interrupt import interruptible
+from neurosym.schema import TRACE, group
 from neurosym.terms import Term
 
 INFERENCE_LIMIT = 10_000_000
 """inferences a strategy may take to choose one object (then the run stops with one line)"""
 
-SCHEMA = (
-    "kb_meta/2", "object/2", "episode/4", "step/4", "at/5", "holding/3", "event/3",
-    "attends/8", "relation/7", "holds/5", "threshold/2", "attention/6", "terrain/4", "grid/3",
-)  # fmt: skip
-"""every predicate of the KB schema, declared dynamic in the agent's module"""
+SCHEMA = tuple(group(TRACE))
+"""every predicate of the KB schema (:mod:`neurosym.schema`), declared dynamic in the agent's module"""
 
 _ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
 
@@ -104,7 +102,7 @@ class PrologAgent:
         try:
             with interruptible():
                 self.kb.query(
-                    "forall(member(PI, Ps), dynamic(PI))", Ps=[_indicator(p) for p in SCHEMA]
+                    "forall(member(PI, Ps), dynamic(PI))", Ps=[Term("/", (p.name, p.arity)) for p in SCHEMA]
                 )
                 self.kb.load_rules(rule_file("route"))
                 _load_policy(self.kb, self.policy.path)
@@ -281,11 +279,6 @@ def check_policy(module: str, file: Path, shown: Path, nesting: int) -> None:
 def _shown(value: Any) -> str:
     text = str(value)
     return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _indicator(text: str) -> Term:
-    name, arity = text.split("/")
-    return Term("/", (name, int(arity)))
 
 
 def _text(value: Any) -> Any:
