@@ -66,6 +66,9 @@ DEFAULT_EPISODES = 100
 
 TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
 
+NETWORK_FACTS = ("attends", "relation", "holds", "threshold", "attention")
+"""the trace predicates an experiment KB leaves out: what the network computed, per state"""
+
 
 @dataclass(frozen=True)
 class Experiment:
@@ -119,7 +122,7 @@ class InterventionReport:
             meta=self.recordings["baseline"].meta,
         )
         trace = extract_facts(merged).prolog_tables()
-        for name in ("attends", "relation", "holds", "threshold", "attention"):
+        for name in NETWORK_FACTS:
             trace.pop(name, None)
         meta = trace.pop("kb_meta")
         meta = meta[meta["key"] != "threshold"]
@@ -177,7 +180,7 @@ class InterventionReport:
             " holding/3, event/3) of every experiment."
         )
         behaviour = ["kb_meta", "object", "episode", "grid", "terrain", "step", "at", "holding", "event"]
-        network = ["holds", "attention", "relation", "attends"]  # none here; rules may ask
+        network = ["holds", "attention", "relation", "attends"]  # none here; rules may ask for them
         dynamic = indicators(behaviour + [p.name for p in group(EXPERIMENT)] + network)
         return write_prolog(
             Path(path), tables, header=header, dynamic=dynamic, term_columns=term_columns(tables)
