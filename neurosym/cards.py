@@ -31,20 +31,43 @@ MODES = ("sampled", "greedy")
 
 
 def check_card(card: Any, where: str = "card") -> dict[str, Any]:
-    """``card`` if it has the shape above (one-line CheckpointError naming what is wrong)."""
+    """``card`` if it has the shape above (one-line CheckpointError naming the field that is wrong)."""
     if not isinstance(card, dict):
         raise CheckpointError(f"{where} is a {type(card).__name__}, not a dict")
     missing = [k for k in CARD_KEYS if k not in card]
     if missing:
         raise CheckpointError(f"{where} lacks {', '.join(missing)}")
+    for key in ("role", "eval_command"):
+        if not isinstance(card[key], str):
+            raise CheckpointError(f"{where}: {key} is a {type(card[key]).__name__}, not text")
     held = card["held_out"]
-    if not isinstance(held, dict) or not all(isinstance(held.get(m), dict) for m in MODES):
-        raise CheckpointError(f"{where}: held_out needs 'sampled' and 'greedy' figures")
+    if not isinstance(held, dict):
+        raise CheckpointError(f"{where}: held_out is a {type(held).__name__}, not a dict")
     for mode in MODES:
+        if not isinstance(held.get(mode), dict):
+            raise CheckpointError(
+                f"{where}: held_out lacks its {mode!r} figures (held_out.{mode} must be a dict)"
+            )
         rate = held[mode].get("success_rate")
         if not isinstance(rate, float) or not 0.0 <= rate <= 1.0:
             raise CheckpointError(f"{where}: held_out.{mode}.success_rate must be in [0, 1]")
+        for name, value in held[mode].items():
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise CheckpointError(
+                    f"{where}: held_out.{mode}.{name} is a {type(value).__name__}, not a number"
+                )
     return card
+
+
+def card_of(meta: dict[str, Any], where: str) -> tuple[dict[str, Any] | None, str | None]:
+    """(the checkpoint's card, None), (None, None) without one, or (None, what is wrong with it)."""
+    card = meta.get("card")
+    if card is None:
+        return None, None
+    try:
+        return check_card(card, where), None
+    except CheckpointError as exc:
+        return None, str(exc)
 
 
 def write_card(path: str | os.PathLike[str], card: dict[str, Any]) -> Path:
@@ -79,6 +102,33 @@ def learner(meta: dict[str, Any]) -> str:
         if words[:2] == ["neurosym", "train"] and "--algo" in words[:-1]:
             algo = words[words.index("--algo") + 1]
     return algo
+
+
+def training_frames(meta: dict[str, Any]) -> tuple[str, str]:
+    """(label, text) of the frames an agent trained for, from its checkpoint's metadata.
+
+    ``frames`` counts the env steps since the run began (``--resume`` adds to
+    it); a run started ``--init-from`` another agent starts from 0 and records
+    the source's count as ``metrics["init_frames"]``. One such step in its
+    command: frames + init_frames is the whole training. Several: the source
+    had a source of its own whose frames were not recorded, so the sum is a
+    lower bound. A command with ``--init-from`` but no ``init_frames`` (an
+    older file): only the last run's count is known, and labelled so.
+    """
+    frames = int(meta.get("frames") or 0)
+    metrics = meta.get("metrics") if isinstance(meta.get("metrics"), dict) else {}
+    init = metrics.get("init_frames")
+    steps = sum(" --init-from " in f" {c} " for c in str(meta.get("command") or "").split(" && "))
+    if isinstance(init, int) and not isinstance(init, bool) and init >= 0:
+        total = f"{frames + init:,}" if steps <= 1 else f"at least {frames + init:,}"
+        source = metrics.get("init_from") or "the agent it started from"
+        return (
+            "frames, whole training",
+            f"{total} ({frames:,} in its last run, after {init:,} of {source})",
+        )
+    if steps:
+        return "frames in the last run", f"{frames:,} (it started from another agent's weights)"
+    return "frames, whole training", f"{frames:,}"
 
 
 def held_out_text(card: dict[str, Any] | None) -> str:
