@@ -29,6 +29,38 @@ from neurosym.errors import CheckpointError
 CARD_KEYS = ("role", "eval_command", "held_out")
 MODES = ("sampled", "greedy")
 
+FIGURE_LABELS = {
+    "success_rate": "success",
+    "optimal_rate": "optimal route",
+    "sword_first_guarded": "sword first when guarded",
+    "no_detour_decoy": "no detour for a decoy sword",
+    "sword_taken_decoy": "decoy sword taken",
+    "mean_return": "mean return",
+    "mean_optimal_return": "mean optimal return",
+    "guarded_episodes": "guarded levels",
+    "decoy_episodes": "decoy levels",
+}
+"""readable names of ``neurosym eval --json``'s figures, as a card shows them"""
+
+RATES = frozenset(
+    ("success_rate", "optimal_rate", "sword_first_guarded", "no_detour_decoy", "sword_taken_decoy")
+)
+"""figures that are shares of episodes (in [0, 1]; shown in percent)"""
+
+
+def figure_label(name: str) -> str:
+    """``sword_first_guarded`` -> ``sword first when guarded``; an unknown name with spaces."""
+    return FIGURE_LABELS.get(name, name.replace("_", " "))
+
+
+def figure_text(name: str, value: Any) -> str:
+    """A figure as a card shows it: a share in percent, a count as is, others to 4 digits."""
+    if isinstance(value, float) and name in RATES:
+        return f"{100 * value:.1f} %"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value)
+
 
 def check_card(card: Any, where: str = "card") -> dict[str, Any]:
     """``card`` if it has the shape above (one-line CheckpointError naming the field that is wrong)."""
@@ -93,12 +125,15 @@ def learner(meta: dict[str, Any]) -> str:
     Agents whose file has no train config were made before it was stored; their
     command names ``--algo`` when it was not the default (a3c).
     """
-    config = meta.get("train_config") or {}
-    if config.get("algo"):
+    config = meta.get("train_config")
+    if isinstance(config, dict) and config.get("algo"):
         return str(config["algo"])
     algo = "a3c"
     for command in str(meta.get("command") or "").split(" && "):
-        words = shlex.split(command)
+        try:
+            words = shlex.split(command)
+        except ValueError:  # unbalanced quotes: an edited file; its words as they stand
+            words = command.split()
         if words[:2] == ["neurosym", "train"] and "--algo" in words[:-1]:
             algo = words[words.index("--algo") + 1]
     return algo
