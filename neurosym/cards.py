@@ -65,16 +65,16 @@ def figure_text(name: str, value: Any) -> str:
 def check_card(card: Any, where: str = "card") -> dict[str, Any]:
     """``card`` if it has the shape above (one-line CheckpointError naming the field that is wrong)."""
     if not isinstance(card, dict):
-        raise CheckpointError(f"{where} is a {type(card).__name__}, not a dict")
+        raise CheckpointError(f"{where} is of type {type(card).__name__}, not a dict")
     missing = [k for k in CARD_KEYS if k not in card]
     if missing:
         raise CheckpointError(f"{where} lacks {', '.join(missing)}")
     for key in ("role", "eval_command"):
         if not isinstance(card[key], str):
-            raise CheckpointError(f"{where}: {key} is a {type(card[key]).__name__}, not text")
+            raise CheckpointError(f"{where}: {key} is of type {type(card[key]).__name__}, not text")
     held = card["held_out"]
     if not isinstance(held, dict):
-        raise CheckpointError(f"{where}: held_out is a {type(held).__name__}, not a dict")
+        raise CheckpointError(f"{where}: held_out is of type {type(held).__name__}, not a dict")
     for mode in MODES:
         if not isinstance(held.get(mode), dict):
             raise CheckpointError(
@@ -86,7 +86,7 @@ def check_card(card: Any, where: str = "card") -> dict[str, Any]:
         for name, value in held[mode].items():
             if not isinstance(value, int | float) or isinstance(value, bool):
                 raise CheckpointError(
-                    f"{where}: held_out.{mode}.{name} is a {type(value).__name__}, not a number"
+                    f"{where}: held_out.{mode}.{name} is of type {type(value).__name__}, not a number"
                 )
     return card
 

@@ -258,14 +258,16 @@ def check_plain_data(value: Any, where: str, error: type[Exception] = Checkpoint
             if isinstance(item, dict):
                 for k in item:
                     if not isinstance(k, str):
-                        raise error(f"{where} has a {type(k).__name__} key (plain metadata: str)")
+                        raise error(
+                            f"{where} has a key of type {type(k).__name__} (plain metadata: str)"
+                        )
                     chars += len(k)
             stack.extend(
                 (v, depth + 1) for v in (item.values() if isinstance(item, dict) else item)
             )
         elif not isinstance(item, _LEAVES):
             raise error(
-                f"{where} holds a {type(item).__name__}; plain metadata holds only str, "
+                f"{where} holds a value of type {type(item).__name__}; plain metadata holds only str, "
                 "int, float, bool, None, lists and dicts"
             )
         if chars > METADATA_CHARS:

@@ -10,7 +10,12 @@ writes, into ``--out`` (default ``kb_out/<env>``), what extract writes
 (``kb.pl``, ``recording/``) plus ``index.html``; everything is staged first
 and moved in by one rename each (:mod:`neurosym.publish`). With
 ``--recording`` it reports a folder extract wrote (or its ``recording/``
-folder) and writes ``index.html`` there (or into ``--out``) atomically.
+folder) and publishes ``index.html`` there beside the KB it was built from
+(or writes it into ``--out``, saying so when the folder's own page is stale).
+The page carries the identity of its recording and KB
+(:func:`neurosym.webreport.build.identity`). The checkpoint the recording
+names gives the card only when it is the agent recorded (env family, module,
+heads).
 ``--probe`` and ``--intervene`` add the tables of the folders ``neurosym
 probe`` and ``neurosym intervene`` wrote.
 """
