@@ -418,21 +418,26 @@ def test_a_bad_recording_meta_is_one_line(
     assert err.count("\n") == 1 and not (copy / "index.html").exists()
 
 
-def test_non_finite_values_reach_the_page_as_null(tmp_path: Path) -> None:
-    """JSON has no NaN or infinity: the page's data say null where the recording has one."""
+def non_finite_recording() -> Recording:
+    """The scripted recording with reward +inf at its first step and relation values -inf, NaN."""
     rec = scripted_recording("predinet")
     steps, relations = rec.steps.copy(), rec.relations.copy()
     steps.loc[steps.index[0], "reward"] = float("inf")
     relations.loc[relations.index[0], "value"] = float("-inf")
     relations.loc[relations.index[1], "value"] = float("nan")
     tables = {name: rec.tables[name] for name in SCHEMA}
-    bad = Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
+    return Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
+
+
+def test_non_finite_values_reach_the_page_as_null(tmp_path: Path) -> None:
+    """JSON has no NaN or infinity: the page's data say null where the recording has one."""
+    bad = non_finite_recording()
     out = tmp_path / "out"
     write_outputs(out, bad, None, ())  # the recording alone: the KB writer refuses inf
     html = report(out)
     data = embedded(html)
-    first = data["player"]["episodes"][int(steps.loc[steps.index[0], "episode"])]
-    assert first["rewards"][int(steps.loc[steps.index[0], "t"])] is None
+    first = bad.steps.iloc[0]
+    assert data["player"]["episodes"][int(first["episode"])]["rewards"][int(first["t"])] is None
     values = [v for ep in data["player"]["episodes"] for v in ep["tables"]["relations"]["value"]]
     assert values.count(None) == 2 and all(v is None or abs(v) < 1e300 for v in values)
 
@@ -472,7 +477,9 @@ def test_the_page_is_its_kbs_and_a_stale_one_is_told_and_rebuilt(
     assert (folder / "index.html").is_symlink()  # published with the KB, as one product
     assert stale_page(folder, first) is None
     again = Recording(**{n: rec.tables[n] for n in SCHEMA}, meta={**rec.meta, "seed": 777})
-    extract_folder(again, folder)  # extract again: the old page is still beside the new KB
+    extract_folder(again, folder)  # extract again, and the old page beside the new KB:
+    (folder / "index.html").unlink(missing_ok=True)  # as extract leaves it, or a copy brings it
+    (folder / "index.html").write_text(html, encoding="utf-8")
     now = identity(folder / "recording", folder / "kb.pl")
     assert now != first
     assert stale_page(folder, now) == (
@@ -485,3 +492,27 @@ def test_the_page_is_its_kbs_and_a_stale_one_is_told_and_rebuilt(
     )
     html = report(folder)
     assert stale_page(folder, now) is None and "seed 777)" in html and "seed 0)" not in html
+
+
+def test_a_page_is_not_published_beside_a_kb_extracted_while_it_was_built(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import neurosym.webreport.page as page_module
+
+    rec = scripted_recording("predinet")
+    folder = extract_folder(rec, tmp_path / "out")
+    again = Recording(**{n: rec.tables[n] for n in SCHEMA}, meta={**rec.meta, "seed": 777})
+    render = page_module.render
+
+    def extract_meanwhile(context: dict) -> str:
+        extract_folder(again, folder)
+        return render(context)
+
+    monkeypatch.setattr(page_module, "render", extract_meanwhile)
+    assert main(["report", "--recording", str(folder), "--quiet"]) == 1
+    assert capsys.readouterr().err == (
+        f"neurosym report: error: {folder} was extracted again while its report was built; "
+        f"nothing was written: run `neurosym report --recording {folder}` again\n"
+    )
+    assert not (folder / "index.html").exists()
+    assert "kb_meta(seed,777)" in (folder / "kb.pl").read_text()  # the new KB, untouched
