@@ -119,5 +119,6 @@ def agent_card(rec_meta: dict[str, Any], agent: Any | None, note: str | None = N
             if problem:
                 note = " ".join(x for x in (note, f"Its card is not shown: {problem}.") if x)
             figures = [(k, _text(metrics[k])) for k in TRAINING_FIGURES if k in metrics]
-            source = "the last figures of training (not held out: the checkpoint has no card)"
+            why = "its card is malformed" if problem else "the checkpoint has no card"
+            source = f"the last figures of training (not held out: {why})"
     return {"rows": rows, "figures": figures, "figures_from": source, "note": note}

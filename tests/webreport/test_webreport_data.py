@@ -329,6 +329,7 @@ def test_card_prefers_the_checkpoints_own_card() -> None:
     bad = {**held, "held_out": {"greedy": {"success_rate": 0.5}}}
     broken = agent_card(rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "card": bad}}))
     assert broken["figures"] == [("greedy_return", "10.7")]
+    assert broken["figures_from"].endswith("(not held out: its card is malformed)")
     assert broken["note"] == (
         "Its card is not shown: the card: held_out lacks its 'sampled' figures "
         "(held_out.sampled must be a dict)."
