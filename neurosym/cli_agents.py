@@ -8,7 +8,10 @@ copy inside an installed package; see :mod:`neurosym.shipped`), or those in
 the file's card (:mod:`neurosym.cards`) and what the agent is for. A shipped
 agent's name works wherever a checkpoint is asked for
 (``--checkpoint rgw2-predinet``). A file that is not a neurosym checkpoint is
-skipped with one line on stderr.
+skipped with one line on stderr; an agent whose card is malformed is listed
+with its held-out figures and role blank, and one line on stderr names the
+field (its weights still play; ``--json`` gives ``card: null`` and the reason
+as ``card_error``).
 """
 
 from __future__ import annotations
@@ -50,9 +53,10 @@ def agent_folder(folder: str | None) -> Path:
 def describe(path: Path) -> dict[str, Any]:
     """One agent's entry: what its file says about it (CheckpointError for a bad file)."""
     from neurosym.agent.checkpoint import read_checkpoint
-    from neurosym.cards import learner
+    from neurosym.cards import card_of, learner
 
-    payload = read_checkpoint(path)
+    payload = read_checkpoint(path)  # its metadata plain and bounded, its counts not negative
+    card, problem = card_of(payload, f"the card in {path.name}")
     return {
         "name": path.stem,
         "file": str(path.resolve()),
@@ -61,7 +65,8 @@ def describe(path: Path) -> dict[str, Any]:
         "module": payload["model_config"].module,
         "learner": learner(payload),
         "frames": payload["frames"],
-        "card": payload.get("card"),
+        "card": card,
+        "card_error": problem,
     }
 
 
@@ -114,6 +119,12 @@ def run(args: argparse.Namespace) -> int:
             agents.append(describe(path))
         except CheckpointError as exc:
             print(f"neurosym agents: skipped {path.name}: {exc}", file=sys.stderr)
+            continue
+        if agents[-1]["card_error"]:
+            print(
+                f"neurosym agents: {agents[-1]['card_error']}; its held-out figures are left blank",
+                file=sys.stderr,
+            )
     if args.json:
         print(json.dumps(agents))
     elif agents:

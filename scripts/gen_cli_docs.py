@@ -52,6 +52,8 @@ def _arguments(parser: argparse.ArgumentParser) -> list[str]:
     for action in parser._actions:
         if isinstance(action, argparse._HelpAction | argparse._SubParsersAction):
             continue
+        if action.help == argparse.SUPPRESS:  # hidden flags stay out of the page, as of --help
+            continue
         if isinstance(action, argparse._VersionAction):
             text = "print the version and exit"
         else:

@@ -22,3 +22,7 @@ def test_docs_cli_md_is_up_to_date() -> None:
     for name in COMMANDS:  # every command has its section, and its flags are in it
         assert f"\n## neurosym {name}\n" in page
     assert "| `--rules FILE` |" in page and "| `--verbose` |" in page and "| `--dir DIR` |" in page
+    # a hidden flag (help=SUPPRESS, e.g. report's --batch) is left out, as from --help
+    report = page[page.index("\n## neurosym report\n") :]
+    report = report[: report.index("\n## ", 1)]
+    assert "SUPPRESS" not in page and "--batch" not in report

@@ -203,6 +203,93 @@ def _require(payload: dict[str, Any], path: Path, key: str, kind: type | tuple[t
     return value
 
 
+def _require_count(payload: dict[str, Any], path: Path, key: str) -> int:
+    """A count (``frames``, ``episodes``): an int, not negative."""
+    value = _require(payload, path, key, int)
+    if value < 0:
+        raise CheckpointError(
+            f"checkpoint {path} is damaged: {key!r} is {value}; it counts, so it is 0 or more"
+        )
+    return value
+
+
+METADATA_NODES = 10_000
+"""values (counted at every place they occur) a checkpoint's metadata or a recording's meta
+may hold: the shipped agents' hold about 200"""
+METADATA_DEPTH = 20
+"""lists and dicts in lists and dicts, at most"""
+METADATA_CHARS = 1_000_000
+"""characters of all its strings and keys together (a curriculum's command is about 1,000)"""
+
+_LEAVES = (str, int, float, bool, type(None))
+
+
+def check_plain_data(value: Any, where: str, error: type[Exception] = CheckpointError) -> None:
+    """Refuse, in one line naming ``where``, anything but plain data of bounded size.
+
+    Plain data: str, int, float, bool, None, lists (tuples) and dicts with str
+    keys. Bounded: at most :data:`METADATA_NODES` values, :data:`METADATA_DEPTH`
+    levels and :data:`METADATA_CHARS` characters, a value met twice (a pickle
+    may share one list everywhere: 40 levels of ``[l, l]`` is 2**40 leaves,
+    printed) counting twice. Why: cards, env options and metrics are printed,
+    compared and embedded in pages; a few MB that expand to terabytes when
+    walked must be refused before anything walks them.
+    """
+    stack: list[tuple[Any, int]] = [(value, 0)]
+    seen = 1  # values visited or waiting on the stack
+    chars = 0
+    while stack:
+        item, depth = stack.pop()
+        if depth > METADATA_DEPTH:
+            raise error(
+                f"{where} is nested more than {METADATA_DEPTH} levels deep (plain metadata)"
+            )
+        if isinstance(item, str):
+            chars += len(item)
+        elif isinstance(item, int) and not isinstance(item, bool) and abs(item) >= 1 << 64:
+            raise error(f"{where} holds an integer of {item.bit_length()} bits (at most 64)")
+        elif isinstance(item, list | tuple | dict):
+            seen += len(item)
+            if seen > METADATA_NODES:
+                raise error(
+                    f"{where} is too large: more than {METADATA_NODES:,} values (counting "
+                    "every place a shared one occurs; plain metadata holds far fewer)"
+                )
+            if isinstance(item, dict):
+                for k in item:
+                    if not isinstance(k, str):
+                        raise error(
+                            f"{where} has a key of type {type(k).__name__} (plain metadata: str)"
+                        )
+                    chars += len(k)
+            stack.extend(
+                (v, depth + 1) for v in (item.values() if isinstance(item, dict) else item)
+            )
+        elif not isinstance(item, _LEAVES):
+            raise error(
+                f"{where} holds a value of type {type(item).__name__}; plain metadata holds only str, "
+                "int, float, bool, None, lists and dicts"
+            )
+        if chars > METADATA_CHARS:
+            raise error(f"{where} is too large: more than {METADATA_CHARS:,} characters of text")
+
+
+WEIGHT_KEYS = ("state_dict", "optimizer")
+"""checkpoint entries of tensors; every other entry is plain metadata (:func:`check_plain_data`)"""
+
+
+def _check_metadata(payload: dict[str, Any], path: Path) -> None:
+    """Every entry but the weights is plain data of bounded size (one line naming the entry)."""
+    for key, value in payload.items():
+        if not isinstance(key, str):
+            raise CheckpointError(
+                f"checkpoint {path} is damaged: it has a key of type "
+                f"{type(key).__name__}; a checkpoint's keys are str"
+            )
+        if key not in WEIGHT_KEYS:
+            check_plain_data(value, f"checkpoint {path}: its {key!r}")
+
+
 def read_checkpoint(
     path: str | os.PathLike[str],
     env: str | None = None,
@@ -228,7 +315,10 @@ def read_checkpoint(
             )
         raise CheckpointError(f"{path} is not a neurosym checkpoint (no 'format' entry)")
     if payload["format"] != FORMAT:
-        raise CheckpointError(f"{path} is not a neurosym checkpoint (format {payload['format']!r})")
+        named = payload["format"]
+        named = repr(named) if isinstance(named, str) and len(named) <= 80 else "unknown"
+        raise CheckpointError(f"{path} is not a neurosym checkpoint (format {named})")
+    _check_metadata(payload, path)
     version = payload.get("format_version")
     if not isinstance(version, int) or version > FORMAT_VERSION or version < 1:
         raise CheckpointError(
@@ -238,8 +328,8 @@ def read_checkpoint(
     env_name = _require(payload, path, "env", str)
     _require(payload, path, "env_kwargs", dict)
     state = _require(payload, path, "state_dict", dict)
-    _require(payload, path, "frames", int)
-    _require(payload, path, "episodes", int)
+    _require_count(payload, path, "frames")
+    _require_count(payload, path, "episodes")
     if not all(isinstance(v, torch.Tensor) for v in state.values()):
         raise CheckpointError(
             f"checkpoint {path} is damaged: its state_dict holds values other than tensors"

@@ -10,7 +10,12 @@ writes, into ``--out`` (default ``kb_out/<env>``), what extract writes
 (``kb.pl``, ``recording/``) plus ``index.html``; everything is staged first
 and moved in by one rename each (:mod:`neurosym.publish`). With
 ``--recording`` it reports a folder extract wrote (or its ``recording/``
-folder) and writes ``index.html`` there (or into ``--out``) atomically.
+folder) and publishes ``index.html`` there beside the KB it was built from
+(or writes it into ``--out``, saying so when the folder's own page is stale).
+The page carries the identity of its recording and KB
+(:func:`neurosym.webreport.build.identity`). The checkpoint the recording
+names gives the card only when it is the agent recorded (env family, module,
+heads).
 ``--probe`` and ``--intervene`` add the tables of the folders ``neurosym
 probe`` and ``neurosym intervene`` wrote.
 """
@@ -18,6 +23,7 @@ probe`` and ``neurosym intervene`` wrote.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -123,20 +129,30 @@ def _from_recording(args: argparse.Namespace, probes: Any, experiments: Any) -> 
     from neurosym.webreport.build import (
         load_agent_or_note,
         load_extract,
-        recording_folder,
         report_context,
+        stale_page,
+        write_beside,
         write_report,
     )
     from neurosym.webreport.card import agent_card
 
-    _, folder = recording_folder(Path(args.recording))
-    rec, facts, kb_path = load_extract(Path(args.recording), args.threshold)
-    agent, note = load_agent_or_note(rec.meta.get("checkpoint"))
+    extract = load_extract(Path(args.recording), args.threshold)
+    rec = extract.rec
+    agent, note = load_agent_or_note(rec.meta.get("checkpoint"), rec.meta)
     card = agent_card(rec.meta, agent, note)
     context = report_context(
-        rec, facts, kb_path, card, probes, experiments, source=f"the recording in {folder}"
-    )
-    return write_report(Path(args.out) if args.out else folder, context)
+        rec, extract.facts, extract.kb_path, card, probes, experiments,
+        source=f"the recording in {extract.folder}", identity=extract.identity,
+    )  # fmt: skip
+    if args.out is None:
+        return write_beside(extract, context)
+    stale = stale_page(extract.folder, extract.identity)
+    if stale and not args.quiet:
+        print(
+            f"note: {stale}; `neurosym report --recording {extract.folder}` rebuilds it",
+            file=sys.stderr,
+        )
+    return write_report(Path(args.out), context)
 
 
 def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) -> Path:
@@ -144,7 +160,7 @@ def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) ->
     from neurosym.export.facts import DEFAULT_THRESHOLD, extract_facts
     from neurosym.export.recorder import record
     from neurosym.publish import publish
-    from neurosym.webreport.build import report_context
+    from neurosym.webreport.build import identity, report_context
     from neurosym.webreport.card import agent_card
     from neurosym.webreport.page import render
 
@@ -171,8 +187,9 @@ def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) ->
         facts.to_prolog(stage / "kb.pl")
         rec.save(stage / "recording")
         context = report_context(
-            rec, facts, stage / "kb.pl", card, probes, experiments, source=f"{args.checkpoint}"
-        )
+            rec, facts, stage / "kb.pl", card, probes, experiments, source=f"{args.checkpoint}",
+            identity=identity(stage / "recording", stage / "kb.pl"),
+        )  # fmt: skip
         (stage / "index.html").write_text(render(context), encoding="utf-8")
 
     written = publish(out, write, folders=("recording",), prefix=".report-")

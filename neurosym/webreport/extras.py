@@ -49,9 +49,32 @@ def _number(value: Any) -> float | None:
     return None if math.isnan(out) else out
 
 
+def _check_probes(df: pd.DataFrame, path: Path) -> None:
+    """Refuse, in one line, a table whose heads are not whole numbers or figures not numbers."""
+    heads = df["head"]
+    if not pd.api.types.is_integer_dtype(heads):
+        bad = next(
+            (h for h in heads if isinstance(h, bool) or not isinstance(h, int | float)
+             or not math.isfinite(h) or h != int(h)),
+            None,
+        )  # fmt: skip
+        if bad is not None or not pd.api.types.is_numeric_dtype(heads):
+            raise ConfigError(
+                f"{path}: head {bad!r} is not a whole number; "
+                "give the probes.parquet `neurosym probe` wrote"
+            )
+    for column in ("accuracy", "control", "selectivity"):
+        if not pd.api.types.is_numeric_dtype(df[column]) or pd.api.types.is_bool_dtype(df[column]):
+            raise ConfigError(
+                f"{path}: column {column} holds {df[column].dtype} values, not numbers; "
+                "give the probes.parquet `neurosym probe` wrote"
+            )
+
+
 def probe_section(folder: Path) -> dict[str, Any]:
     """Per head, its :data:`PROBES_PER_HEAD` most selective probes (accuracy - control)."""
     df = _read(folder, "probes.parquet", "--probe", "probe", ("head", *PROBE_COLUMNS))
+    _check_probes(df, folder / "probes.parquet")
     untrained = "untrained_selectivity" in df.columns
     heads = []
     for head, group in df.groupby("head", sort=True):

@@ -24,15 +24,20 @@ PLAYER_TABLES = ("positions", "holding", "events", "attends", "relations", "atte
 """recording tables embedded per episode"""
 
 
+def finite(value: float) -> float | None:
+    """``value``, or None for NaN and +-inf: JSON has neither, and the page's data block is JSON."""
+    return value if math.isfinite(value) else None
+
+
 def columns(df: pd.DataFrame, drop: tuple[str, ...] = ("episode",)) -> dict[str, list[Any]]:
-    """``{column: values}`` of ``df`` without ``drop``; NaN becomes None (JSON has no NaN)."""
+    """``{column: values}`` of ``df`` without ``drop``; NaN and +-inf become None (not JSON)."""
     out: dict[str, list[Any]] = {}
     for name in df.columns:
         if name in drop:
             continue
         values = df[name].tolist()
         if df[name].dtype.kind == "f":
-            values = [None if math.isnan(v) else v for v in values]
+            values = [v if math.isfinite(v) else None for v in values]
         elif df[name].dtype.kind not in "iub":
             values = [str(v) for v in values]
         out[name] = values
@@ -72,12 +77,12 @@ def player_data(rec: Recording) -> dict[str, Any]:
             {
                 "episode": e,
                 "steps": int(row["steps"]),
-                "return": float(row["return"]),
+                "return": finite(float(row["return"])),
                 "outcome": str(row["outcome"]),
                 "seed": int(row["seed"]),
                 "terrain": terrains.index(terrain),
                 "actions": [str(a) for a in own["action"]],
-                "rewards": [float(r) for r in own["reward"]],
+                "rewards": [finite(float(r)) for r in own["reward"]],
                 "tables": {
                     name: columns(by_episode[name].get(e, _empty(name))) for name in PLAYER_TABLES
                 },

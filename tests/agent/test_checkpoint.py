@@ -307,3 +307,88 @@ def test_a_small_model_on_a_small_map_loads_whatever_its_unused_sizes(tmp_path: 
     assert (
         agent.config.value_size == 64 > max(max(t.shape) for t in agent.model.state_dict().values())
     )
+
+
+def shared_lists(levels: int) -> list:
+    """``[l, l]`` nested ``levels`` times: 2**levels leaves when walked, a few bytes pickled."""
+    out: list = [0]
+    for _ in range(levels):
+        out = [out, out]
+    return out
+
+
+@pytest.mark.parametrize(
+    ("entry", "value", "message"),
+    [
+        ("card", shared_lists(40), "its 'card' is nested more than 20 levels deep"),
+        ("env_kwargs", {"map": shared_lists(40)}, "its 'env_kwargs' is nested more than 20 levels"),
+        ("card", shared_lists(15), "its 'card' is too large: more than 10,000 values (counting "
+         "every place a shared one occurs"),
+        ("metrics", {"names": ["x" * 600_000] * 2}, "its 'metrics' is too large: more than "
+         "1,000,000 characters of text"),
+        ("metrics", {"loss": torch.zeros(2)}, "its 'metrics' holds a value of type Tensor; plain metadata holds "
+         "only str, int, float, bool, None, lists and dicts"),
+        ("card", {1: "a"}, "its 'card' has a key of type int (plain metadata: str)"),
+    ],
+)  # fmt: skip
+def test_metadata_is_bounded_plain_data(
+    tmp_path: Path, entry: str, value: object, message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A card, env options or metrics that expand when walked (shared lists: accepted by
+    torch.load(weights_only=True)) are refused once, where the file is read, in one line; so
+    `neurosym agents` skips the file and `neurosym report` stops at once."""
+    from neurosym.cli import main
+
+    path = tmp_path / "a.pt"
+    write(path)
+    torch.save({**torch.load(path, weights_only=True), entry: value}, path)
+    assert error_of(path).startswith(f"checkpoint {path}: {message}")
+    assert main(["agents", "--dir", str(tmp_path), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert out == "[]\n" and err.startswith(f"neurosym agents: skipped a.pt: checkpoint {path}: ")
+    assert err.count("\n") == 1
+    assert main(["report", "--checkpoint", str(path), "--out", str(tmp_path / "page")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"neurosym report: error: checkpoint {path}: {message}")
+    assert err.count("\n") == 1 and not (tmp_path / "page" / "index.html").exists()
+
+
+def test_negative_counts_are_refused(tmp_path: Path) -> None:
+    path = tmp_path / "a.pt"
+    write(path)
+    torch.save({**torch.load(path, weights_only=True), "frames": -5}, path)
+    assert error_of(path) == (
+        f"checkpoint {path} is damaged: 'frames' is -5; it counts, so it is 0 or more"
+    )
+
+
+@pytest.mark.parametrize(
+    ("card", "why"),
+    [
+        ({"role": "r", "eval_command": "e", "held_out": {"greedy": {"success_rate": 0.5}}},
+         "the card in a.pt: held_out lacks its 'sampled' figures (held_out.sampled must be a dict)"),
+        ([1, 2], "the card in a.pt is of type list, not a dict"),
+        ({"role": 3, "eval_command": "e", "held_out": {}}, "the card in a.pt: role is of type int, not text"),
+    ],
+)  # fmt: skip
+def test_agents_lists_an_agent_with_a_malformed_card_with_its_figures_blank(
+    tmp_path: Path, card: object, why: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Its weights still play, so it is listed; its held-out cell and role are blank, and one
+    line names the field that is wrong."""
+    import json
+
+    from neurosym.cli import main
+
+    path = tmp_path / "a.pt"
+    write(path)
+    torch.save({**torch.load(path, weights_only=True), "card": card}, path)
+    assert main(["agents", "--dir", str(tmp_path), "--json"]) == 0
+    out, err = capsys.readouterr()
+    (agent,) = json.loads(out)
+    assert agent["card"] is None and agent["card_error"] == why
+    assert err == f"neurosym agents: {why}; its held-out figures are left blank\n"
+    assert main(["agents", "--dir", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.split()[:1] == ["a"])
+    assert row.split() == ["a", "rgw2", "predinet", "a3c", "1", "k", "-", "-"]

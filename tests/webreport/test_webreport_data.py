@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 
 import pandas as pd
@@ -17,6 +18,7 @@ from neurosym.export.facts import extract_facts
 from neurosym.export.heads import head_summary
 from neurosym.export.recording import SCHEMA, Recording, conform
 from neurosym.export.report import rule_answers
+from neurosym.webreport.build import identity, stale_page
 from neurosym.webreport.player import PLAYER_TABLES
 
 DATA = re.compile(r'<script type="application/json" id="report-data">(.*?)</script>', re.S)
@@ -149,13 +151,26 @@ def test_report_from_a_checkpoint_writes_extracts_products(run_neurosym, tmp_pat
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == f"wrote {out / 'index.html'}"
-    assert sorted(p.name for p in out.iterdir()) == [".neurosym", "index.html", "kb.pl", "recording"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".neurosym",
+        "index.html",
+        "kb.pl",
+        "recording",
+    ]
     html = (out / "index.html").read_text(encoding="utf-8")
     rec = Recording.load(out / "recording")
     assert tables_back(embedded(html), "attends").equals(rec.attends)
     assert "rgw2-predinet.pt on rgw2" in html
-    assert "<dt>learner</dt><dd>a3c</dd>" in html and "<dt>frames</dt><dd>505,601</dd>" in html
+    assert "<dt>learner</dt><dd>a3c</dd>" in html
+    assert "<dt>frames, whole training</dt><dd>505,601</dd>" in html
     assert "the checkpoint&#39;s card (held-out evaluation)" in html
+    # the card's figures by readable names, shares in percent
+    assert "<dt>held-out, sampled: sword first when guarded</dt><dd>6.7 %</dd>" in html
+    assert "held_out." not in html and "sword_first_guarded" not in html
+    assert (
+        f'<meta name="neurosym-recording" content="{identity(out / "recording", out / "kb.pl")}">'
+        in html
+    )
 
 
 def test_boxworld_page(tmp_path: Path) -> None:
@@ -285,16 +300,220 @@ def test_card_prefers_the_checkpoints_own_card() -> None:
     plain = agent_card(rec_meta, agent)
     assert plain["figures"] == [("greedy_return", "10.7")]
     assert plain["figures_from"].startswith("the last figures of training (not held out")
-    assert ("learner", "ppo") in plain["rows"] and ("frames", "1,200") in plain["rows"]
-    held = {"held_out": {"levels": 1000, "success": 0.9512}, "env": "rgw-random"}
+    assert ("learner", "ppo") in plain["rows"] and ("frames, whole training", "1,200") in plain[
+        "rows"
+    ]
+    held = {"role": "a test agent", "eval_command": "neurosym eval ... --json",
+            "held_out": {"env": "rgw-random", "env_options": {"num_mountains": 6}, "episodes": 300,
+                         "seed": 3000000000,
+                         "sampled": {"success_rate": 0.987, "sword_first_guarded": 1.0},
+                         "greedy": {"success_rate": 0.9512}}}  # fmt: skip
     card = agent_card(
         rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "meta": {"card": held}}})
     )
     assert card["figures"] == [
-        ("held_out.levels", "1000"),
-        ("held_out.success", "0.9512"),
-        ("env", "rgw-random"),
+        ("role", "a test agent"),
+        (
+            "held-out levels",
+            "300 levels of rgw-random (num_mountains=6), reset seeds from 3000000000",
+        ),
+        ("held-out, sampled: success", "98.7 %"),
+        ("held-out, sampled: sword first when guarded", "100.0 %"),
+        ("held-out, greedy: success", "95.1 %"),
+        ("measured by", "neurosym eval ... --json"),
     ]
     assert card["figures_from"] == "the checkpoint's card (held-out evaluation)"
     top = agent_card(rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "card": held}}))
     assert top["figures"] == card["figures"]  # a card at the payload's top level reads the same
+    # a malformed card: the training figures, and a note naming the field
+    bad = {**held, "held_out": {"greedy": {"success_rate": 0.5}}}
+    broken = agent_card(rec_meta, SimpleNamespace(**{**vars(agent), "meta": {**meta, "card": bad}}))
+    assert broken["figures"] == [("greedy_return", "10.7")]
+    assert broken["figures_from"].endswith("(not held out: its card is malformed)")
+    assert broken["note"] == (
+        "Its card is not shown: the card: held_out lacks its 'sampled' figures "
+        "(held_out.sampled must be a dict)."
+    )
+
+
+def test_frames_are_the_whole_trainings_where_the_checkpoint_records_them() -> None:
+    """A curriculum step counts from 0 and records its source's frames; a resume adds to frames."""
+    from neurosym.cards import training_frames
+
+    one = "neurosym train --env bw1 --out a && neurosym train --env bw2 --init-from a.pt --out b"
+    init = {"init_from": "a.pt", "init_frames": 4_500_955}
+    assert training_frames({"frames": 7_052_189, "command": one, "metrics": init}) == (
+        "frames, whole training",
+        "11,553,144 (7,052,189 in its last run, after 4,500,955 of a.pt)",
+    )
+    two = f"{one} && neurosym train --env bw3 --init-from b.pt --out c"
+    assert training_frames({"frames": 10, "command": two, "metrics": init})[1].startswith(
+        "at least 4,500,965 ("
+    )
+    assert training_frames({"frames": 10, "command": one, "metrics": {}}) == (
+        "frames in the last run",
+        "10 (it started from another agent's weights)",
+    )
+    resumed = "neurosym train --env rgw2 --out r && neurosym train --out r --resume"
+    assert training_frames({"frames": 505_601, "command": resumed, "metrics": {}}) == (
+        "frames, whole training",
+        "505,601",
+    )
+
+
+def received(folder: Path, out: Path, **meta: object) -> Path:
+    """A copy of the extract ``folder`` (kb.pl, recording/) with ``meta`` in its meta.json."""
+    out.mkdir()
+    shutil.copy(folder / "kb.pl", out / "kb.pl")
+    shutil.copytree(folder / "recording", out / "recording")
+    path = out / "recording" / "meta.json"
+    head = json.loads(path.read_text())
+    head["meta"].update(meta)
+    path.write_text(json.dumps(head))
+    return out
+
+
+@pytest.mark.parametrize(
+    ("checkpoint", "why"),
+    [
+        ("bw2-predinet", "it was trained on bw2, a boxworld env; the recording is of rgw2"),
+        ("rgw2-mhdpa", "its module is mhdpa, the recording&#39;s predinet"),
+    ],
+)
+def test_a_recording_naming_another_agent_shows_no_card(
+    checkpoint: str, why: str, predinet_page: tuple[Recording, Path, str], tmp_path: Path
+) -> None:
+    _, folder, _ = predinet_page
+    path = Path(__file__).resolve().parents[2] / "checkpoints" / f"{checkpoint}.pt"
+    copy = received(folder, tmp_path / "got", checkpoint=str(path))
+    html = report(copy)
+    assert f"The checkpoint {path} the recording names is not the agent recorded ({why}" in html
+    assert "its card is not shown" in html and "held-out" not in html
+    assert "none: the checkpoint is not at hand" in html
+
+
+@pytest.mark.parametrize(
+    ("meta", "message"),
+    [
+        ({"heads": "four"}, "its recording's meta.json has heads 'four'; it must be a whole number"),
+        ({"heads": 2.5}, "its recording's meta.json has heads 2.5; it must be a whole number"),
+        ({"heads": 10**6}, "its recording's meta.json has heads 1000000; at most 1024"),
+        ({"seed": -1}, "its recording's meta.json has seed -1; it must be a whole number, 0 or more"),
+        ({"env": ["rgw2"]}, "its recording's meta.json has env ['rgw2']; it must be text"),
+        ({"note": [[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]},
+         "its recording's meta.json is nested more than 20 levels deep"),
+    ],
+)  # fmt: skip
+def test_a_bad_recording_meta_is_one_line(
+    meta: dict,
+    message: str,
+    predinet_page: tuple[Recording, Path, str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    _, folder, _ = predinet_page
+    copy = received(folder, tmp_path / "got", **meta)
+    assert main(["report", "--recording", str(copy), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"neurosym report: error: {copy}: {message}")
+    assert err.count("\n") == 1 and not (copy / "index.html").exists()
+
+
+def non_finite_recording() -> Recording:
+    """The scripted recording with reward +inf at its first step and relation values -inf, NaN."""
+    rec = scripted_recording("predinet")
+    steps, relations = rec.steps.copy(), rec.relations.copy()
+    steps.loc[steps.index[0], "reward"] = float("inf")
+    relations.loc[relations.index[0], "value"] = float("-inf")
+    relations.loc[relations.index[1], "value"] = float("nan")
+    tables = {name: rec.tables[name] for name in SCHEMA}
+    return Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
+
+
+def test_non_finite_values_reach_the_page_as_null(tmp_path: Path) -> None:
+    """JSON has no NaN or infinity: the page's data say null where the recording has one."""
+    bad = non_finite_recording()
+    out = tmp_path / "out"
+    write_outputs(out, bad, None, ())  # the recording alone: the KB writer refuses inf
+    html = report(out)
+    data = embedded(html)
+    first = bad.steps.iloc[0]
+    assert data["player"]["episodes"][int(first["episode"])]["rewards"][int(first["t"])] is None
+    values = [v for ep in data["player"]["episodes"] for v in ep["tables"]["relations"]["value"]]
+    assert values.count(None) == 2 and all(v is None or abs(v) < 1e300 for v in values)
+
+
+def test_a_probe_table_with_a_non_integer_head_is_one_line(
+    predinet_page: tuple[Recording, Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, folder, _ = predinet_page
+    for name, heads in (
+        ("words", ["a", "0"]),
+        ("halves", [0.5, 1.0]),
+        ("nan", [0.0, float("nan")]),
+    ):
+        probe = tmp_path / name
+        probe.mkdir()
+        pd.DataFrame({"head": heads, "relation": ["0", "all"], "predicate": ["p", "q"],
+                      "accuracy": [0.9, 0.8], "control": [0.6, 0.7],
+                      "selectivity": [0.3, 0.1]}).to_parquet(probe / "probes.parquet")  # fmt: skip
+        out = ["--out", str(tmp_path / "page")]
+        assert main(["report", "--recording", str(folder), "--probe", str(probe), *out]) == 1
+        err = capsys.readouterr().err
+        bad = heads[0] if name != "nan" else "nan"
+        want = f"neurosym report: error: {probe / 'probes.parquet'}: head {bad!r} is not a whole number"
+        assert err.startswith(want.replace("'nan'", "nan")) and err.count("\n") == 1
+
+
+def test_the_page_is_its_kbs_and_a_stale_one_is_told_and_rebuilt(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A page carries the identity of the recording and KB it was built from; re-extracting
+    beside it makes it stale, report says so, and report --recording publishes a new one."""
+    rec = scripted_recording("predinet")
+    folder = extract_folder(rec, tmp_path / "out")
+    html = report(folder)
+    first = identity(folder / "recording", folder / "kb.pl")
+    assert f'<meta name="neurosym-recording" content="{first}">' in html
+    assert (folder / "index.html").is_symlink()  # published with the KB, as one product
+    assert stale_page(folder, first) is None
+    again = Recording(**{n: rec.tables[n] for n in SCHEMA}, meta={**rec.meta, "seed": 777})
+    extract_folder(again, folder)  # extract again, and the old page beside the new KB:
+    (folder / "index.html").unlink(missing_ok=True)  # as extract leaves it, or a copy brings it
+    (folder / "index.html").write_text(html, encoding="utf-8")
+    now = identity(folder / "recording", folder / "kb.pl")
+    assert now != first
+    assert stale_page(folder, now) == (
+        f"{folder / 'index.html'} was built from another recording or KB than the one beside it"
+    )
+    assert main(["report", "--recording", str(folder), "--out", str(tmp_path / "else")]) == 0
+    assert capsys.readouterr().err == (
+        f"note: {folder / 'index.html'} was built from another recording or KB than the one "
+        f"beside it; `neurosym report --recording {folder}` rebuilds it\n"
+    )
+    html = report(folder)
+    assert stale_page(folder, now) is None and "seed 777)" in html and "seed 0)" not in html
+
+
+def test_a_page_is_not_published_beside_a_kb_extracted_while_it_was_built(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import neurosym.webreport.page as page_module
+
+    rec = scripted_recording("predinet")
+    folder = extract_folder(rec, tmp_path / "out")
+    again = Recording(**{n: rec.tables[n] for n in SCHEMA}, meta={**rec.meta, "seed": 777})
+    render = page_module.render
+
+    def extract_meanwhile(context: dict) -> str:
+        extract_folder(again, folder)
+        return render(context)
+
+    monkeypatch.setattr(page_module, "render", extract_meanwhile)
+    assert main(["report", "--recording", str(folder), "--quiet"]) == 1
+    assert capsys.readouterr().err == (
+        f"neurosym report: error: {folder} was extracted again while its report was built; "
+        f"nothing was written: run `neurosym report --recording {folder}` again\n"
+    )
+    assert not (folder / "index.html").exists()
+    assert "kb_meta(seed,777)" in (folder / "kb.pl").read_text()  # the new KB, untouched

@@ -18,6 +18,8 @@
     if (parent) parent.appendChild(node);
     return node;
   }
+  // a number of the data, or "not finite" where it was NaN or +-inf (null in the JSON)
+  function fx(v, digits) { return typeof v === "number" && Number.isFinite(v) ? v.toFixed(digits) : "not finite"; }
   function headColour(i) { return palette[i % palette.length]; }
   function styleOf(name) {
     return styles[name] || { fill: "#cccccc", text: "black", label: String(name).slice(0, 2) };
@@ -140,9 +142,9 @@
     for (const arg of [1, 2]) {
       const i = found[arg], g = arg === 1 ? panel.a1 : panel.a2;
       if (i === null) { place(g, null); continue; }
-      const tip = `head ${panel.head} a${arg}: ${at.entity[i]} (${at.row[i]}, ${at.col[i]}), weight ${at.weight[i].toFixed(3)}`;
+      const tip = `head ${panel.head} a${arg}: ${at.entity[i]} (${at.row[i]}, ${at.col[i]}), weight ${fx(at.weight[i], 3)}`;
       place(g, at.row[i], at.col[i], c, tip);
-      text.push(`a${arg} ${at.entity[i]} (${at.row[i]},${at.col[i]}) ${at.weight[i].toFixed(2)}`);
+      text.push(`a${arg} ${at.entity[i]} (${at.row[i]},${at.col[i]}) ${fx(at.weight[i], 2)}`);
     }
     panel.cap.textContent = `head ${panel.head}: ` + (text.length ? text.join(" · ") : "no step (final state)");
   }
@@ -163,10 +165,10 @@
     panel.heat.forEach((r, k) => r.setAttribute("fill-opacity", top > 0 ? (0.75 * sum[k] / top).toFixed(3) : 0));
     if (best === null) { place(panel.focus, null); } else {
       place(panel.focus, at.key_row[best], at.key_col[best], panel.map.cell,
-        `head ${panel.head}: the agent's strongest key ${at.key[best]}, weight ${at.weight[best].toFixed(3)}`);
+        `head ${panel.head}: the agent's strongest key ${at.key[best]}, weight ${fx(at.weight[best], 3)}`);
     }
     panel.cap.textContent = `head ${panel.head}: ` + (rows.length === 0 ? "no step (final state)" :
-      best === null ? "keys shaded by weight" : `agent -> ${at.key[best]} (${at.key_row[best]},${at.key_col[best]}) ${at.weight[best].toFixed(2)}`);
+      best === null ? "keys shaded by weight" : `agent -> ${at.key[best]} (${at.key_row[best]},${at.key_col[best]}) ${fx(at.weight[best], 2)}`);
   }
 
   let dscale = null;
@@ -204,10 +206,10 @@
       tr.cells[1].textContent = `${rel.a[i]} - ${rel.b[i]}`;
       const td = tr.cells[rel.j[i] + 2], v = rel.value[i];
       const col = diverging(v, dscale[rel.j[i]]);
-      td.textContent = v.toFixed(2);
+      td.textContent = fx(v, 2);
       td.style.background = col.bg; td.style.color = col.fg;
       const thr = data.thresholds[String(rel.j[i])];
-      const held = thr !== undefined && Math.abs(v) > thr;
+      const held = typeof thr === "number" && Math.abs(v) > thr;
       td.className = held ? "held" : "";
       td.title = `D_${rel.j[i]}(${rel.a[i]}, ${rel.b[i]}) = ${v}` + (held ? ` (above threshold ${thr.toPrecision(4)}: a holds/5 fact)` : "");
     }
@@ -216,10 +218,10 @@
   function drawStatus(ep, t) {
     $("stepno").textContent = `state ${t} of ${ep.steps}`;
     $("s-action").textContent = t < ep.steps ? ep.actions[t] : "none (final state)";
-    $("s-reward").textContent = t < ep.steps ? String(ep.rewards[t]) : "-";
+    $("s-reward").textContent = t < ep.steps ? (ep.rewards[t] === null ? "not finite" : String(ep.rewards[t])) : "-";
     let ret = 0;
-    for (let k = 0; k < Math.min(t, ep.steps); k++) ret += ep.rewards[k];
-    $("s-return").textContent = `${ret.toFixed(2)} so far (episode: ${ep.return.toFixed(2)}, ${ep.outcome})`;
+    for (let k = 0; k < Math.min(t, ep.steps); k++) ret += ep.rewards[k] === null ? NaN : ep.rewards[k];
+    $("s-return").textContent = `${fx(ret, 2)} so far (episode: ${fx(ep.return, 2)}, ${ep.outcome})`;
     const hold = ep.tables.holding, hs = ep.byT.holding[t] || [];
     $("s-holding").textContent = hs.length ? hs.map((i) => hold.item[i]).join(", ") : "nothing";
     const ev = ep.tables.events, es = ep.byT.events[t] || [];
@@ -291,7 +293,7 @@
     P.episodes.forEach((ep, i) => {
       const o = document.createElement("option");
       o.value = String(i);
-      o.textContent = `episode ${ep.episode}: ${ep.outcome}, return ${ep.return.toFixed(2)}, ${ep.steps} steps`;
+      o.textContent = `episode ${ep.episode}: ${ep.outcome}, return ${fx(ep.return, 2)}, ${ep.steps} steps`;
       select.appendChild(o);
     });
     relationScale();
