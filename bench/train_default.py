@@ -55,12 +55,13 @@ class SeedRun:
         rate = "-" if self.success_rate is None else f"{self.success_rate:.1%}"
         return (
             f"{self.seed:>4}  {'yes' if self.reached else 'no':>7}  {when}  "
-            f"{self.wall_s:7.1f} {self.frames:>10,}  {rate:>8}  "
+            f"{self.wall_s:7.1f} {self.frames:>10,} {self.frames / max(self.wall_s, 1e-9):7,.0f}  "
+            f"{rate:>8}  "
             f"{self.load_before:4.2f} -> {self.load_after:4.2f}"
         )
 
 
-HEADER = "seed  reached  to_90%_s  to_90%_frames  train_s     frames  success  load (1 min avg)"
+HEADER = "seed  reached  to_90%_s  to_90%_frames  train_s     frames  frames/s  success  load (1 min avg)"
 
 
 def run_seed(args: argparse.Namespace, seed: int) -> SeedRun:
