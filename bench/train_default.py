@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"neurosym train --env {args.env} --module {args.module} --target-success {args.target} "
         f"--window {args.window} --minutes {args.minutes:g} {args.args}".rstrip()
-        + f"; {os.cpu_count()} cores",
+        + f"; {len(os.sched_getaffinity(0))} cores",
         flush=True,
     )
     print(HEADER, flush=True)

@@ -38,6 +38,7 @@ from __future__ import annotations
 import ast
 import inspect
 import math
+import numbers
 import textwrap
 from dataclasses import MISSING, asdict, dataclass, field, fields
 from functools import cache
@@ -80,7 +81,7 @@ class Range:
 
     def holds(self, value: Any) -> bool:
         """Whether one number is finite and inside the range."""
-        if isinstance(value, bool) or not isinstance(value, int | float):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):  # numpy's too
             return False
         if not math.isfinite(value):
             return False
@@ -94,7 +95,7 @@ class Range:
 
 
 def _number(value: float) -> str:
-    """A range's end as people write it: 4096, 0.5, 1e-05, 1e+12."""
+    """A range's end as people write it: 4096, 0.5, 1e-05, 1e12."""
     if abs(value) < 10**7 and float(value).is_integer():
         return str(int(value))
     return f"{value:g}".replace("e+", "e")
@@ -119,7 +120,7 @@ FLAG = flag()
 
 
 def range_error(name: str, value: Any, kind: type, bounds: Range) -> str | None:
-    """Why ``value`` does not fit the setting ``name`` ("" -> None when it fits)."""
+    """Why ``value`` does not fit the setting ``name``, in one line (None when it fits)."""
     what = "an integer" if kind is int else "a finite number"
     if bounds.length is not None:  # widths: 1 to length entries, each in range
         entries = value if isinstance(value, tuple | list) else (value,)
@@ -133,7 +134,7 @@ def range_error(name: str, value: Any, kind: type, bounds: Range) -> str | None:
 
 
 def _fits(value: Any, kind: type, bounds: Range) -> bool:
-    if kind is int and not (isinstance(value, int) and not isinstance(value, bool)):
+    if kind is int and not isinstance(value, numbers.Integral):
         return False
     return bounds.holds(value)
 
@@ -441,7 +442,7 @@ class PPOConfig:
     """passes over each rollout"""
     ppo_minibatches: int = field(default=4, metadata=flag("[1, 65536]"))
     """minibatches per pass"""
-    clip_range: float = field(default=0.2, metadata=bounded("(0, 10]"))
+    clip_range: float = field(default=0.2, metadata=bounded("(0, 1000]"))
     """probability-ratio clip"""
     ppo_advantages: str = "minibatch"
     """with normalize_advantages: "minibatch" centres and scales each minibatch's advantages

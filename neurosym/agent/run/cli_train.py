@@ -86,7 +86,7 @@ def default_text(cls: type, f: Field[Any]) -> str:
     if cls is RunOptions:
         return "none" if f.default is None else _shown(f.default)
     if f.name == "workers":
-        return "one per CPU core"
+        return "one per CPU core it may use"
     per_algo: dict[str, dict[str, Any]] = {}
     for (family, algo), values in _preset_values().items():
         if f.name in values and (cls is not ModelConfig or algo == "a3c"):  # the model's: any
@@ -357,12 +357,21 @@ def command_line(args: argparse.Namespace) -> str:
     return command
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (taskset, a container's CPU set), else all of them:
+    A3C's default worker count."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # no affinity on this platform
+        return os.cpu_count() or 1
+
+
 def run(args: argparse.Namespace) -> int:
     from neurosym.agent.run.trainer import train
 
     overrides = overrides_of(args)
     if "workers" not in overrides["train"] and not args.resume and args.algo in (None, "a3c"):
-        overrides["train"]["workers"] = os.cpu_count() or 1
+        overrides["train"]["workers"] = usable_cores()
     given = {
         f.name: getattr(args, f.name)
         for f in fields(RunOptions)
