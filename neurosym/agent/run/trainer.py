@@ -99,9 +99,9 @@ class TrainingDiverged(NeurosymError):
     them; the checkpoint keeps the last finite weights it had written (if any)."""
 
 
-def non_finite(model: torch.nn.Module) -> str | None:
-    """The first parameter or buffer of ``model`` holding inf or NaN, in words (None: all finite)."""
-    for name, tensor in model.state_dict().items():
+def non_finite(state: dict[str, torch.Tensor]) -> str | None:
+    """The first tensor of a model's ``state`` holding inf or NaN, in words (None: all finite)."""
+    for name, tensor in state.items():
         if tensor.is_floating_point() and not bool(torch.isfinite(tensor).all()):
             return f"its weights {name} are not finite"
     return None
@@ -423,7 +423,9 @@ class _Supervisor:
         """Write ``checkpoint.pt``: the shared model (or ``state_dict``) and the run's record;
         weights that are not finite are never written (the run stops as diverged)."""
         plan = self.plan
-        if state_dict is None and self.weights_diverged():
+        if state_dict is None:  # a copy: the learners go on changing the shared weights
+            state_dict = {k: v.detach().clone() for k, v in self.shared.state_dict().items()}
+        if self.weights_diverged(state_dict):
             return
         self.checkpoint_frames = self.stats.frames
         metrics = {**(self.rows[-1] if self.rows else {}), **plan.init_meta, **extra}
@@ -448,9 +450,10 @@ class _Supervisor:
         )
         self.wrote_checkpoint = True
 
-    def weights_diverged(self) -> bool:
-        """Whether the shared weights hold inf or NaN (then the outcome says so)."""
-        problem = non_finite(self.shared)
+    def weights_diverged(self, state: dict[str, torch.Tensor] | None = None) -> bool:
+        """Whether ``state`` (by default the shared weights) holds inf or NaN; the outcome
+        then says so."""
+        problem = non_finite(self.shared.state_dict() if state is None else state)
         if problem is not None and self.outcome.diverged is None:
             self.outcome.diverged = problem
         return problem is not None
@@ -486,10 +489,9 @@ class _Supervisor:
         ):
             return
         snapshot = {k: v.detach().clone() for k, v in self.shared.state_dict().items()}
-        self.eval_model.load_state_dict(snapshot)
-        if non_finite(self.eval_model) is not None:
-            self.weights_diverged()  # says so; the watch loop stops the run
+        if self.weights_diverged(snapshot):  # the watch loop stops the run
             return
+        self.eval_model.load_state_dict(snapshot)
         done = self.evaluate()
         outcome.greedy = float(np.mean(done.returns))
         outcome.greedy_success = float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes]))
