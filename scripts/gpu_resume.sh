@@ -18,6 +18,23 @@
 # carried to the next machine with `carry: [RUN]` and trained on with the same command.
 set -euo pipefail
 
+USAGE="usage: $0 train RUN MINUTES [TRAIN ARGS...] | collect FILES RUN | --help"
+
+usage_error() {  # MESSAGE: one line on stderr, then exit 2
+    echo "$0: $1; $USAGE" >&2
+    exit 2
+}
+
+names() {  # COMMAND COUNT ARGS...: the command's first COUNT arguments are names, not options
+    local command=$1 count=$2 name
+    shift 2
+    (($# >= count)) || usage_error "$command needs $count names, got $#"
+    for name in "${@:1:count}"; do
+        [[ -n $name ]] || usage_error "$command: an empty name"
+        [[ $name != -* ]] || usage_error "$command: $name is not a name (names come first, without '-')"
+    done
+}
+
 handback() {  # RUN OUT: the run's files into OUT, each replaced whole
     local run=$1 out=$2 tmp
     tmp=$(mktemp -d "$out/.handback.XXXX")
@@ -34,8 +51,11 @@ handback() {  # RUN OUT: the run's files into OUT, each replaced whole
 }
 
 train() {
+    names train 2 "$@"
     local run=$1 minutes=$2
     shift 2
+    [[ $minutes =~ ^[0-9]+([.][0-9]+)?$ ]] && [[ ! $minutes =~ ^0+([.]0+)?$ ]] \
+        || usage_error "train: MINUTES must be a positive number, got $minutes"
     : "${OUT:?OUT must name the folder that comes back (the device tool sets it)}"
     local python=${PYTHON:-python3}
     if ! "$python" -c "import gymnasium" 2>/dev/null; then
@@ -65,7 +85,10 @@ train() {
 }
 
 collect() {
+    names collect 2 "$@"
     local files=$1 run=$2
+    (($# == 2)) || usage_error "collect takes FILES and RUN only, got $# arguments"
+    [[ -d $files ]] || { echo "$0: collect: FILES folder $files does not exist (the folder the device tool handed back)" >&2; exit 1; }
     mkdir -p "$run"
     if compgen -G "$files/checkpoint.pt.part*" >/dev/null; then
         cat "$files"/checkpoint.pt.part* >"$run/.checkpoint.pt.tmp"
@@ -79,5 +102,6 @@ collect() {
 case ${1:-} in
     train) shift; train "$@" ;;
     collect) shift; collect "$@" ;;
-    *) echo "usage: $0 train RUN MINUTES [TRAIN ARGS...] | collect FILES RUN" >&2; exit 2 ;;
+    -h | --help) echo "$USAGE"; exit 0 ;;
+    *) echo "$USAGE" >&2; exit 2 ;;
 esac

@@ -37,6 +37,8 @@ from __future__ import annotations
 
 import ast
 import inspect
+import math
+import numbers
 import textwrap
 from dataclasses import MISSING, asdict, dataclass, field, fields
 from functools import cache
@@ -54,13 +56,107 @@ INITS = ("orthogonal", "torch")
 QUERIES = ("scene", "learned")
 KEYS = ("entities", "cells")
 
-FLAG = {"flag": True}
+
+@dataclass(frozen=True)
+class Range:
+    """The values a numeric setting may take: finite, from ``low`` to ``high``, each end
+    open or closed; for a tuple setting (widths), each entry, and at most ``length`` of them.
+
+    Declared with the setting (``field(metadata=bounded("(0, 1]"))``): the config
+    classes check their values against it (:func:`check_ranges`), and ``neurosym
+    train --set`` reads it. Sizes are bounded too, since they size allocations.
+    """
+
+    low: float
+    high: float
+    low_open: bool = False
+    high_open: bool = False
+    length: int | None = None
+
+    @classmethod
+    def parse(cls, text: str, length: int | None = None) -> Range:
+        """'(0, 1]' -> Range(0, 1, low_open=True); ends are Python numbers."""
+        low, high = (ast.literal_eval(part.strip()) for part in text[1:-1].split(","))
+        return cls(low, high, text[0] == "(", text[-1] == ")", length)
+
+    def holds(self, value: Any) -> bool:
+        """Whether one number is finite and inside the range."""
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):  # numpy's too
+            return False
+        if not math.isfinite(value):
+            return False
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above and below
+
+    def __str__(self) -> str:
+        low, high = _number(self.low), _number(self.high)
+        return f"{'(' if self.low_open else '['}{low}, {high}{')' if self.high_open else ']'}"
+
+
+def _number(value: float) -> str:
+    """A range's end as people write it: 4096, 0.5, 1e-05, 1e12."""
+    if abs(value) < 10**7 and float(value).is_integer():
+        return str(int(value))
+    return f"{value:g}".replace("e+", "e")
+
+
+def bounded(interval: str, *, length: int | None = None, **meta: Any) -> dict[str, Any]:
+    """Field metadata: the setting's :class:`Range` (``interval`` such as "(0, 1]") and ``meta``."""
+    return {**meta, "range": Range.parse(interval, length)}
+
+
+def flag(interval: str | None = None, **cli: Any) -> dict[str, Any]:
+    """Field metadata for a setting with a flag: its range (``interval``, as :func:`bounded`),
+    ``choices``, ``metavar``, ``parse`` ("channels"), ``length`` (for a tuple)."""
+    meta = {"flag": True, **cli}
+    if interval is not None:
+        meta = bounded(interval, **meta)
+    return meta
+
+
+FLAG = flag()
 """field metadata: the setting is a ``neurosym train`` flag of its own (others: ``--set``)"""
 
 
-def flag(**cli: Any) -> dict[str, Any]:
-    """Field metadata for a setting with a flag: ``choices``, ``metavar``, ``parse`` ("channels")."""
-    return {"flag": True, **cli}
+def range_error(name: str, value: Any, kind: type, bounds: Range) -> str | None:
+    """Why ``value`` does not fit the setting ``name``, in one line (None when it fits)."""
+    what = "an integer" if kind is int else "a finite number"
+    if bounds.length is not None:  # widths: 1 to length entries, each in range
+        entries = value if isinstance(value, tuple | list) else (value,)
+        if 1 <= len(entries) <= bounds.length and all(_fits(v, kind, bounds) for v in entries):
+            return None
+        shown = ",".join(map(str, entries))
+        return f"{name} must be 1 to {bounds.length} entries, each {what} in {bounds}, got {shown}"
+    if _fits(value, kind, bounds):
+        return None
+    return f"{name} must be {what} in {bounds}, got {value}"
+
+
+def _fits(value: Any, kind: type, bounds: Range) -> bool:
+    if kind is int and not isinstance(value, numbers.Integral):
+        return False
+    return bounds.holds(value)
+
+
+def field_kind(cls: type, name: str) -> type:
+    """int or float: how a numeric field's values are read (a tuple's entries are ints)."""
+    declared = str(next(f.type for f in fields(cls) if f.name == name))
+    return float if "float" in declared else int
+
+
+def check_ranges(config: Any) -> None:
+    """Refuse, in one line, a field value outside the range declared with it (:class:`Range`)."""
+    for f in fields(config):
+        bounds = f.metadata.get("range")
+        if bounds is None:
+            continue
+        value = getattr(config, f.name)
+        if value is None:  # an optional setting left unset
+            continue
+        problem = range_error(f.name, value, field_kind(type(config), f.name), bounds)
+        if problem:
+            raise ConfigError(problem)
 
 
 # Table 4 values that differ by env family.
@@ -136,6 +232,15 @@ _DEFAULT_MODEL: dict[str, dict[str, Any]] = {
     # a forward-backward; 32 halves both
     "boxworld": {**_SEEING_MODEL, "key_size": 32},
 }
+_DEFAULT_PREDINET: dict[str, dict[str, Any]] = {
+    # Box-World: learned queries. Scene queries (Q = flat(L) W_Q) let one update fix every
+    # head's attention on a few cells of the first levels it saw (the largest weight goes from
+    # 0.03 to 0.78 in two PPO updates), and A3C on bw1 then misses 90 % training success on 2 of
+    # 3 seeds in 10 minutes; learned queries reach it on all 3, 2-3x sooner, and skip the
+    # query projection, most of a forward's arithmetic (docs/results.md, "Against
+    # Stable-Baselines3 on bw1"; bench/train_default.py). Checkpoints record their query.
+    "boxworld": {"query": "learned"},
+}
 _LEGACY: dict[str, dict[str, Any]] = {
     # what the code did before each setting existed (checkpoints without the key)
     "ModelConfig": {"entity_norm": False, "attention_gain": 1.0, "init": "torch"},
@@ -174,14 +279,6 @@ def _check_choice(config: Any, name: str, allowed: tuple[str, ...]) -> None:
         raise ConfigError(f"unknown {name} {value!r}; expected one of {', '.join(allowed)}")
 
 
-def _check_positive(config: Any, *names: str, integer: bool = False) -> None:
-    for name in names:
-        value = getattr(config, name)
-        if not (int(value) >= 1 if integer else float(value) > 0):
-            kind = "a positive integer" if integer else "positive"
-            raise ConfigError(f"{name} must be {kind}, got {value}")
-
-
 def preset_env_kwargs(family: str, preset: str = "default") -> dict[str, Any]:
     """Env options a preset trains with: Box-World's one-hot observation by default, RGB for the thesis."""
     _check_family(family)
@@ -199,33 +296,36 @@ class ModelConfig:
     """relational module: "predinet" or "mhdpa" """
     obs_shape: tuple[int, int, int]
     """observation shape (C, H, W); the model has H * W entities"""
-    obs_scale: float = 1.0
+    obs_scale: float = field(default=1.0, metadata=bounded("(0, 1]"))
     """factor turning raw observation values into [0, 1] (1 for onehot, 1/255 for grey/RGB)"""
     conv_channels: tuple[int, ...] = field(
-        default=(12, 24), metadata=flag(parse="channels", metavar="C1,C2,...")
+        default=(12, 24),
+        metadata=flag("[1, 1024]", length=16, parse="channels", metavar="C1,C2,..."),
     )
     """output channels of the encoder's conv layers (Table 4: 12,24)"""
-    kernel_size: int = field(default=2, metadata=FLAG)
+    kernel_size: int = field(default=2, metadata=flag("[1, 15]"))
     """encoder conv kernel, stride 1, padded so the feature map keeps the grid shape (Table 4: 2)"""
-    heads: int = field(default=4, metadata=FLAG)
+    heads: int = field(default=4, metadata=flag("[1, 64]"))
     """attention heads (Table 4: 4)"""
-    key_size: int = 32
+    key_size: int = field(default=32, metadata=bounded("[1, 1024]"))
     """query and key size per head (Table 4: 32 RGW, 64 BW)"""
-    relations: int = 8
+    relations: int = field(default=8, metadata=bounded("[1, 256]"))
     """PrediNet relations J per head (Table 4: 8; the thesis text says 4)"""
-    value_size: int = 64
+    value_size: int = field(default=64, metadata=bounded("[1, 1024]"))
     """MHDPA value size per head (Table 4: 64)"""
-    output_size: int = 26
+    output_size: int = field(default=26, metadata=bounded("[1, 1024]"))
     """width of the vector the relational module hands the actor-critic (Table 4: 26)"""
-    hidden_sizes: tuple[int, ...] = (256, 128, 64)
+    hidden_sizes: tuple[int, ...] = field(
+        default=(256, 128, 64), metadata=bounded("[1, 8192]", length=8)
+    )
     """actor-critic MLP widths (Table 4: 256, 128, 64)"""
-    n_actions: int = 4
-    """policy outputs (up, right, down, left)"""
+    n_actions: int = field(default=4, metadata=bounded("[1, 64]"))
+    """policy outputs (up, right, down, left): the env's actions"""
     entity_norm: bool = True
     """LayerNorm over each entity's conv features before the relational module (thesis: off).
     Without it the fresh network's entities are small and alike: PrediNet's attention is
     uniform and the logits barely vary across observations."""
-    attention_gain: float = 8.0
+    attention_gain: float = field(default=8.0, metadata=bounded("(0, 1000]"))
     """factor on the attention logits, softmax(gain * Q K^T / sqrt(d)) (thesis: 1). At 1 the
     fresh attention is close to uniform, so every head attends to the mean entity; at 8 the
     heads start out looking at something."""
@@ -262,23 +362,7 @@ class ModelConfig:
             raise ConfigError(
                 f"obs_shape must be (C, H, W) with positive sizes, got {self.obs_shape}"
             )
-        if not self.conv_channels or not self.hidden_sizes:
-            raise ConfigError("conv_channels and hidden_sizes need at least one entry each")
-        for name in (
-            "kernel_size",
-            "heads",
-            "key_size",
-            "relations",
-            "value_size",
-            "output_size",
-            "n_actions",
-        ):
-            if int(getattr(self, name)) < 1:
-                raise ConfigError(f"{name} must be a positive integer, got {getattr(self, name)}")
-        if min(self.conv_channels) < 1 or min(self.hidden_sizes) < 1:
-            raise ConfigError("conv_channels and hidden_sizes must be positive")
-        if not self.obs_scale > 0:
-            raise ConfigError(f"obs_scale must be positive, got {self.obs_scale}")
+        check_ranges(self)
         # PrediNet's switches: the first choice is DESIGN's, the only one MHDPA has
         for name, allowed, plural in (("query", QUERIES, "queries"), ("keys", KEYS, "keys")):
             value, default = getattr(self, name), allowed[0]
@@ -291,8 +375,6 @@ class ModelConfig:
                 )
         if self.init not in INITS:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
-        if not self.attention_gain > 0:
-            raise ConfigError(f"attention_gain must be positive, got {self.attention_gain}")
 
     @property
     def n_entities(self) -> int:
@@ -318,6 +400,8 @@ class ModelConfig:
         _check_family(family)
         _check_preset(preset)
         switches = _THESIS_MODEL if preset == "thesis" else _DEFAULT_MODEL[family]
+        if preset == "default" and module == "predinet":
+            switches = {**switches, **_DEFAULT_PREDINET.get(family, {})}
         values = {
             **_MODEL_FAMILY[family],
             **switches,
@@ -339,28 +423,26 @@ class ModelConfig:
 class A3CConfig:
     """A3C's own settings (``--algo a3c``): asynchronous workers, self-imitation."""
 
-    workers: int = field(default=2, metadata=FLAG)
-    """worker processes W (neurosym train's default: one per CPU core)"""
-    sil: float = field(default=0.0, metadata=FLAG)
+    workers: int = field(default=2, metadata=flag("[1, 256]"))
+    """worker processes W (2 when built in Python)"""
+    sil: float = field(default=0.0, metadata=flag("[0, 100]"))
     """weight of the self-imitation loss on the best episodes so far (0: none)"""
-    sil_episodes: int = 32
+    sil_episodes: int = field(default=32, metadata=bounded("[1, 100000]"))
     """best episodes each worker keeps for self-imitation"""
 
     def __post_init__(self) -> None:
-        _check_positive(self, "workers", "sil_episodes", integer=True)
-        if self.sil < 0:
-            raise ConfigError(f"sil must be >= 0, got {self.sil}")
+        check_ranges(self)
 
 
 @dataclass(frozen=True)
 class PPOConfig:
     """PPO's own settings (``--algo ppo``): clipped-surrogate epochs over each rollout."""
 
-    ppo_epochs: int = field(default=4, metadata=FLAG)
+    ppo_epochs: int = field(default=4, metadata=flag("[1, 1000]"))
     """passes over each rollout"""
-    ppo_minibatches: int = field(default=4, metadata=FLAG)
+    ppo_minibatches: int = field(default=4, metadata=flag("[1, 65536]"))
     """minibatches per pass"""
-    clip_range: float = 0.2
+    clip_range: float = field(default=0.2, metadata=bounded("(0, 1000]"))
     """probability-ratio clip"""
     ppo_advantages: str = "minibatch"
     """with normalize_advantages: "minibatch" centres and scales each minibatch's advantages
@@ -368,8 +450,7 @@ class PPOConfig:
     far (A3C's), so that a rollout without reward keeps its small advantages small"""
 
     def __post_init__(self) -> None:
-        _check_positive(self, "ppo_epochs", "ppo_minibatches", integer=True)
-        _check_positive(self, "clip_range")
+        check_ranges(self)
         _check_choice(self, "ppo_advantages", PPO_ADVANTAGES)
 
 
@@ -377,15 +458,15 @@ class PPOConfig:
 class ImitationConfig:
     """DAgger's own settings (``--algo imitate``): imitation of the RGW planner."""
 
-    dagger_beta_frames: int = 200_000
+    dagger_beta_frames: int = field(default=200_000, metadata=bounded("[0, 1e12]"))
     """frames over which the chance of following the planner falls from 1 to 0"""
-    dagger_buffer: int = 204_800
+    dagger_buffer: int = field(default=204_800, metadata=bounded("[1, 1_048_576]"))
     """labelled states kept (the latest)"""
-    dagger_batch: int = 512
+    dagger_batch: int = field(default=512, metadata=bounded("[1, 65536]"))
     """states per gradient step"""
-    dagger_steps: int = field(default=8, metadata=FLAG)
+    dagger_steps: int = field(default=8, metadata=flag("[1, 10000]"))
     """gradient steps per rollout of envs x n_steps labelled states"""
-    safe_coef: float = field(default=0.0, metadata=flag(metavar="C"))
+    safe_coef: float = field(default=0.0, metadata=flag("[0, 100]", metavar="C"))
     """weight of a second set loss on every action that gives no return up (the planner's
     regret 0) beside the fastest actions' loss (0: none). It weighs only the states where an
     episode can miss its optimum, which the fastest-route loss weighs like any other."""
@@ -394,16 +475,15 @@ class ImitationConfig:
     planner are symmetric), so that the network does not memorise its labelled states"""
 
     def __post_init__(self) -> None:
-        _check_positive(self, "dagger_buffer", "dagger_batch", "dagger_steps", integer=True)
-        for name in ("dagger_beta_frames", "safe_coef"):
-            if getattr(self, name) < 0:
-                raise ConfigError(f"{name} must be >= 0, got {getattr(self, name)}")
+        check_ranges(self)
 
 
 LearnerConfig = A3CConfig | PPOConfig | ImitationConfig
 LEARNER_CONFIGS: dict[str, type] = {"a3c": A3CConfig, "ppo": PPOConfig, "imitate": ImitationConfig}
 """each ``--algo``'s own settings"""
 SEED_LIMIT = 2**64
+ROLLOUT_LIMIT = 2**20
+"""states one rollout may hold (envs x n_steps): the buffers are allocated for them"""
 """seeds are integers in [0, 2**64): what torch and numpy accept"""
 
 
@@ -423,37 +503,37 @@ class TrainConfig:
     optimizer: str = "adam"
     """"adam" (its per-weight step is about lr whatever the gradient's size) or "rmsprop"
     (Table 4; with its epsilon 0.1 the tiny gradients of a fresh encoder barely move it)"""
-    lr: float = field(default=1e-3, metadata=FLAG)
+    lr: float = field(default=1e-3, metadata=flag("(0, 1]"))
     """learning rate (Table 4, RMSprop: 2e-3 RGW, 2e-4 BW)"""
-    entropy: float = field(default=0.02, metadata=FLAG)
+    entropy: float = field(default=0.02, metadata=flag("[0, 100]"))
     """entropy bonus weight (Table 4: 0.02 RGW, 0.01 BW)"""
-    gamma: float = field(default=0.99, metadata=FLAG)
+    gamma: float = field(default=0.99, metadata=flag("(0, 1]"))
     """discount (not in the thesis)"""
-    n_steps: int = field(default=40, metadata=FLAG)
+    n_steps: int = field(default=40, metadata=flag("[1, 10000]"))
     """rollout length per update (Table 4 "buffer": 40)"""
-    value_coef: float = 0.5
+    value_coef: float = field(default=0.5, metadata=bounded("[0, 1000]"))
     """weight of the value loss"""
-    explore: float = 0.0
+    explore: float = field(default=0.0, metadata=bounded("[0, 1000]"))
     """count-based exploration bonus beta (intrinsic reward beta / sqrt(visits)); 0: none"""
-    explore_half_life: float = 2000.0
+    explore_half_life: float = field(default=2000.0, metadata=bounded("(0, 1e12]"))
     """half-life of the visit counts, in learner steps (K frames each)"""
-    rms_eps: float = 1e-5
+    rms_eps: float = field(default=1e-5, metadata=bounded("(0, 1]"))
     """RMSprop epsilon (Table 4: 0.1, which stalls learning here)"""
-    adam_eps: float = 1e-5
+    adam_eps: float = field(default=1e-5, metadata=bounded("(0, 1]"))
     """Adam epsilon"""
-    reward_scale: float = 1.0
+    reward_scale: float = field(default=1.0, metadata=bounded("(0, 1000]"))
     """factor on the env's rewards in the training signal (reported returns stay the env's)"""
     normalize_advantages: bool = True
     """scale each update's advantages, so that the actor's gradient does not grow with the
     rewards' size and the critic does not drown it on the shared layers"""
-    gae_lambda: float = 0.95
+    gae_lambda: float = field(default=0.95, metadata=bounded("[0, 1]"))
     """GAE lambda for the advantages (1: the n-step returns of Table 4's A3C)"""
-    rms_alpha: float = 0.99
+    rms_alpha: float = field(default=0.99, metadata=bounded("(0, 1)"))
     """RMSprop decay (Table 4: 0.99), no momentum"""
-    grad_clip: float = 0.5
+    grad_clip: float = field(default=0.5, metadata=bounded("(0, 1e6]"))
     """global gradient-norm clip (Table 4: 400, which never bites; 0.5, as common A2C/PPO code
     has it, keeps one rollout with a rare large reward from throwing the weights far)"""
-    envs: int = field(default=8, metadata=FLAG)
+    envs: int = field(default=8, metadata=flag("[1, 4096]"))
     """environments per learner K (1: classic A3C with one env per worker)"""
     seed: int = field(default=0, metadata=FLAG)
     """base seed of the run's envs, sampling and initial weights"""
@@ -468,15 +548,12 @@ class TrainConfig:
             object.__setattr__(self, "learner", own())
         elif not isinstance(self.learner, own):
             raise ConfigError(f"--algo {self.algo} needs {own.__name__}, got {self.learner!r}")
-        _check_positive(self, "lr", "gamma", "rms_eps", "adam_eps", "rms_alpha", "grad_clip",
-                        "explore_half_life", "reward_scale")  # fmt: skip
-        _check_positive(self, "n_steps", "envs", integer=True)
-        if not 0 < self.gamma <= 1 or not 0 < self.rms_alpha < 1:
-            raise ConfigError("gamma must be in (0, 1] and rms_alpha in (0, 1)")
-        if not 0 <= self.gae_lambda <= 1:
-            raise ConfigError(f"gae_lambda must be in [0, 1], got {self.gae_lambda}")
-        if self.entropy < 0 or self.value_coef < 0 or self.explore < 0:
-            raise ConfigError("entropy, value_coef and explore must be >= 0")
+        check_ranges(self)
+        if self.envs * self.n_steps > ROLLOUT_LIMIT:
+            raise ConfigError(
+                f"envs x n_steps must be at most {ROLLOUT_LIMIT:,} states per rollout, got "
+                f"{self.envs} x {self.n_steps} = {self.envs * self.n_steps:,}"
+            )
         if not isinstance(self.seed, int) or not 0 <= self.seed < SEED_LIMIT:
             raise ConfigError(f"--seed must be an integer from 0 to 2**64 - 1, got {self.seed}")
 

@@ -79,7 +79,7 @@ def test_config_round_trip_and_errors() -> None:
         ModelConfig(module="lstm", obs_shape=(1, 2, 2))
     with pytest.raises(ConfigError, match="unknown ModelConfig keys: colour"):
         ModelConfig.from_dict({**data, "colour": 1})
-    with pytest.raises(ConfigError, match="heads must be a positive integer"):
+    with pytest.raises(ConfigError, match=r"^heads must be an integer in \[1, 64\], got 0$"):
         ModelConfig(module="predinet", obs_shape=(1, 4, 4), heads=0)
     with pytest.raises(ConfigError, match="unknown env family"):
         TrainConfig.for_family("atari")

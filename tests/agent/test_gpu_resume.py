@@ -56,3 +56,46 @@ def test_a_run_continues_from_the_files_handed_back(tmp_path: Path) -> None:
 def test_usage_is_one_line() -> None:
     proc = subprocess.run(["bash", str(SCRIPT)], capture_output=True, text=True)
     assert proc.returncode == 2 and proc.stderr.startswith("usage: ")
+
+
+@pytest.mark.parametrize("flag", ["--help", "-h"])
+def test_help_prints_the_usage(flag: str) -> None:
+    proc = subprocess.run(["bash", str(SCRIPT), flag], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == ""
+    assert proc.stdout == (
+        f"usage: {SCRIPT} train RUN MINUTES [TRAIN ARGS...] | collect FILES RUN | --help\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("train", "-x", "5"), "train: -x is not a name (names come first, without '-')"),
+        (("train", "--help", "5"), "train: --help is not a name (names come first, without '-')"),
+        (("train", "run"), "train needs 2 names, got 1"),
+        (("train", "run", "soon"), "train: MINUTES must be a positive number, got soon"),
+        (("collect", "-x", "run"), "collect: -x is not a name (names come first, without '-')"),
+        (("collect", "files"), "collect needs 2 names, got 1"),
+    ],
+)
+def test_an_option_or_a_missing_name_is_refused_in_one_line(
+    tmp_path: Path, args: tuple[str, ...], message: str
+) -> None:
+    proc = _script(*args, out=tmp_path)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"{SCRIPT}: {message}; usage: {SCRIPT} train RUN MINUTES [TRAIN ARGS...] | "
+        "collect FILES RUN | --help"
+    ]
+    assert list(tmp_path.iterdir()) == []  # nothing made, nothing trained
+
+
+def test_collect_refuses_a_missing_files_folder(tmp_path: Path) -> None:
+    files, run = tmp_path / "handed-bak", tmp_path / "run"
+    proc = _script("collect", str(files), str(run), out=tmp_path)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"{SCRIPT}: collect: FILES folder {files} does not exist (the folder the device tool "
+        "handed back)"
+    ]
+    assert not run.exists()

@@ -271,7 +271,7 @@ def test_safe_coef_adds_the_loss_of_the_set_that_gives_nothing_up() -> None:
     assert losses[3.0] == pytest.approx(fast + 3.0 * kept, rel=1e-4)
     with pytest.raises(ConfigError, match="--safe-coef is a setting of --algo imitate; this run's learner is a3c"):
         TrainConfig.for_family("rgw", safe_coef=1.0)
-    with pytest.raises(ConfigError, match="safe_coef must be >= 0, got -1"):
+    with pytest.raises(ConfigError, match=r"^safe_coef must be a finite number in \[0, 100\], got -1.0$"):
         TrainConfig.for_family("rgw", algo="imitate", safe_coef=-1.0)
 
 

@@ -64,6 +64,23 @@ def test_default_preset_departures_and_algo() -> None:
         TrainConfig(gae_lambda=1.5)
 
 
+def test_box_world_predinets_default_to_learned_queries() -> None:
+    """The default preset's Box-World PrediNet learns with learned queries; the others keep
+    scene queries, and a checkpoint's recorded (or missing: scene) query is what loads."""
+    bw = ModelConfig.for_family("boxworld", "predinet", (26, 14, 14))
+    assert bw.query == "learned"
+    assert ModelConfig.for_family("boxworld", "mhdpa", (26, 14, 14)).query == "scene"
+    assert ModelConfig.for_family("rgw", "predinet", (9, 10, 10)).query == "scene"
+    thesis = ModelConfig.for_family("boxworld", "predinet", (3, 14, 14), preset="thesis")
+    assert thesis.query == "scene"
+    assert ModelConfig.for_family("boxworld", "predinet", (26, 14, 14), query="scene").query == (
+        "scene"
+    )
+    recorded = bw.to_dict()
+    del recorded["query"]  # the shipped bw agents predate the setting
+    assert ModelConfig.from_dict(recorded).query == "scene"
+
+
 def test_configs_without_the_new_keys_load_as_the_code_was() -> None:
     """A checkpoint's config predating a setting gets the value the code had then."""
     model = ModelConfig.for_family("rgw", "predinet", (9, 10, 10)).to_dict()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import functools
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -338,8 +339,50 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
             ("--env", "rgw2"),
             "--module (predinet or mhdpa) is needed unless --resume continues a run or --init-from",
         ),
-        (("--env", "rgw2", "--module", "predinet", "--lr", "-1"), "lr must be positive"),
-        (("--env", "rgw2", "--module", "predinet", "--sil", "-1"), "sil must be >= 0"),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--lr", "-1"),
+            "error: lr must be a finite number in (0, 1], got -1.0",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--lr", "1e999"),
+            "error: lr must be a finite number in (0, 1], got inf",
+        ),
+        (
+            ("--env", "rgw2", "--module", "predinet", "--sil", "-1"),
+            "error: sil must be a finite number in [0, 100], got -1.0",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "attention_gain=1e999"),
+            "error: --set attention_gain=1e999: attention_gain must be a finite number in "
+            "(0, 1000], got inf",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "reward_scale=1e999"),
+            "error: --set reward_scale=1e999: reward_scale must be a finite number in (0, 1000], "
+            "got inf",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "value_coef=1e308"),
+            "error: --set value_coef=1e308: value_coef must be a finite number in [0, 1000], "
+            "got 1e+308",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "hidden_sizes=100000000"),
+            "error: --set hidden_sizes=100000000: hidden_sizes must be 1 to 8 entries, each an "
+            "integer in [1, 8192], got 100000000",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "n_actions=1000"),
+            "error: --set n_actions: not a setting; the env's number of actions decides it",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--set", "hidden_sizes=8192,8192"),
+            "error: the model would have 67,384,243 weights, more than the 50,000,000 a run may",
+        ),
+        (
+            ("--env", "bw1", "--module", "predinet", "--envs", "4096", "--n-steps", "1000"),
+            "error: envs x n_steps must be at most 1,048,576 states per rollout, got 4096 x 1000",
+        ),
         (
             ("--env", "bw1", "--module", "predinet", "--algo", "ppo", "--sil", "1"),
             "--sil is a setting of --algo a3c; this run's learner is ppo",
@@ -528,3 +571,113 @@ def test_a_read_only_file_system_is_one_line(
         ConfigError, match="^cannot write to the run directory .*: permission denied$"
     ):
         make_run_directory(tmp_path)
+
+
+def _nan_once_checkpointed(
+    checkpoint: Path, make_nan: Callable[..., object]
+) -> Callable[..., object]:
+    """``make_nan`` told whether to go NaN: once ``checkpoint`` holds some trained frames."""
+    late: list[bool] = []
+
+    def wrapped(*args: object, **kwargs: object) -> object:
+        if not late and checkpoint.exists():
+            if torch.load(checkpoint, weights_only=True)["frames"] > 0:
+                late.append(True)
+        return make_nan(bool(late), *args, **kwargs)
+
+    return wrapped
+
+
+@pytest.mark.parametrize("what", ["loss", "weights"])
+def test_a_run_that_goes_nan_stops_and_keeps_its_last_finite_checkpoint(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, what: str
+) -> None:
+    """A loss that turns NaN (the worker refuses the step) or weights that do (the trainer
+    finds them): the run stops with one line, and checkpoint.pt holds finite weights."""
+    import math
+
+    from neurosym.agent.learners import a3c
+    from neurosym.agent.run import trainer
+    from neurosym.agent.run.options import RunOptions
+
+    real_loss, real_update = a3c.a3c_loss, a3c.apply_update
+
+    def nan_loss(late: bool, *args: object, **kwargs: object) -> object:
+        loss, stats = real_loss(*args, **kwargs)
+        return (loss * math.nan if late else loss), stats
+
+    def nan_weights(late: bool, local, shared, *args: object, **kwargs: object) -> object:
+        norm = real_update(local, shared, *args, **kwargs)
+        if late:  # a step that overflowed: the workers' own check never saw a NaN gradient
+            with torch.no_grad():
+                next(shared.parameters()).fill_(math.inf)
+        return norm
+
+    out = tmp_path / "run"
+    if what == "loss":  # forked workers inherit the patch
+        monkeypatch.setattr(
+            a3c, "a3c_loss", _nan_once_checkpointed(out / "checkpoint.pt", nan_loss)
+        )
+    else:
+        monkeypatch.setattr(
+            a3c, "apply_update", _nan_once_checkpointed(out / "checkpoint.pt", nan_weights)
+        )
+    options = RunOptions(frames=10**7, progress=False, eval_episodes=1, eval_interval=0.2,
+                         log_interval=0.1, checkpoint_interval=0.2)  # fmt: skip
+    with pytest.raises(trainer.TrainingDiverged) as info:
+        trainer.train("rgw1", "predinet", out, options=options, print_fn=lambda text: None,
+                      train_overrides={"workers": 1, "envs": 2, "n_steps": 5})  # fmt: skip
+    message = str(info.value)
+    assert len(message.splitlines()) == 1
+    cause = (
+        "worker 0: its loss is nan"
+        if what == "loss"
+        else "its weights [^ ]+ are not finite|worker 0: its loss is nan"
+    )
+    match = re.fullmatch(
+        rf"training diverged at ([\d,]+) frames \(({cause})\); {re.escape(str(out))}/checkpoint.pt "
+        r"keeps the last finite weights \(([\d,]+) frames\): lower --lr or the settings that "
+        r"scale the loss \(reward_scale, value_coef, attention_gain\)",
+        message,
+    )
+    assert match, message
+    kept = torch.load(out / "checkpoint.pt", weights_only=True)
+    assert kept["frames"] == int(match.group(match.lastindex).replace(",", ""))
+    assert 0 < kept["frames"] <= int(match.group(1).replace(",", ""))
+    weights = load_agent(out / "checkpoint.pt").model.state_dict().values()
+    assert all(torch.isfinite(v.float()).all() for v in weights)
+    assert kept["metrics"]["stop_reason"] == "running"  # the last periodic checkpoint
+
+
+def test_help_shows_every_flags_default_and_range() -> None:
+    import argparse
+
+    from neurosym.agent.run import cli_train
+
+    parser = argparse.ArgumentParser()
+    cli_train.configure(parser)
+    helps = {a.dest: a.help for a in parser._actions}
+    for _, f in cli_train.flag_fields():
+        assert "(default " in helps[f.name], f.name
+    assert helps["slim"].endswith("(default as the checkpoint a resumed run continues, else off)")
+    assert helps["lr"].endswith(
+        "(default rgw 0.002, bw 0.0005; --algo ppo 0.0005; --algo imitate 0.0005; range (0, 1])"
+    )
+    assert helps["frames"].endswith("(default none)")
+    assert helps["conv_channels"].endswith("(default 12,24; each in [1, 1024])")
+    assert "  query                  PrediNet's queries (default rgw scene, bw learned)" in (
+        parser.epilog.splitlines()
+    )
+
+
+def test_every_numeric_setting_declares_its_range() -> None:
+    """A number that sizes work or scales the loss is checked where it is declared."""
+    from dataclasses import fields
+
+    from neurosym.agent.run import cli_train
+
+    for cls in [cls for _, cls, _ in cli_train.SETTINGS]:
+        for f in fields(cls):
+            numeric = any(kind in str(f.type) for kind in ("int", "float"))
+            if numeric and f.name not in ("seed", "obs_shape"):
+                assert "range" in f.metadata, f"{cls.__name__}.{f.name}"

@@ -43,7 +43,12 @@ import torch.nn.functional as F
 from neurosym.agent.config import TrainConfig
 from neurosym.agent.learners.exploration import CountBonus
 from neurosym.agent.learners.messages import LossStats
-from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
+from neurosym.agent.learners.process import (
+    LearnerContext,
+    check_finite,
+    learner_process,
+    report_update,
+)
 from neurosym.agent.learners.returns import AdvantageScale, gae_advantages
 from neurosym.agent.learners.sil import EpisodeMemory, SILBatch, sil_loss
 from neurosym.agent.networks.model import ActorCritic
@@ -122,6 +127,7 @@ def apply_update(
     local.zero_grad(set_to_none=True)
     loss.backward()
     norm = torch.nn.utils.clip_grad_norm_(local.parameters(), clip)
+    check_finite(norm, loss)  # a NaN step would reach every worker through the shared weights
     for shared_p, local_p in zip(shared.parameters(), local.parameters(), strict=True):
         shared_p.grad = local_p.grad
     optimizer.step()

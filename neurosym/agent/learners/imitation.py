@@ -38,7 +38,12 @@ from neurosym.agent.learners.augment import augment_batch
 from neurosym.agent.learners.messages import LossStats, Stopped
 from neurosym.agent.learners.optimizers import copy_into_shared, private_copy
 from neurosym.agent.learners.planner_loss import optimal_set_nll
-from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
+from neurosym.agent.learners.process import (
+    LearnerContext,
+    check_finite,
+    learner_process,
+    report_update,
+)
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
@@ -127,6 +132,7 @@ def imitation_update(
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
+        check_finite(norm, loss)
         optimizer.step()
         with torch.no_grad():
             logp = torch.log_softmax(logits, dim=-1)

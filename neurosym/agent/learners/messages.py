@@ -1,8 +1,9 @@
 """What learner processes tell the trainer: one typed message per event.
 
 A learner sends an :class:`Update` after every update, :class:`Stopped` when
-it ends on a stop, and :class:`Failed` when anything in it raised. The
-trainer reads the fields by name.
+it ends on a stop, :class:`Diverged` when an update's gradient is not finite
+(it did not take that step), and :class:`Failed` when anything else in it
+raised. The trainer reads the fields by name.
 """
 
 from __future__ import annotations
@@ -60,4 +61,13 @@ class Failed:
     traceback: str
 
 
-Message = Update | Stopped | Failed
+@dataclass(frozen=True)
+class Diverged:
+    """A learner's loss or gradient became inf or NaN; it stopped before stepping with it.
+    ``what`` says which, in words."""
+
+    rank: int
+    what: str
+
+
+Message = Update | Stopped | Failed | Diverged

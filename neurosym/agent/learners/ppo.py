@@ -43,7 +43,12 @@ from neurosym.agent.learners import distributed
 from neurosym.agent.learners.exploration import CountBonus
 from neurosym.agent.learners.messages import LossStats, Stopped
 from neurosym.agent.learners.optimizers import copy_into_shared, private_copy
-from neurosym.agent.learners.process import LearnerContext, learner_process, report_update
+from neurosym.agent.learners.process import (
+    LearnerContext,
+    check_finite,
+    learner_process,
+    report_update,
+)
 from neurosym.agent.learners.returns import AdvantageScale, explained_variance, gae_advantages
 from neurosym.agent.rollout import Finished, Rollout, RolloutState, collect_rollout
 
@@ -153,6 +158,7 @@ def _minibatch_step(
     optimizer.zero_grad(set_to_none=True)
     (loss * weight).backward()
     norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
+    check_finite(norm, loss)  # the same on every rank: DDP averaged the gradients
     optimizer.step()
     with torch.no_grad():
         # Schulman's low-variance estimator of KL(old || new), as SB3 and CleanRL log it

@@ -9,16 +9,19 @@ with the messages of :mod:`neurosym.agent.learners.messages`.
 from __future__ import annotations
 
 import contextlib
+import math
 import signal
 import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+import torch
+
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.learners import distributed
 from neurosym.agent.learners.allocator import keep_freed_memory
-from neurosym.agent.learners.messages import Failed, LossStats, Update
+from neurosym.agent.learners.messages import Diverged, Failed, LossStats, Update
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import Finished
 
@@ -49,6 +52,21 @@ class LearnerContext:
     """frames the run trained before this session (a resumed run)"""
 
 
+class Divergence(Exception):
+    """Raised in a learner whose update is not finite; its process reports :class:`Diverged`."""
+
+
+def check_finite(norm: torch.Tensor | float, loss: torch.Tensor | float) -> None:
+    """Refuse a step whose clipped gradient's norm is inf or NaN (a loss that is: its gradient
+    is too). Call after clipping, before the optimiser's step, so the weights stay finite."""
+    if math.isfinite(float(norm)):
+        return
+    loss_value = float(loss)
+    if not math.isfinite(loss_value):
+        raise Divergence(f"its loss is {loss_value}")
+    raise Divergence(f"its gradient's norm is {float(norm)} (loss {loss_value:.4g})")
+
+
 class Learner(Protocol):
     """A learner process's entry point."""
 
@@ -69,8 +87,9 @@ def learner_process(
     Freed memory stays in the process for the next update's tensors
     (:mod:`neurosym.agent.learners.allocator`); Ctrl-C is the parent's
     business (SIGINT ignored); the process dies with its trainer
-    (:func:`distributed.die_with_parent`); any exception becomes a
-    :class:`~neurosym.agent.learners.messages.Failed` message; the queue is
+    (:func:`distributed.die_with_parent`); a :class:`Divergence` becomes a
+    :class:`~neurosym.agent.learners.messages.Diverged` message, any other exception a
+    :class:`~neurosym.agent.learners.messages.Failed` one; the queue is
     flushed before ``cleanup`` runs (leaving a gloo group whose peer has gone
     can block while holding the GIL, which would starve the queue's feeder thread).
     """
@@ -79,6 +98,8 @@ def learner_process(
     distributed.die_with_parent()
     try:
         yield
+    except Divergence as exc:
+        queue.put(Diverged(rank, str(exc)))
     except BaseException:  # noqa: BLE001 - reported to the parent, which raises it
         queue.put(Failed(rank, traceback.format_exc()))
     finally:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import functools
 import os
 import shlex
 from dataclasses import Field, fields
@@ -29,6 +30,7 @@ from neurosym.agent.config import (
     TrainConfig,
     field_docs,
     option_name,
+    range_error,
 )
 from neurosym.agent.run.options import RunOptions
 from neurosym.cli import parse_env_options
@@ -46,8 +48,11 @@ SETTINGS: tuple[tuple[str, type, str], ...] = (
     ("model (default: Table 4 and the preset's switches)", ModelConfig, "model"),
 )
 """(argument group title, config class, train | model) of the settings' flags, in help order"""
-FIXED = {"algo", "preset", "learner", "module", "obs_shape", "obs_scale"}
+FIXED = {"algo", "preset", "learner", "module", "obs_shape", "obs_scale", "n_actions"}
 """config fields that are not settings of a run (own flags, derived, or nested)"""
+FROM_ENV = {"obs_shape": "observation shape", "obs_scale": "observation scale",
+            "n_actions": "number of actions"}  # fmt: skip
+"""fixed fields the env decides (a ``--set`` of one says so)"""
 GROUPS = {
     "stop": "stopping (any that is reached; none: run until Ctrl-C)",
     "watch": "watching",
@@ -55,7 +60,8 @@ GROUPS = {
 
 
 def _help(cls: type, f: Field[Any]) -> str:
-    """The field's docstring up to its first top-level '. ', '; ' or ': ', plus the default."""
+    """The field's docstring up to its first top-level '. ', '; ' or ': ', plus its default
+    (a setting's: the default preset's for each env family and learner, :mod:`.defaults`)."""
     text, depth = field_docs(cls).get(f.name, ""), 0
     for i, char in enumerate(text):
         depth += {"(": 1, ")": -1}.get(char, 0)
@@ -63,9 +69,65 @@ def _help(cls: type, f: Field[Any]) -> str:
             text = text[:i]
             break
     text = text.replace("``", "")
-    if cls is RunOptions and f.default is not None and not isinstance(f.default, bool):
-        text += f" (default {f.default})"  # the settings' defaults are the preset's
+    bounds = f.metadata.get("range")
+    within = (
+        f"; each in {bounds}" if bounds and bounds.length else f"; range {bounds}" if bounds else ""
+    )
+    text += f" (default {default_text(cls, f)}{within})"
     return text.replace("%", "%%")
+
+
+def default_text(cls: type, f: Field[Any]) -> str:
+    """A flag's default as its help shows it: a setting's is the default preset's, per env
+    family ("rgw", "bw") and learner where they differ; a field may say it in words
+    (metadata ``shown``)."""
+    if "shown" in f.metadata:
+        return str(f.metadata["shown"])
+    if cls is RunOptions:
+        return "none" if f.default is None else _shown(f.default)
+    if f.name == "workers":
+        return "one per CPU core it may use"
+    per_algo: dict[str, dict[str, Any]] = {}
+    for (family, algo), values in _preset_values().items():
+        if f.name in values and (cls is not ModelConfig or algo == "a3c"):  # the model's: any
+            per_algo.setdefault(algo, {})[family] = values[f.name]
+    texts = {algo: _per_family(values) for algo, values in per_algo.items()}
+    first = next(iter(texts))
+    others = [f"--algo {algo} {text}" for algo, text in texts.items() if text != texts[first]]
+    return "; ".join([texts[first], *others])
+
+
+@functools.cache
+def _preset_values() -> dict[tuple[str, str], dict[str, Any]]:
+    """(family label, algo) -> the default preset's flat settings and PrediNet model switches."""
+    table: dict[tuple[str, str], dict[str, Any]] = {}
+    for family, label in (("rgw", "rgw"), ("boxworld", "bw")):
+        model = ModelConfig.for_family(family, "predinet", (1, 1, 1))
+        model_values = {f.name: getattr(model, f.name) for f in fields(ModelConfig)}
+        for algo in ("a3c", "ppo", "imitate"):
+            if algo == "imitate" and family != "rgw":
+                continue
+            train = TrainConfig.for_family(family, algo=algo).flat()
+            table[(label, algo)] = {**model_values, **train}
+    return table
+
+
+def _per_family(values: dict[str, Any]) -> str:
+    """'0.002' when every family has it, else 'rgw 0.002, bw 0.0005'."""
+    shown = {family: _shown(v) for family, v in values.items()}
+    if len(set(shown.values())) == 1:
+        return next(iter(shown.values()))
+    return ", ".join(f"{family} {text}" for family, text in shown.items())
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, tuple):
+        return ",".join(map(str, value))
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(value)
 
 
 def _channels(text: str) -> tuple[int, ...]:
@@ -180,6 +242,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def _parse_value(name: str, f: Field[Any], text: str) -> Any:
+    """``--set NAME=TEXT``'s value, read as the field's type and checked against its range."""
+    value = _read_value(name, f, text)
+    bounds = f.metadata.get("range")
+    if bounds is not None:
+        kind = float if _kind(f) == "float" else int
+        problem = range_error(name, value, kind, bounds)
+        if problem:
+            raise ConfigError(f"--set {name}={text}: {problem}")
+    return value
+
+
+def _read_value(name: str, f: Field[Any], text: str) -> Any:
     kind = _kind(f)
     if kind == "channels":
         try:
@@ -210,6 +284,8 @@ def parse_settings(items: list[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for item in items:
         name, sep, text = item.partition("=")
+        if name in FROM_ENV:
+            raise ConfigError(f"--set {name}: not a setting; the env's {FROM_ENV[name]} decides it")
         if not sep or name not in known:
             raise ConfigError(
                 f"--set wants NAME=VALUE with NAME a setting ({', '.join(sorted(known))}), "
@@ -281,12 +357,21 @@ def command_line(args: argparse.Namespace) -> str:
     return command
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (taskset, a container's CPU set), else all of them:
+    A3C's default worker count."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # no affinity on this platform
+        return os.cpu_count() or 1
+
+
 def run(args: argparse.Namespace) -> int:
     from neurosym.agent.run.trainer import train
 
     overrides = overrides_of(args)
     if "workers" not in overrides["train"] and not args.resume and args.algo in (None, "a3c"):
-        overrides["train"]["workers"] = os.cpu_count() or 1
+        overrides["train"]["workers"] = usable_cores()
     given = {
         f.name: getattr(args, f.name)
         for f in fields(RunOptions)

@@ -39,7 +39,10 @@ class RunOptions:
     """seconds between metrics rows"""
     window: int = field(default=100, metadata=WATCH)
     """recent episodes behind mean_return and success_rate"""
-    slim: bool | None = field(default=None, metadata=WATCH)
+    slim: bool | None = field(
+        default=None,
+        metadata={**WATCH, "shown": "as the checkpoint a resumed run continues, else off"},
+    )
     """leave the optimizer state out of checkpoints; None: as the checkpoint a resumed run
     continues, else keep it"""
     progress: bool = True

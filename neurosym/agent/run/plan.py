@@ -24,6 +24,8 @@ from neurosym.errors import CheckpointError, ConfigError
 CHECKPOINT_NAME = "checkpoint.pt"
 METRICS_NAME = "metrics.csv"
 SNAPSHOTS_DIR = "snapshots"
+WEIGHT_LIMIT = 50_000_000
+"""The most weights a new run's model may have (about 200 MB a copy)."""
 INIT_KEYS = ("init_from", "init_env", "init_frames", "init_wall_s")
 """What a run started with --init-from records of its source, in its metrics (kept on resume)."""
 
@@ -187,6 +189,23 @@ def check_model_fits(
         )
 
 
+def check_model_size(config: ModelConfig) -> None:
+    """Refuse a model with more than :data:`WEIGHT_LIMIT` weights before any is allocated
+    (the sizes are each in range, but their product may not fit in memory)."""
+    import torch
+
+    from neurosym.agent.networks.model import ActorCritic
+
+    with torch.device("meta"):  # shapes only, no memory
+        weights = sum(p.numel() for p in ActorCritic(config).parameters())
+    if weights > WEIGHT_LIMIT:
+        raise ConfigError(
+            f"the model would have {weights:,} weights, more than the {WEIGHT_LIMIT:,} a run "
+            "may train (each learner holds copies): lower hidden_sizes, heads, key_size, "
+            "relations, value_size or conv_channels"
+        )
+
+
 def _resumed(
     out: Path,
     env: str | None,
@@ -255,6 +274,7 @@ def _new(
         model_config = ModelConfig.for_family(
             family, module, shape, scale, preset=preset, **model_overrides
         )
+        check_model_size(model_config)
     else:
         source = read_checkpoint(init_from, env=name)
         model_config = source["model_config"]

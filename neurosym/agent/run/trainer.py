@@ -47,7 +47,7 @@ from neurosym.agent.checkpoint import build_model, save_checkpoint
 from neurosym.agent.evaluation import play_episodes
 from neurosym.agent.learners.a3c import worker
 from neurosym.agent.learners.imitation import imitation_learner
-from neurosym.agent.learners.messages import Failed, Stopped, Update
+from neurosym.agent.learners.messages import Diverged, Failed, Stopped, Update
 from neurosym.agent.learners.optimizers import (
     SharedOptimizer,
     set_optimizer_hyperparameters,
@@ -76,14 +76,35 @@ from neurosym.agent.run.plan import (
     resolve_run,
 )
 from neurosym.atomic import write_bytes_atomic
-from neurosym.errors import CheckpointError, ConfigError, OutputError
+from neurosym.errors import CheckpointError, ConfigError, NeurosymError, OutputError
 
-__all__ = ["LEARNERS", "RunOptions", "TrainResult", "probe_env", "snapshot_path", "train"]
+__all__ = [
+    "LEARNERS",
+    "RunOptions",
+    "TrainResult",
+    "TrainingDiverged",
+    "probe_env",
+    "snapshot_path",
+    "train",
+]
 
 LEARNERS: dict[str, Learner] = {"a3c": worker, "ppo": ppo_learner, "imitate": imitation_learner}
 """Each ``--algo``'s learner process (:mod:`neurosym.agent.learners`)."""
 TARGET_TOLERANCE = 1e-6
 """A greedy mean return within this of the target counts as reaching it (10.7 is not exact in binary)."""
+
+
+class TrainingDiverged(NeurosymError):
+    """A run whose loss, gradient or weights became inf or NaN: it stopped without writing
+    them; the checkpoint keeps the last finite weights it had written (if any)."""
+
+
+def non_finite(state: dict[str, torch.Tensor]) -> str | None:
+    """The first tensor of a model's ``state`` holding inf or NaN, in words (None: all finite)."""
+    for name, tensor in state.items():
+        if tensor.is_floating_point() and not bool(torch.isfinite(tensor).all()):
+            return f"its weights {name} are not finite"
+    return None
 
 
 @dataclass
@@ -95,7 +116,8 @@ class TrainResult:
     episodes: int
     wall_s: float
     stop_reason: str
-    """frames, time, target, interrupted, peer (another rank stopped the run)"""
+    """frames, time, target, interrupted, peer (another rank stopped the run); a run that
+    diverged raises :class:`TrainingDiverged` instead"""
     greedy_return: float | None
     solved_frames: int | None = None
     solved_wall_s: float | None = None
@@ -358,6 +380,8 @@ class _Outcome:
     solved_wall: float | None = None
     learner_stopped: bool = False
     digests: list[str] = field(default_factory=list)
+    diverged: str | None = None
+    """what went inf or NaN (the run stops without writing it)"""
 
 
 class _Supervisor:
@@ -385,6 +409,7 @@ class _Supervisor:
         self.clock = _Clock(time.monotonic())
         self.rate = FrameRate(self.clock.start, self.stats.frames)
         self.wrote_checkpoint = False
+        self.checkpoint_frames = plan.frames0
 
     def log_row(self, row: dict[str, Any]) -> None:
         if not self.world.leader:
@@ -395,8 +420,14 @@ class _Supervisor:
             self.board.add(row)
 
     def checkpoint(self, state_dict: dict[str, torch.Tensor] | None, extra: dict[str, Any]) -> None:
-        """Write ``checkpoint.pt``: the shared model (or ``state_dict``) and the run's record."""
+        """Write ``checkpoint.pt``: the shared model (or ``state_dict``) and the run's record;
+        weights that are not finite are never written (the run stops as diverged)."""
         plan = self.plan
+        if state_dict is None:  # a copy: the learners go on changing the shared weights
+            state_dict = {k: v.detach().clone() for k, v in self.shared.state_dict().items()}
+        if self.weights_diverged(state_dict):
+            return
+        self.checkpoint_frames = self.stats.frames
         metrics = {**(self.rows[-1] if self.rows else {}), **plan.init_meta, **extra}
         metrics = {
             k: (float(v) if isinstance(v, np.floating) else v)
@@ -419,6 +450,14 @@ class _Supervisor:
         )
         self.wrote_checkpoint = True
 
+    def weights_diverged(self, state: dict[str, torch.Tensor] | None = None) -> bool:
+        """Whether ``state`` (by default the shared weights) holds inf or NaN; the outcome
+        then says so."""
+        problem = non_finite(self.shared.state_dict() if state is None else state)
+        if problem is not None and self.outcome.diverged is None:
+            self.outcome.diverged = problem
+        return problem is not None
+
     def drain(self, messages: Any, block_s: float) -> None:
         """Read the learners' messages for up to ``block_s`` seconds."""
         outcome = self.outcome
@@ -433,9 +472,14 @@ class _Supervisor:
                 self.stats.add(msg)
             elif isinstance(msg, Stopped):
                 outcome.learner_stopped, outcome.digests = True, list(msg.digests)
+            elif isinstance(msg, Diverged) and outcome.diverged is None:
+                outcome.diverged = f"{self._learner_name(msg.rank)}: {msg.what}"
             elif isinstance(msg, Failed) and outcome.failure is None:
-                where = f"rank {self.world.rank} " if self.world.distributed else ""
-                outcome.failure = f"{where}worker {msg.rank} failed:\n{msg.traceback}"
+                outcome.failure = f"{self._learner_name(msg.rank)} failed:\n{msg.traceback}"
+
+    def _learner_name(self, rank: int) -> str:
+        where = f"rank {self.world.rank} " if self.world.distributed else ""
+        return f"{where}worker {rank}"
 
     def evaluate_if_due(self, now: float) -> None:
         """A greedy evaluation of a snapshot of the shared weights, at most ~5 % of the time."""
@@ -445,6 +489,8 @@ class _Supervisor:
         ):
             return
         snapshot = {k: v.detach().clone() for k, v in self.shared.state_dict().items()}
+        if self.weights_diverged(snapshot):  # the watch loop stops the run
+            return
         self.eval_model.load_state_dict(snapshot)
         done = self.evaluate()
         outcome.greedy = float(np.mean(done.returns))
@@ -533,7 +579,9 @@ class _Supervisor:
         """One turn of the watch loop; True when the run stops."""
         outcome = self.outcome
         self.drain(learners.messages, 0.1)
-        if stop_signal.received:
+        if outcome.diverged:
+            outcome.stop_reason = "diverged"
+        elif stop_signal.received:
             outcome.stop_reason = "interrupted"
         elif outcome.failure:
             outcome.stop_reason = "error"
@@ -541,7 +589,7 @@ class _Supervisor:
             outcome.stop_reason = "peer"
         elif not learners.any_alive():
             outcome.failure, outcome.stop_reason = "all workers exited unexpectedly", "error"
-        if outcome.stop_reason in ("interrupted", "error", "peer"):
+        if outcome.stop_reason in ("interrupted", "error", "peer", "diverged"):
             return True
         # a stop decided in the last turn (frames, minutes, success) still gets its last
         # evaluation chance and the final metrics row and progress figures
@@ -588,6 +636,10 @@ class _Supervisor:
         """The last metrics row and the final checkpoint; what the run did."""
         plan, outcome, stats, world = self.plan, self.outcome, self.stats, self.world
         wall = plan.wall0 + time.monotonic() - self.clock.start
+        if outcome.failure or (world.leader and outcome.best_state is None):
+            self.weights_diverged()  # NaN weights, found before the last checkpoint takes them
+        if outcome.diverged is not None:
+            self._raise_diverged()
         if outcome.failure:
             if (
                 world.distributed
@@ -625,6 +677,25 @@ class _Supervisor:
                 f"{fmt(outcome.greedy, '.2f') or '-'}; checkpoint {plan.checkpoint}"
             )
         return result
+
+    def _raise_diverged(self) -> None:
+        """Stop as diverged, in one line: what went inf or NaN, what the checkpoint still holds."""
+        frames, what = self.stats.frames, self.outcome.diverged
+        if self.board is not None:
+            self.board.close()
+        if self.wrote_checkpoint:
+            kept = (
+                f"{self.plan.checkpoint} keeps the last finite weights "
+                f"({self.checkpoint_frames:,} frames)"
+            )
+        elif self.plan.resume:
+            kept = f"{self.plan.checkpoint} is as it was ({self.plan.frames0:,} frames)"
+        else:
+            kept = "no checkpoint was written"
+        raise TrainingDiverged(
+            f"training diverged at {frames:,} frames ({what}); {kept}: lower --lr or the "
+            "settings that scale the loss (reward_scale, value_coef, attention_gain)"
+        )
 
     def _summary(self, wall: float) -> dict[str, Any]:
         """The final checkpoint's record of the run."""
