@@ -221,22 +221,29 @@ def test_save_refuses_objects(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        ({"hidden_sizes": [10**6, 10**6]}, "hidden_sizes (1000000, 1000000)"),
-        ({"heads": 10**9}, "heads 1000000000"),
-        ({"conv_channels": [12, 10**7]}, "conv_channels (12, 10000000)"),
+        (
+            {"hidden_sizes": [10**6, 10**6]},
+            "has a bad model config: hidden_sizes must be 1 to 8 entries, each an integer in "
+            "[1, 8192], got 1000000,1000000",
+        ),
+        ({"heads": 10**9}, "has a bad model config: heads must be an integer in [1, 64], got 1000000000"),
+        (
+            {"hidden_sizes": [8192, 8192]},
+            "is damaged: its model config has hidden_sizes (8192, 8192), larger than any dimension "
+            "of its weights (2600)",
+        ),
     ],
 )
-def test_a_config_far_larger_than_its_weights_is_refused_before_building(
+def test_a_config_out_of_range_or_far_larger_than_its_weights_is_refused_before_building(
     tmp_path: Path, run_neurosym, edit: dict, message: str
 ) -> None:
+    """Out of a setting's range: the config's own line; in range but larger than every weight
+    dimension (a damaged file): refused before the model is built."""
     path = tmp_path / "a.pt"
     write(path)
     raw = torch.load(path, weights_only=True)
     torch.save({**raw, "model_config": {**raw["model_config"], **edit}}, path)
-    expected = (
-        f"checkpoint {path} is damaged: its model config has {message}, "
-        "larger than any dimension of its weights (2600)"
-    )
+    expected = f"checkpoint {path} {message}"
     assert error_of(path) == expected
     proc = run_neurosym("eval", "--checkpoint", path, "--episodes", 1)
     assert (proc.returncode, proc.stderr) == (1, f"neurosym eval: error: {expected}\n")
