@@ -96,7 +96,7 @@ META_KEYS = (
 OPTIONAL_TABLES = ("terrain", "grids")
 """tables that recordings of older versions lack: they load as empty tables"""
 
-MAX_COUNT = 4096
+MAX_COUNT = 1024
 """the most heads or relations a recording's meta may give (they size the tables readers draw)"""
 
 _FORMAT = "neurosym-recording"

@@ -28,8 +28,6 @@ PAGE = "index.html"
 IDENTITY = re.compile(rb'<meta name="neurosym-recording" content="([0-9a-f]{16})">')
 """the page's identity tag (in its first bytes, see report.html.j2)"""
 IDENTITY_BYTES = 1024
-MAX_HEADS = 1024
-"""a recording's heads, at most (a PrediNet has a handful; the player draws one layer each)"""
 
 
 @dataclass(frozen=True)
@@ -87,26 +85,22 @@ def stale_page(folder: Path, current: str) -> str | None:
     return None
 
 
-def check_meta(meta: dict[str, Any], where: str) -> None:
+def check_page_meta(meta: dict[str, Any], where: str) -> None:
     """Refuse, in one line naming the field, a recording meta the page cannot be built from.
 
     meta.json is a file a colleague may have edited: plain data of bounded
     size (:func:`~neurosym.agent.checkpoint.check_plain_data`), whole numbers
-    where the page counts (heads, relations, seed), names where it names.
+    where the page counts (heads and relations: :func:`neurosym.export.recording.check_meta`,
+    which :meth:`Recording.load` applies first; the seed), names where it names.
     """
     from neurosym.agent.checkpoint import check_plain_data
+    from neurosym.export.recording import check_meta
 
     check_plain_data(meta, where, error=ConfigError)
-    for key, low, high in (("heads", 0, MAX_HEADS), ("relations", 0, None), ("seed", 0, None)):
-        value = meta.get(key)
-        if value is None:
-            continue
-        if not isinstance(value, int) or isinstance(value, bool) or value < low:
-            raise ConfigError(
-                f"{where} has {key} {value!r}; it must be a whole number, {low} or more"
-            )
-        if high is not None and value > high:
-            raise ConfigError(f"{where} has {key} {value}; at most {high}")
+    check_meta(meta, where)
+    seed = meta.get("seed")
+    if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool) or seed < 0):
+        raise ConfigError(f"{where} has seed {seed!r}; it must be a whole number, 0 or more")
     for key in ("env", "module", "checkpoint"):
         value = meta.get(key)
         if value is not None and not isinstance(value, str):
@@ -311,7 +305,7 @@ def load_extract(path: Path, threshold: str | None = None) -> Extract:
         rec_dir = rec_dir.resolve()
         folder = rec_dir.parent
     rec = Recording.load(rec_dir)
-    check_meta(rec.meta, f"{path}: its recording's meta.json")
+    check_page_meta(rec.meta, f"{path}: its recording's meta.json")
     kb = folder / "kb.pl"
     kb_path = kb if kb.is_file() else None
     spec = threshold or threshold_of(folder, kb_path) or DEFAULT_THRESHOLD

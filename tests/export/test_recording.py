@@ -222,5 +222,5 @@ def test_load_refuses_heads_that_are_not_a_count(tmp_path: Path, heads: object) 
         Recording.load(tmp_path / "rec")
     assert str(err.value) == (
         f"{tmp_path / 'rec'}/meta.json gives heads {heads!r}; expected a whole number from 0 "
-        "to 4096 (the checkpoint's heads count)"
+        "to 1024 (the checkpoint's heads count)"
     )

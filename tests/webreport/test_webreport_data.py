@@ -19,7 +19,7 @@ from neurosym.export.heads import head_summary
 from neurosym.export.recording import SCHEMA, Recording, conform
 from neurosym.export.report import rule_answers
 from neurosym.webreport.build import identity, stale_page
-from neurosym.webreport.player import PLAYER_TABLES
+from neurosym.webreport.player import PLAYER_TABLES, player_data
 
 DATA = re.compile(r'<script type="application/json" id="report-data">(.*?)</script>', re.S)
 
@@ -395,13 +395,13 @@ def test_a_recording_naming_another_agent_shows_no_card(
 @pytest.mark.parametrize(
     ("meta", "message"),
     [
-        ({"heads": "four"}, "its recording's meta.json has heads 'four'; it must be a whole number"),
-        ({"heads": 2.5}, "its recording's meta.json has heads 2.5; it must be a whole number"),
-        ({"heads": 10**6}, "its recording's meta.json has heads 1000000; at most 1024"),
-        ({"seed": -1}, "its recording's meta.json has seed -1; it must be a whole number, 0 or more"),
-        ({"env": ["rgw2"]}, "its recording's meta.json has env ['rgw2']; it must be text"),
+        ({"heads": "four"}, "/recording/meta.json gives heads 'four'; expected a whole number from 0 to 1024"),
+        ({"heads": 2.5}, "/recording/meta.json gives heads 2.5; expected a whole number from 0 to 1024"),
+        ({"heads": 10**6}, "/recording/meta.json gives heads 1000000; expected a whole number from 0 to 1024"),
+        ({"seed": -1}, ": its recording's meta.json has seed -1; it must be a whole number, 0 or more"),
+        ({"env": ["rgw2"]}, ": its recording's meta.json has env ['rgw2']; it must be text"),
         ({"note": [[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]},
-         "its recording's meta.json is nested more than 20 levels deep"),
+         ": its recording's meta.json is nested more than 20 levels deep"),
     ],
 )  # fmt: skip
 def test_a_bad_recording_meta_is_one_line(
@@ -415,7 +415,7 @@ def test_a_bad_recording_meta_is_one_line(
     copy = received(folder, tmp_path / "got", **meta)
     assert main(["report", "--recording", str(copy), "--quiet"]) == 1
     err = capsys.readouterr().err
-    assert err.startswith(f"neurosym report: error: {copy}: {message}")
+    assert err.startswith(f"neurosym report: error: {copy}{message}")
     assert err.count("\n") == 1 and not (copy / "index.html").exists()
 
 
@@ -430,17 +430,30 @@ def non_finite_recording() -> Recording:
     return Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
 
 
-def test_non_finite_values_reach_the_page_as_null(tmp_path: Path) -> None:
-    """JSON has no NaN or infinity: the page's data say null where the recording has one."""
+def test_non_finite_values_reach_the_page_as_null() -> None:
+    """JSON has no NaN or infinity: the page's data say null where a recording has one (a
+    recording read from disk never has one: Recording.load refuses it, see the next test)."""
     bad = non_finite_recording()
-    out = tmp_path / "out"
-    write_outputs(out, bad, None, ())  # the recording alone: the KB writer refuses inf
-    html = report(out)
-    data = embedded(html)
+    data = json.loads(json.dumps(player_data(bad), allow_nan=False))
     first = bad.steps.iloc[0]
-    assert data["player"]["episodes"][int(first["episode"])]["rewards"][int(first["t"])] is None
-    values = [v for ep in data["player"]["episodes"] for v in ep["tables"]["relations"]["value"]]
+    assert data["episodes"][int(first["episode"])]["rewards"][int(first["t"])] is None
+    values = [v for ep in data["episodes"] for v in ep["tables"]["relations"]["value"]]
     assert values.count(None) == 2 and all(v is None or abs(v) < 1e300 for v in values)
+
+
+def test_a_recording_with_a_non_finite_value_is_one_line(
+    predinet_page: tuple[Recording, Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, folder, _ = predinet_page
+    copy = received(folder, tmp_path / "got")
+    steps = pd.read_parquet(copy / "recording" / "steps.parquet")
+    steps.loc[steps.index[0], "reward"] = float("inf")
+    steps.to_parquet(copy / "recording" / "steps.parquet")
+    assert main(["report", "--recording", str(copy), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("neurosym report: error: ") and err.count("\n") == 1
+    assert "recording table 'steps' has inf in column 'reward' (row 0)" in err
+    assert not (copy / "index.html").exists()
 
 
 def test_a_probe_table_with_a_non_integer_head_is_one_line(
