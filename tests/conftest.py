@@ -31,6 +31,23 @@ def swipl() -> Path:
 
 
 @pytest.fixture(scope="session")
+def fake_swipl() -> Callable[[Path, int], Path]:
+    """Makes a `swipl` in a folder that answers --dump-runtime-variables with a version (what
+    neurosym probes), for the tests of locating SWI-Prolog."""
+
+    def make(directory: Path, version: int) -> Path:
+        directory.mkdir(parents=True, exist_ok=True)
+        exe = directory / "swipl"
+        exe.write_text(
+            f"#!/bin/sh\necho 'PLBASE=\"{directory}/home\";'\necho 'PLVERSION=\"{version}\";'\n"
+        )
+        exe.chmod(0o755)
+        return exe
+
+    return make
+
+
+@pytest.fixture(scope="session")
 def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
     """Run ``python -m neurosym ARGS...`` in a subprocess, from the repository root."""
 

@@ -15,17 +15,6 @@ from neurosym import setup_prolog
 from neurosym.errors import NeurosymError
 
 
-def _fake_swipl(directory: Path, version: int) -> Path:
-    """A `swipl` that answers --dump-runtime-variables with ``version`` (what neurosym probes)."""
-    directory.mkdir(parents=True, exist_ok=True)
-    exe = directory / "swipl"
-    exe.write_text(
-        f"#!/bin/sh\necho 'PLBASE=\"{directory}/home\";'\necho 'PLVERSION=\"{version}\";'\n"
-    )
-    exe.chmod(0o755)
-    return exe
-
-
 @pytest.fixture
 def bare_prefix(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """sys.prefix of an empty venv, NEUROSYM_SWIPL unset, locate's cache cleared around the test."""
@@ -40,16 +29,16 @@ def bare_prefix(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def test_an_old_swipl_on_path_is_passed_over_for_a_build(
-    bare_prefix: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys
+    bare_prefix: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys, fake_swipl
 ) -> None:
-    old = _fake_swipl(tmp_path / "usr" / "bin", 90004)
+    old = fake_swipl(tmp_path / "usr" / "bin", 90004)
     monkeypatch.setenv("PATH", str(old.parent))
     new = bare_prefix / "swipl" / "bin" / "swipl"
     built: list[Path] = []
 
     def build(prefix: Path) -> Path:  # what setup_swipl.sh leaves, without the 70 s
         built.append(prefix)
-        return _fake_swipl(new.parent, 90209)
+        return fake_swipl(new.parent, 90209)
 
     monkeypatch.setattr(setup_prolog, "build_swipl", build)
     swipl, how = setup_prolog.choose_swipl(None, bare_prefix)
@@ -70,13 +59,13 @@ def test_an_old_swipl_on_path_is_passed_over_for_a_build(
 
 
 def test_the_venv_link_points_at_the_prolog_and_is_replaced_whole(
-    bare_prefix: Path, tmp_path: Path
+    bare_prefix: Path, tmp_path: Path, fake_swipl
 ) -> None:
-    built = _fake_swipl(bare_prefix / "swipl" / "bin", 90209)
+    built = fake_swipl(bare_prefix / "swipl" / "bin", 90209)
     link = setup_prolog.link_swipl(bare_prefix, built)
     assert (link, os.readlink(link)) == (bare_prefix / "bin" / "swipl", "../swipl/bin/swipl")
     assert setup_prolog.find_swipl().executable == link  # neurosym finds the venv's own first
-    other = _fake_swipl(tmp_path / "opt" / "bin", 90300)
+    other = fake_swipl(tmp_path / "opt" / "bin", 90300)
     assert os.readlink(setup_prolog.link_swipl(bare_prefix, other)) == str(other)
     assert sorted(p.name for p in (bare_prefix / "bin").iterdir()) == ["swipl"]  # no temporary left
     link.unlink()

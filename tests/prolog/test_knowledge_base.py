@@ -297,16 +297,6 @@ def test_unreadable_qlf_is_recompiled_from_its_source(tmp_path: Path) -> None:
 # --- locating SWI-Prolog -------------------------------------------------------
 
 
-def _fake_swipl(directory: Path, version: int) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    exe = directory / "swipl"
-    exe.write_text(
-        f"#!/bin/sh\necho 'PLBASE=\"{directory}/home\";'\necho 'PLVERSION=\"{version}\";'\n"
-    )
-    exe.chmod(0o755)
-    return exe
-
-
 @pytest.fixture
 def fresh_locate(monkeypatch: pytest.MonkeyPatch):
     from neurosym.prolog import locate
@@ -317,8 +307,8 @@ def fresh_locate(monkeypatch: pytest.MonkeyPatch):
     locate.find_swipl.cache_clear()
 
 
-def test_neurosym_swipl_is_checked(tmp_path: Path, monkeypatch, fresh_locate) -> None:
-    monkeypatch.setenv("NEUROSYM_SWIPL", str(_fake_swipl(tmp_path / "old", 90004)))
+def test_neurosym_swipl_is_checked(tmp_path: Path, monkeypatch, fresh_locate, fake_swipl) -> None:
+    monkeypatch.setenv("NEUROSYM_SWIPL", str(fake_swipl(tmp_path / "old", 90004)))
     with pytest.raises(NeurosymError, match=r"is SWI-Prolog 9\.0\.4; janus-swi needs >= 9\.1\.12"):
         fresh_locate.find_swipl()
     fresh_locate.find_swipl.cache_clear()
@@ -326,7 +316,7 @@ def test_neurosym_swipl_is_checked(tmp_path: Path, monkeypatch, fresh_locate) ->
     with pytest.raises(NeurosymError, match="is not a runnable swipl"):
         fresh_locate.find_swipl()
     fresh_locate.find_swipl.cache_clear()
-    new = _fake_swipl(tmp_path / "new", 90209)
+    new = fake_swipl(tmp_path / "new", 90209)
     monkeypatch.setenv("NEUROSYM_SWIPL", str(new))
     found = fresh_locate.find_swipl()
     assert (found.executable, found.home, found.version_text) == (
@@ -336,19 +326,21 @@ def test_neurosym_swipl_is_checked(tmp_path: Path, monkeypatch, fresh_locate) ->
     )
 
 
-def test_old_swipl_on_path_is_not_used(tmp_path: Path, monkeypatch, fresh_locate) -> None:
+def test_old_swipl_on_path_is_not_used(tmp_path: Path, monkeypatch, fresh_locate, fake_swipl) -> None:
     monkeypatch.delenv("NEUROSYM_SWIPL", raising=False)
     monkeypatch.setattr(sys, "prefix", str(tmp_path / "empty-venv"))
-    old = _fake_swipl(tmp_path / "bin", 90004)
+    old = fake_swipl(tmp_path / "bin", 90004)
     monkeypatch.setenv("PATH", str(old.parent))
     with pytest.raises(NeurosymError, match=r"swipl on PATH .* is version 9\.0\.4; .*neurosym setup-prolog"):
         fresh_locate.find_swipl()
 
 
-def test_janus_gets_the_venv_home_despite_an_old_swipl_on_path(tmp_path: Path, swipl: Path) -> None:
+def test_janus_gets_the_venv_home_despite_an_old_swipl_on_path(
+    tmp_path: Path, swipl: Path, fake_swipl
+) -> None:
     if not swipl.is_relative_to(sys.prefix):  # the venv's bin/swipl link or its swipl/ build
         pytest.skip("this setup uses a SWI-Prolog outside the venv")
-    old = _fake_swipl(tmp_path / "bin", 90004)
+    old = fake_swipl(tmp_path / "bin", 90004)
     code = (
         "import os, sys\n"
         "from neurosym.prolog.knowledge_base import KnowledgeBase\n"
