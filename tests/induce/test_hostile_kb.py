@@ -112,18 +112,23 @@ def test_a_hostile_kb_learns_a_strategy_that_runs_nothing(
     assert main(["play", "--policy", str(out), "--env", "bw1", "--episodes", "1",
                  "--env-option", "max_steps=3"]) == 0  # fmt: skip
     assert main(["query", "--kb", str(kb), "--rules", str(out), "goal(0, 0, O)", "--limit", "1"]) == 0
-    plain = subprocess.run(
-        [str(swipl), "-q", "-g", "halt", str(kb), str(out)], capture_output=True, text=True,
-        cwd=tmp_path, timeout=60,
-    )  # fmt: skip
-    assert plain.returncode == 0, plain.stderr
-    assert not (tmp_path / "hit").exists()
+    loads_in_plain_swipl(swipl, kb, out, tmp_path)
     learned = "".join(f"{term} .\n" for _, term in learned_clauses(strategy))
     want = [*terms(swipl, LIBRARIES, tmp_path), *terms(swipl, learned, tmp_path),
             *terms(swipl, STRATEGY_BACKGROUND + ROUTE, tmp_path)]  # fmt: skip
     assert terms(swipl, out.read_text(), tmp_path) == want
     if case == "type":
         assert "route_not_longer(E, T, O, 'key(x). :- shell(\"touch hit\"). k(y')" in out.read_text()
+
+
+def loads_in_plain_swipl(swipl: Path, kb: Path, learned: Path, where: Path) -> None:
+    """``swipl kb.pl learned.pl`` loads without error, and the marker file never appears."""
+    plain = subprocess.run(
+        [str(swipl), "-q", "-g", "halt", str(kb), str(learned)], capture_output=True, text=True,
+        cwd=where, timeout=60,
+    )  # fmt: skip
+    assert plain.returncode == 0, plain.stderr
+    assert not (where / "hit").exists()
 
 
 WORLD_CASES = {
@@ -143,12 +148,7 @@ def test_a_hostile_kb_learns_world_rules_that_run_nothing(
     rules = induce_world(kb, holdout=kb)
     out = rules.write(tmp_path / "world.pl")
     assert main(["query", "--kb", str(kb), "--rules", str(out), "predicts(E, T, X)", "--limit", "1"]) == 0
-    plain = subprocess.run(
-        [str(swipl), "-q", "-g", "halt", str(kb), str(out)], capture_output=True, text=True,
-        cwd=tmp_path, timeout=60,
-    )  # fmt: skip
-    assert plain.returncode == 0, plain.stderr
-    assert not (tmp_path / "hit").exists()
+    loads_in_plain_swipl(swipl, kb, out, tmp_path)
     learned = "".join(f"{c.term()} .\n" for c in rules.clauses)
     want = [*terms(swipl, DISCONTIGUOUS, tmp_path), *terms(swipl, learned, tmp_path),
             *terms(swipl, WORLD_BACKGROUND, tmp_path)]  # fmt: skip
