@@ -36,7 +36,9 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench"))
+sys.path.insert(
+    0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench")
+)
 
 from kb import relation_table  # noqa: E402
 
@@ -88,7 +90,13 @@ def measure(pl: Path, qlf_path: Path, fast: Path) -> dict[str, float]:
         ).stdout  # fmt: skip
     finally:
         os.unlink(prog.name)
-    names = ("lines_cpu_s", "read_term_cpu_s", "read_assert_cpu_s", "fast_read_assert_cpu_s", "qlf_load_s")
+    names = (
+        "lines_cpu_s",
+        "read_term_cpu_s",
+        "read_assert_cpu_s",
+        "fast_read_assert_cpu_s",
+        "qlf_load_s",
+    )
     return {name: round(float(v), 3) for name, v in zip(names, out.split(), strict=True)}
 
 
