@@ -11,7 +11,7 @@ with thread_signal/2 when SIGINT arrives during an interruptible block.
 %   Posted to the main thread by the watcher; aborts the goal while
 %   interruptible block Block still runs (abort/0: a catch/3 in the goal
 %   cannot swallow it), and does nothing when the signal arrives after the
-%   block ended (Python's running/1 says which block runs).
+%   block ended (Python's running(Block) says which block runs).
 stop(Block) :-
     py_call('neurosym.prolog.interrupt':running(Block), Running),
     (   Running == @(true)
