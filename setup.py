@@ -4,6 +4,8 @@ The repository's rules/ (the source of truth, beside its plunit files) and
 checkpoints/ (the curated agents) are mapped into the package as
 ``neurosym.rules`` and ``neurosym.checkpoints``: an installed neurosym finds its
 rule files and agents without a clone, and nothing is copied in the repository.
+The Prolog modules of the janus bridge (neurosym/prolog/pl/*.pl) ship as
+package data; their plunit files (*.plt) stay behind.
 """
 
 from setuptools import find_packages, setup
@@ -18,6 +20,7 @@ setup(
     package_data={
         "neurosym": ["setup_swipl.sh"],  # `neurosym setup-prolog` builds SWI-Prolog with it
         "neurosym.envs": ["maps/*.txt"],
+        "neurosym.prolog": ["pl/*.pl"],  # the bridge's Prolog modules (not their .plt tests)
         "neurosym.webreport": ["templates/*"],
         "neurosym.rules": ["*.pl"],
         "neurosym.checkpoints": ["*.pt"],

@@ -46,22 +46,13 @@ import signal
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 MODULE = "neurosym_interrupt"
 
-SOURCE = r"""
-:- module(neurosym_interrupt, [stop/1]).
-
-%   stop(+Block): posted to the main thread by the watcher; aborts the goal
-%   while interruptible block Block still runs.
-stop(Block) :-
-    py_call('neurosym.prolog.interrupt':running(Block), Running),
-    (   Running == @(true)
-    ->  abort
-    ;   true
-    ).
-"""
+FILE = Path(__file__).resolve().with_name("pl") / "interrupt.pl"
+"""the Prolog module (``stop/1``), shipped in the package"""
 
 _KICK_SECONDS = 0.25
 """how often the watcher kicks the main thread again until the block ends"""

@@ -137,13 +137,29 @@ _consult_lock = threading.Lock()
 
 
 def janus_with(*modules: ModuleType) -> ModuleType:
-    """janus with each embedded Prolog module (a Python module holding its ``MODULE`` name and
-    ``SOURCE`` text) consulted, in order, once per process."""
+    """janus with each embedded Prolog module consulted, in order, once per process.
+
+    Each is a Python module holding its Prolog module's ``MODULE`` name and either
+    ``FILE``, the path of a ``.pl`` file shipped in the package (then ``SETUP``, when
+    there, is a ``(goal, inputs)`` pair run once right after the file is loaded), or
+    ``SOURCE``, the Prolog text itself."""
     janus = import_janus()
     if any(m.MODULE not in _consulted for m in modules):
         with _consult_lock:
             for m in modules:
                 if m.MODULE not in _consulted:
-                    janus.consult(f"/neurosym/{m.MODULE}.pl", data=m.SOURCE)
+                    _consult(janus, m)
                     _consulted.add(m.MODULE)
     return janus
+
+
+def _consult(janus: ModuleType, module: ModuleType) -> None:
+    """Load one embedded Prolog module: its ``FILE`` (and ``SETUP``) or its ``SOURCE``."""
+    file = getattr(module, "FILE", None)
+    if file is None:
+        janus.consult(f"/neurosym/{module.MODULE}.pl", data=module.SOURCE)
+        return
+    janus.consult(str(file))
+    setup = getattr(module, "SETUP", None)
+    if setup is not None:
+        janus.query_once(*setup)

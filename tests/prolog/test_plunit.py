@@ -1,4 +1,8 @@
-"""Run every plunit test file under rules/ through pytest, one swipl call per file.
+"""Run every plunit test file under rules/ and neurosym/ through pytest, one swipl call per file.
+
+The package's own Prolog modules (``neurosym/prolog/pl/<name>.pl``: the fact
+reader, the janus bridge, Ctrl-C) have their ``<name>.plt`` beside them,
+loading ``<name>.pl`` relative to their own directory like the rule files'.
 
 The convention for ``rules/<name>.plt``:
 
@@ -25,8 +29,10 @@ from pathlib import Path
 
 import pytest
 
-RULES = Path(__file__).resolve().parents[2] / "rules"
+REPO = Path(__file__).resolve().parents[2]
+RULES = REPO / "rules"
 PLT_FILES = sorted(RULES.glob("*.plt"))
+PACKAGE_PLT_FILES = sorted((REPO / "neurosym").rglob("*.plt"))
 
 
 def run_plunit(swipl: Path, plt: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
@@ -47,6 +53,19 @@ def assert_plunit_passes(swipl: Path, plt: Path) -> None:
 @pytest.mark.parametrize("plt", PLT_FILES, ids=[p.name for p in PLT_FILES])
 def test_rule_files(swipl: Path, plt: Path) -> None:
     assert_plunit_passes(swipl, plt)
+
+
+@pytest.mark.parametrize(
+    "plt", PACKAGE_PLT_FILES, ids=[str(p.relative_to(REPO / "neurosym")) for p in PACKAGE_PLT_FILES]
+)
+def test_package_prolog_modules(swipl: Path, plt: Path) -> None:
+    assert_plunit_passes(swipl, plt)
+
+
+def test_every_package_prolog_module_has_its_plunit_file() -> None:
+    modules = sorted((REPO / "neurosym").rglob("*.pl"))
+    assert modules, "no Prolog module found under neurosym/"
+    assert [p.with_suffix(".plt") for p in modules] == PACKAGE_PLT_FILES
 
 
 def _pair(tmp_path: Path, test_body: str) -> Path:
