@@ -9,8 +9,13 @@ Measures (from the code's AST, nothing imported):
   (a line ending a clause with ``.`` after ``:-``, or a directive ``:- ...``).
 * ``module_name_comparisons``: comparisons (``==``, ``!=``, ``in``) against the relational
   modules' names ("predinet", "mhdpa") outside neurosym/agent/networks/ and config.
-* ``kb_predicate_lists``: modules that list three or more KB predicate names (kb_meta's
-  schema: the names the fact writer declares) in one literal.
+* ``kb_predicate_lists``: modules that list three or more KB predicate names (those
+  neurosym/schema.py declares, read from its AST) in one literal (tuple, list, set, dict
+  keys) whose strings are mostly such names; a literal of other names that shares a few
+  words with the schema (a recording's tables ``holding``, ``terrain``, ``attends``
+  beside ``positions``, ``events``, ...) is not a list of predicates, nor is a producer:
+  a dict from predicates to the tables it computes (every value a call or a variable,
+  no text). schema.py's own declarations count as its list.
 * ``grid_searches_outside_envs``: functions outside neurosym/envs/ that run a queue-driven
   search (``popleft`` and ``append`` in one loop), i.e. a routing written again.
 * ``functions_over_100_lines`` and ``import_cycles`` (strongly connected components of more
@@ -30,10 +35,17 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "neurosym"
 MODULE_NAMES = {"predinet", "mhdpa"}
 NETWORKS = ("agent/networks/", "agent/config.py")
-KB_PREDICATES = {
-    "kb_meta", "threshold", "episode", "step", "at", "object", "holding", "event",
-    "relation", "attends", "terrain", "grid", "outcome", "visit", "head_summary",
-}
+SCHEMA = "schema.py"
+
+
+def kb_predicates(schema: ast.Module) -> set[str]:
+    """The predicate names schema.py declares: the first argument of each ``_p(...)`` call."""
+    return {
+        node.args[0].value
+        for node in ast.walk(schema)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "_p"
+        and node.args and isinstance(node.args[0], ast.Constant)
+    }
 CLAUSE_END = re.compile(r"(:-.*\.\s*$)|(^\s*:-)|(^\s*[a-z]\w*\(.*\)\s*:-)")
 
 
@@ -74,17 +86,35 @@ def module_comparisons(tree: ast.Module) -> list[int]:
     ]
 
 
-def predicate_lists(tree: ast.Module) -> list[int]:
-    """Line numbers of literals (tuple, list, set, dict keys) naming >= 3 KB predicates."""
+def predicate_lists(tree: ast.Module, predicates: set[str]) -> list[int]:
+    """Line numbers of literals (tuple, list, set, dict keys) naming >= 3 KB predicates, which
+    make up most of the literal's strings; producers (:func:`_produces`) aside."""
     found = []
     for node in ast.walk(tree):
         elts = node.keys if isinstance(node, ast.Dict) else getattr(node, "elts", None)
         if not isinstance(node, (ast.Tuple, ast.List, ast.Set, ast.Dict)) or not elts:
             continue
         names = {e.value for e in elts if isinstance(e, ast.Constant) and isinstance(e.value, str)}
-        if len(names & KB_PREDICATES) >= 3:
+        named = names & predicates
+        if len(named) >= 3 and 2 * len(named) > len(names) and not _produces(node):
             found.append(node.lineno)
     return found
+
+
+def _produces(node: ast.AST) -> bool:
+    """A dict whose every value is computed (a call, variable, attribute or item): a producer."""
+    computed = (ast.Call, ast.Name, ast.Attribute, ast.Subscript)
+    return isinstance(node, ast.Dict) and all(isinstance(v, computed) for v in node.values)
+
+
+def _declarations(schema: ast.Module) -> list[int]:
+    """The line of schema.py's first declaration: its list of the predicates."""
+    calls = [
+        node.lineno
+        for node in ast.walk(schema)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "_p"
+    ]
+    return [min(calls)] if calls else []
 
 
 def grid_searches(tree: ast.Module) -> list[int]:
@@ -202,11 +232,13 @@ def _sccs(graph: dict[str, set[str]], nodes: set[str]) -> list[list[str]]:
 def measure() -> dict[str, dict[str, list[int]]]:
     """Per measure, the places (module -> line numbers) where it occurs."""
     trees = modules()
+    predicates = kb_predicates(trees[SCHEMA])
     places: dict[str, dict[str, list[int]]] = defaultdict(dict)
     for rel, tree in trees.items():
+        declared = _declarations(tree) if rel == SCHEMA else []
         checks = {
             "prolog_lines_in_python": prolog_lines(tree),
-            "kb_predicate_lists": predicate_lists(tree),
+            "kb_predicate_lists": declared + predicate_lists(tree, predicates),
             "functions_over_100_lines": long_functions(tree),
         }
         if not rel.startswith(NETWORKS):

@@ -17,10 +17,14 @@ name, a :class:`~neurosym.terms.Term`).
 
 from __future__ import annotations
 
+import re
+import textwrap
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 KINDS = ("int", "float", "atom", "term", "value")
+_VARIABLE = re.compile(r"[A-Z_][A-Za-z0-9_]*|[a-z][A-Za-z0-9_]*\([A-Z_][A-Za-z0-9_]*\)")
+"""what a reader's goal puts in an argument: a variable, or one wrapped (``r(J)`` of holds/5)"""
 
 
 @dataclass(frozen=True)
@@ -34,6 +38,11 @@ class Arg:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"argument {self.column}: unknown kind {self.kind!r}")
+
+    @property
+    def dtype(self) -> str:
+        """The column's dtype in a recording table (``str``: Prolog text)."""
+        return {"int": "int64", "float": "float64"}.get(self.kind, "str")
 
 
 @dataclass(frozen=True)
@@ -67,6 +76,33 @@ class Predicate:
     def head(self) -> str:
         """``name(Arg, ...)`` as rules and docs write it."""
         return f"{self.name}({', '.join(a.name for a in self.args)})"
+
+    @property
+    def per_state(self) -> bool:
+        """Whether each fact is of one state: the first arguments are the episode and the state."""
+        return self.columns[:2] == ("episode", "t")
+
+    def __post_init__(self) -> None:
+        if len(self.meaning.splitlines()) != 1:
+            raise ValueError(f"{self.name}: the meaning must be one line (it is a KB comment)")
+
+    def goal(self, **variables: str) -> str:
+        """A reader's goal: ``name(...)`` with the named columns as those variables, ``_`` elsewhere.
+
+        ``SCHEMA["at"].goal(episode="E", t="T", id="O")`` is ``at(E, T, O, _, _)``;
+        a column the predicate lacks, or a name that is not a Prolog variable, is
+        refused, so a reader's goals follow the declarations.
+        """
+        unknown = sorted(set(variables) - set(self.columns))
+        if unknown:
+            raise ValueError(
+                f"{self.indicator} has no column {', '.join(unknown)}; "
+                f"its columns: {', '.join(self.columns)}"
+            )
+        bad = [v for v in variables.values() if not _VARIABLE.fullmatch(v)]
+        if bad:
+            raise ValueError(f"{self.indicator}: {bad[0]!r} is not a Prolog variable (or r(J))")
+        return f"{self.name}({', '.join(variables.get(c, '_') for c in self.columns)})"
 
 
 def _p(name: str, args: str, meaning: str, group: str, writers: str) -> Predicate:
@@ -161,6 +197,14 @@ def group(name: str) -> list[Predicate]:
     return [p for p in SCHEMA.values() if p.group == name]
 
 
+def written_by(command: str, group_name: str | None = None) -> list[Predicate]:
+    """The predicates ``command`` writes (of one group if given), in declaration order."""
+    return [
+        p for p in SCHEMA.values()
+        if command in p.writers and group_name in (None, p.group)
+    ]
+
+
 def indicators(names: Iterable[str]) -> list[str]:
     """``name/arity`` of the named predicates (for ``:- dynamic``)."""
     return [SCHEMA[n].indicator for n in names]
@@ -171,9 +215,25 @@ def term_columns(names: Iterable[str]) -> dict[str, tuple[str, ...]]:
     return {n: SCHEMA[n].term_columns for n in names if SCHEMA[n].term_columns}
 
 
-def header_lines(names: Iterable[str]) -> list[str]:
-    """PlDoc-style ``%!`` lines naming each predicate's arguments, for a KB's header."""
-    return [f"%!  {SCHEMA[n].head}: {SCHEMA[n].meaning}" for n in names]
+def header_lines(name: str) -> list[str]:
+    """The PlDoc comment a KB writes above the predicate's dynamic declaration.
+
+    ``%!  grid(?E, ?Rows, ?Cols)`` (its arguments; every one ``?``: a fact
+    answers any mode), then ``%   the size of episode E's map ...`` (its
+    meaning, wrapped at 100 columns).
+    """
+    p = SCHEMA[name]
+    head = f"%!  {p.name}({', '.join('?' + a.name for a in p.args)})"
+    body = textwrap.wrap(
+        p.meaning, 100, initial_indent="%   ", subsequent_indent="%   ",
+        break_long_words=False, break_on_hyphens=False,
+    )
+    return [head, *body]
+
+
+def comments(names: Iterable[str]) -> dict[str, list[str]]:
+    """``name/arity`` -> :func:`header_lines`, the writer's ``comments`` for the named predicates."""
+    return {SCHEMA[n].indicator: header_lines(n) for n in names}
 
 
 def markdown_table(name: str) -> str:

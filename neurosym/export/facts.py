@@ -46,7 +46,7 @@ from neurosym.atomic import atomic_write, make_folder
 from neurosym.errors import ConfigError
 from neurosym.export.recording import META_KEYS, Recording
 from neurosym.export.thresholds import Threshold, parse_threshold
-from neurosym.schema import TRACE, group, indicators
+from neurosym.schema import TRACE, comments, group, indicators
 from neurosym.terms import Term
 
 PREDICATES: dict[str, tuple[str, ...]] = {p.name: p.columns for p in group(TRACE)}
@@ -187,7 +187,9 @@ class FactSet:
 
         Every schema predicate is declared dynamic, so rules that ask for facts the
         KB has none of (attention/6 in a PrediNet KB) fail instead of raising, and
-        the file loads in plain ``swipl`` without warnings. Returns the .pl path.
+        the file loads in plain ``swipl`` without warnings; a PlDoc ``%!`` comment
+        above each declaration names its arguments and says what it means (both
+        from :mod:`neurosym.schema`). Returns the .pl path.
         """
         from neurosym.export.prolog_writer import write_prolog
 
@@ -198,6 +200,7 @@ class FactSet:
             dynamic=predicate_indicators(),
             qlf=qlf,
             term_columns=TERM_COLUMNS,
+            comments=comments(PREDICATES),
         )
         return Path(written)
 
@@ -220,10 +223,7 @@ class FactSet:
         return (
             "neurosym knowledge base: facts extracted from recorded episodes.\n"
             f"{meta}\nthreshold={self.threshold}\n"
-            "Schema (docs/design.md): kb_meta/2, object/2, episode/4, grid/3, terrain/4, step/4, at/5,\n"
-            "holding/3, event/3, "
-            "attends/8, relation/7, holds/5, threshold/2, attention/6.\n"
-            "Heads and relations count from 0."
+            "Heads and relations count from 0. The predicates (docs/design.md, \"Facts\"):"
         )
 
 

@@ -224,6 +224,22 @@ def _indicator(spec: str | tuple[str, int]) -> tuple[str, int]:
     return name, arity
 
 
+def _comments(
+    comments: Mapping[str, Iterable[str]], declared: Mapping[tuple[str, int], None]
+) -> dict[tuple[str, int], list[str]]:
+    """``comments`` by indicator, each line checked to be one Prolog comment line."""
+    out: dict[tuple[str, int], list[str]] = {}
+    for spec, lines in comments.items():
+        key = _indicator(spec)
+        if key not in declared:
+            raise FactError(f"comments name {spec!r}, which is not declared dynamic")
+        out[key] = [str(line) for line in lines]
+        for line in out[key]:
+            if not line.startswith("%") or line.splitlines() != [line]:
+                raise FactError(f"comment line {line!r} of {spec} is not one line starting with %")
+    return out
+
+
 def write_prolog(
     path: str | os.PathLike[str],
     tables: Mapping[str, pd.DataFrame],
@@ -232,13 +248,17 @@ def write_prolog(
     dynamic: Iterable[str | tuple[str, int]] = (),
     qlf: bool = False,
     term_columns: Mapping[str, Iterable[str]] | None = None,
+    comments: Mapping[str, Iterable[str]] | None = None,
 ) -> Path:
     """Write ``tables`` (predicate name -> DataFrame of its arguments) as facts at ``path``.
 
     ``header`` becomes ``%`` comment lines at the top. ``dynamic`` names extra
     predicates (``"name/arity"``) to declare ``:- dynamic``, so rules can ask
     for facts a KB lacks; empty tables are declared dynamic automatically.
-    ``term_columns`` maps a table to its columns of Prolog term text. With
+    ``term_columns`` maps a table to its columns of Prolog term text.
+    ``comments`` maps a declared ``"name/arity"`` to comment lines (each one
+    line starting with ``%``: a PlDoc ``%!`` line naming its arguments) written
+    above its ``:- dynamic`` line, a blank line before each. With
     ``qlf=True`` the file is also compiled to ``<stem>.qlf`` beside it
     (``path`` must then end in ``.pl``). Returns the ``.pl`` path.
     """
@@ -252,6 +272,7 @@ def write_prolog(
             f"term_columns names tables that are not written: {', '.join(sorted(unknown))}"
         )
     declared: dict[tuple[str, int], None] = dict.fromkeys(_indicator(d) for d in dynamic)
+    docs = _comments(comments or {}, declared)
     for name, df in tables.items():
         if not isinstance(name, str) or not name:
             raise FactError(f"table name {name!r} is not a predicate name")
@@ -269,7 +290,10 @@ def write_prolog(
     with open_atomic(path, "wb") as out:
         lines = [f"% {line}".rstrip() for line in (header or "").splitlines()]
         lines.append(":- encoding(utf8).")
-        lines += [f":- dynamic {atom_text(name)}/{arity}." for name, arity in declared]
+        for name, arity in declared:
+            doc = docs.get((name, arity))
+            lines += ["", *doc] if doc else []
+            lines.append(f":- dynamic {atom_text(name)}/{arity}.")
         out.write(("\n".join(lines) + "\n").encode("utf-8"))
         for name, df in tables.items():
             if len(df):

@@ -2,7 +2,9 @@
 
 A :class:`Recording` is what :func:`neurosym.export.recorder.record` returns and what
 :func:`neurosym.export.facts.extract_facts` reads. Its tables and their columns are
-fixed in ``docs/interfaces.md`` ("Recording"); this module owns that schema, brings
+fixed in ``docs/interfaces.md`` ("Recording"); this module owns that schema (the tables
+the fact writer copies column for column into a predicate's facts take their columns
+from that predicate's declaration in :mod:`neurosym.schema`), brings
 hand-made tables to it (so tests and notebooks can build recordings directly) and
 round-trips a recording through one Parquet file per table plus ``meta.json``.
 
@@ -26,17 +28,19 @@ import pandas as pd
 
 from neurosym.atomic import atomic_write, file_kind, make_folder
 from neurosym.errors import ConfigError
+from neurosym.schema import SCHEMA as PREDICATES
+
+
+def _arguments(predicate: str, *extra: tuple[str, str]) -> tuple[tuple[str, str], ...]:
+    """The columns of a table the fact writer copies into ``predicate``'s facts: its arguments'
+    columns and dtypes (:mod:`neurosym.schema`; atoms and terms are "str"), then ``extra``."""
+    return tuple((a.column, a.dtype) for a in PREDICATES[predicate].args) + extra
+
 
 # table -> ordered (column, dtype); "str" columns hold Prolog text (atoms or terms).
 SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
-    "episodes": (
-        ("episode", "int64"),
-        ("steps", "int64"),
-        ("return", "float64"),
-        ("outcome", "str"),
-        ("seed", "int64"),
-    ),
-    "steps": (("episode", "int64"), ("t", "int64"), ("action", "str"), ("reward", "float64")),
+    "episodes": _arguments("episode", ("seed", "int64")),
+    "steps": _arguments("step"),
     "positions": (
         ("episode", "int64"),
         ("t", "int64"),
@@ -45,36 +49,14 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
         ("row", "int64"),
         ("col", "int64"),
     ),
-    "holding": (("episode", "int64"), ("t", "int64"), ("item", "str")),
-    "terrain": (("episode", "int64"), ("type", "str"), ("row", "int64"), ("col", "int64")),
-    "grids": (("episode", "int64"), ("rows", "int64"), ("cols", "int64")),
-    "events": (("episode", "int64"), ("t", "int64"), ("event", "str")),
-    "attends": (
-        ("episode", "int64"),
-        ("t", "int64"),
-        ("head", "int64"),
-        ("arg", "int64"),
-        ("entity", "str"),
-        ("row", "int64"),
-        ("col", "int64"),
-        ("weight", "float64"),
-    ),
-    "relations": (
-        ("episode", "int64"),
-        ("t", "int64"),
-        ("head", "int64"),
-        ("j", "int64"),
-        ("a", "str"),
-        ("b", "str"),
-        ("value", "float64"),
-    ),
-    "attention": (
-        ("episode", "int64"),
-        ("t", "int64"),
-        ("head", "int64"),
-        ("query", "str"),
-        ("key", "str"),
-        ("weight", "float64"),
+    "holding": _arguments("holding"),
+    "terrain": _arguments("terrain"),
+    "grids": _arguments("grid"),
+    "events": _arguments("event"),
+    "attends": _arguments("attends"),
+    "relations": _arguments("relation"),
+    "attention": _arguments(
+        "attention",
         ("query_row", "int64"),
         ("query_col", "int64"),
         ("key_row", "int64"),

@@ -19,6 +19,7 @@ import pandas as pd
 
 from neurosym.display import plain
 from neurosym.errors import ConfigError
+from neurosym.schema import SCHEMA
 from neurosym.terms import format_value
 
 CONTACTS = frozenset(
@@ -49,23 +50,47 @@ KINDS: dict[str, str] = {}
 """A type's (or held item's) canonical text -> the canonical text of its kind (``key(red)`` ->
 ``key``), from Prolog's own answer: filled by :func:`load_trace`, read by the features."""
 
-TABLES = {
-    "object": "object(O, Ty0), format(atom(Ty), '~k', [Ty0]), " + _KIND.format(x="Ty0"),
-    "at": "at(E, T, O, R, C)",
-    "step": "step(E, T, A, _)",
-    "event": "event(E, T, Ev0), term_to_atom(Ev0, Ev)",
-    "holding": "holding(E, T, I0), format(atom(I), '~k', [I0]), " + _KIND.format(x="I0"),
-    "attends": "attends(E, T, H, Arg, _, R, C, _)",
-    "holds": "holds(E, T, r(J), X0, Y0), format(atom(X), '~k', [X0]), format(atom(Y), '~k', [Y0])",
-    "attention": (
-        "attention(E, T, H, Q0, K0, _), format(atom(Q), '~k', [Q0]), format(atom(K), '~k', [K0])"
-    ),
-    "meta": "kb_meta(Key, V0), term_to_atom(V0, V)",
-    "terrain": (
-        "catch(terrain(E, Ty0, R, C), error(existence_error(_, _), _), fail), term_to_atom(Ty0, Ty)"
-    ),
-    "grid": "catch(grid(E, Rows, Cols), error(existence_error(_, _), _), fail)",
-}
+_FORMAT = "format(atom({x}), '~k', [{x}0])"
+"""binds {x} to the canonical text of the term {x}0"""
+
+
+def _table(name: str, *then: str, old: bool = False, **variables: str) -> tuple[str, str]:
+    """``(name, goal)``: the schema's goal for ``name`` binding ``variables`` (by column), then ``then``.
+
+    ``old``: KBs written before the predicate existed lack its declaration; a goal
+    on it reads no rows there instead of raising.
+    """
+    goal = SCHEMA[name].goal(**variables)
+    if old:
+        goal = f"catch({goal}, error(existence_error(_, _), _), fail)"
+    return name, ", ".join((goal, *then))
+
+
+TABLES: dict[str, str] = dict(
+    (
+        _table("object", _FORMAT.format(x="Ty"), _KIND.format(x="Ty0"), id="O", type="Ty0"),
+        _table("at", episode="E", t="T", id="O", row="R", col="C"),
+        _table("step", episode="E", t="T", action="A"),
+        _table("event", "term_to_atom(Ev0, Ev)", episode="E", t="T", event="Ev0"),
+        _table(
+            "holding", _FORMAT.format(x="I"), _KIND.format(x="I0"), episode="E", t="T", item="I0"
+        ),
+        _table("attends", episode="E", t="T", head="H", arg="Arg", row="R", col="C"),
+        _table(
+            "holds", _FORMAT.format(x="X"), _FORMAT.format(x="Y"),
+            episode="E", t="T", j="r(J)", a="X0", b="Y0",
+        ),
+        _table(
+            "attention", _FORMAT.format(x="Q"), _FORMAT.format(x="K"),
+            episode="E", t="T", head="H", query="Q0", key="K0",
+        ),
+        _table("kb_meta", "term_to_atom(V0, V)", key="Key", value="V0"),
+        _table(
+            "terrain", "term_to_atom(Ty0, Ty)", old=True, episode="E", type="Ty0", row="R", col="C"
+        ),
+        _table("grid", old=True, episode="E", rows="Rows", cols="Cols"),
+    )
+)
 """The goal that reads each table, compound terms as their Prolog text: types, items and
 entities canonical (``write_canonical``: quoted, no operators), which
 :func:`neurosym.terms.parse_term` reads back, so a learned file spells them as the KB does."""
@@ -97,7 +122,8 @@ class Trace:
         keep = set(episodes)
         parts = {
             name: getattr(self, name)[getattr(self, name)["E"].isin(keep)].reset_index(drop=True)
-            for name in ("at", "step", "event", "holding", "attends", "holds", "attention", "terrain", "grid")
+            for name in TABLES
+            if SCHEMA[name].columns[0] == "episode"
         }
         return Trace(self.path, self.object, meta=self.meta, **parts)
 
@@ -123,8 +149,8 @@ def load_trace(path: str | Path) -> Trace:
             if text not in KINDS:
                 KINDS[text] = format_value(kind)
         tables[name] = table.drop(columns="Kind")
-    meta = dict(zip(tables["meta"]["Key"], tables["meta"]["V"], strict=True))
-    trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "meta"})
+    meta = dict(zip(tables["kb_meta"]["Key"], tables["kb_meta"]["V"], strict=True))
+    trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "kb_meta"})
     if trace.at.empty:
         raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
     check_types(trace)

@@ -18,6 +18,7 @@ from neurosym.induce.strategy_features import (
 )
 from neurosym.induce.strategy_route import PROLOG as ROUTE
 from neurosym.induce.strategy_tree import Clause, simplify
+from neurosym.schema import indicators
 from neurosym.terms import Term, Var, format_value
 
 if TYPE_CHECKING:
@@ -30,11 +31,20 @@ LEARNERS = {
     "holding next objects, ordered by their share",
 }
 
+def _reads(*names: str) -> str:
+    """``name/arity, ...`` of the named predicates, arities from the schema."""
+    return ", ".join(indicators(names))
+
+
+_WORLD = _reads("at", "holding", "object", "grid", "terrain")
+_NETWORK = _reads("attends", "holds", "attention")
 READS = {
-    "world": "at/5, holding/3, object/2, grid/3, terrain/4",
-    "relations": "at/5 and object/2 (to map cells and entities to objects), attends/8, holds/5, attention/6",
-    "both": "at/5, holding/3, object/2, grid/3, terrain/4, attends/8, holds/5, attention/6",
+    "world": _WORLD,
+    "relations": f"{_reads('at')} and {_reads('object')} (to map cells and entities to objects), "
+    + _NETWORK,
+    "both": f"{_WORLD}, {_NETWORK}",
 }
+"""the facts each feature set reads, as the learned file's notes name them"""
 
 
 def threshold(x: float) -> int | float:

@@ -59,6 +59,7 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
+from neurosym.schema import TRACE, group
 from neurosym.terms import Term
 
 DEFAULT_EPISODES = 100
@@ -66,8 +67,9 @@ DEFAULT_EPISODES = 100
 
 TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
 
-NETWORK_FACTS = ("attends", "relation", "holds", "threshold", "attention")
-"""the trace predicates an experiment KB leaves out: what the network computed, per state"""
+NETWORK_FACTS = tuple(p.name for p in group(TRACE) if "intervene" not in p.writers)
+"""the trace predicates an experiment KB leaves out (:mod:`neurosym.schema`: those intervene does
+not write): what the network computed, per state"""
 
 
 @dataclass(frozen=True)
@@ -167,7 +169,7 @@ class InterventionReport:
     def to_prolog(self, path: str | os.PathLike[str]) -> Path:
         """Write the KB: trace facts of every experiment's episodes plus the experiment facts."""
         from neurosym.export.prolog_writer import write_prolog
-        from neurosym.schema import EXPERIMENT, group, indicators, term_columns
+        from neurosym.schema import indicators, term_columns, written_by
 
         tables = self.facts()
         header = (
@@ -179,11 +181,11 @@ class InterventionReport:
             " B, Share),\nand the trace facts (episode/4, grid/3, terrain/4, step/4, at/5,"
             " holding/3, event/3) of every experiment."
         )
-        behaviour = ["kb_meta", "object", "episode", "grid", "terrain", "step", "at", "holding", "event"]
-        network = ["holds", "attention", "relation", "attends"]  # none here; rules may ask for them
-        dynamic = indicators(behaviour + [p.name for p in group(EXPERIMENT)] + network)
+        # the network's facts: none here, rules may ask for them
+        names = [p.name for p in written_by("intervene")] + list(NETWORK_FACTS)
         return write_prolog(
-            Path(path), tables, header=header, dynamic=dynamic, term_columns=term_columns(tables)
+            Path(path), tables, header=header, dynamic=indicators(names),
+            term_columns=term_columns(tables),
         )
 
 

@@ -197,17 +197,17 @@ class PrologAgent:
             raise PrologError(f"{self.policy.path}: {' '.join(str(exc).split())}") from None
 
     def state_facts(self, episode: int, t: int) -> dict[str, list[tuple[Any, ...]]]:
-        """The at/5, holding/3, step/4 and event/3 facts of (episode, t) now in the agent's KB, as text rows."""
-        goals = {
-            "at": ("at(E, T, Id, R, C)", ("Id", "R", "C")),
-            "holding": ("holding(E, T, I)", ("I",)),
-            "step": ("step(E, T, A, W)", ("A", "W")),
-            "event": ("event(E, T, Ev)", ("Ev",)),
-        }
+        """The facts of state (episode, t) now in the agent's KB, per schema predicate of one
+        state (at/5, holding/3, step/4, event/3, and the network's when asserted), as text rows
+        of their arguments after E and T."""
         out: dict[str, list[tuple[Any, ...]]] = {}
-        for name, (goal, cols) in goals.items():
+        for p in SCHEMA:
+            if not p.per_state:
+                continue
+            cols = [f"V{i}" for i in range(p.arity - 2)]
+            goal = p.goal(**dict(zip(p.columns, ["E", "T", *cols], strict=True)))
             rows = self.kb.query(goal, E=episode, T=t)
-            out[name] = sorted(tuple(_text(r[c]) for c in cols) for r in rows)
+            out[p.name] = sorted(tuple(_text(r[c]) for c in cols) for r in rows)
         return out
 
     def close(self) -> None:

@@ -18,7 +18,7 @@ from typing import Any
 
 import pandas as pd
 
-from neurosym.export.recording import SCHEMA, Recording
+from neurosym.export.recording import SCHEMA, Recording, empty_table
 
 PLAYER_TABLES = ("positions", "holding", "events", "attends", "relations", "attention")
 """recording tables embedded per episode"""
@@ -75,11 +75,7 @@ def player_data(rec: Recording) -> dict[str, Any]:
         own = steps.get(e, pd.DataFrame(columns=["t", "action", "reward"])).sort_values("t")
         episodes.append(
             {
-                "episode": e,
-                "steps": int(row["steps"]),
-                "return": finite(float(row["return"])),
-                "outcome": str(row["outcome"]),
-                "seed": int(row["seed"]),
+                **{c: _cell(row[c], dtype) for c, dtype in SCHEMA["episodes"]},
                 "terrain": terrains.index(terrain),
                 "actions": [str(a) for a in own["action"]],
                 "rewards": [finite(float(r)) for r in own["reward"]],
@@ -99,9 +95,18 @@ def player_data(rec: Recording) -> dict[str, Any]:
     }
 
 
+def _cell(value: Any, dtype: str) -> Any:
+    """One cell of a recording table as JSON data, by the recording schema's dtype."""
+    if dtype == "int64":
+        return int(value)
+    if dtype == "float64":
+        return finite(float(value))
+    return str(value)
+
+
 def _empty(name: str) -> pd.DataFrame:
     if name not in _EMPTY:
-        _EMPTY[name] = pd.DataFrame({c: pd.Series([], dtype=d) for c, d in SCHEMA[name]})
+        _EMPTY[name] = empty_table(name)
     return _EMPTY[name]
 
 

@@ -234,4 +234,4 @@ def test_kb_meta_names_the_env_options(tmp_path: Path, run_neurosym) -> None:  #
     table = pd.read_parquet(facts.to_parquet(tmp_path / "facts") / "kb_meta.parquet")
     assert dict(zip(table["key"], table["value"], strict=True))["env_option(map)"] == "my map.txt"
     rec.meta["env_kwargs"] = {}  # an env's defaults: no option facts, the rest unchanged
-    assert "env_option" not in extract_facts(rec).to_prolog(tmp_path / "kb2.pl").read_text()
+    assert "\nkb_meta(env_option" not in extract_facts(rec).to_prolog(tmp_path / "kb2.pl").read_text()

@@ -109,6 +109,24 @@ def test_bad_dynamic_and_table_shapes(tmp_path: Path) -> None:
         write_prolog(tmp_path / "kb.txt", {}, qlf=True)
 
 
+def test_comments_stay_comments(tmp_path: Path) -> None:
+    path = write_prolog(
+        tmp_path / "kb.pl", {"p": pd.DataFrame({"x": [1]})}, dynamic=["q/1"],
+        comments={"q/1": ["%!  q(?X)", "%   what q means"]},
+    )
+    assert path.read_text() == ":- encoding(utf8).\n\n%!  q(?X)\n%   what q means\n:- dynamic q/1.\n\np(1).\n"
+    for lines, why in (
+        (["%!  q(?X)\n:- initialization(halt)."], "is not one line starting with %"),
+        (["%!  q(?X)\r:- initialization(halt)."], "is not one line starting with %"),
+        (["q(?X)"], "is not one line starting with %"),
+    ):
+        with pytest.raises(FactError, match=f"comment line .* of q/1 {why}$"):
+            write_prolog(tmp_path / "bad.pl", {}, dynamic=["q/1"], comments={"q/1": lines})
+    with pytest.raises(FactError, match=r"^comments name 'r/1', which is not declared dynamic$"):
+        write_prolog(tmp_path / "bad.pl", {}, dynamic=["q/1"], comments={"r/1": ["% r"]})
+    assert not (tmp_path / "bad.pl").exists()
+
+
 def test_failed_write_leaves_the_old_file_intact(tmp_path: Path) -> None:
     path = write_prolog(tmp_path / "kb.pl", {"p": pd.DataFrame({"x": [1]})})
     before = path.read_text()
