@@ -19,7 +19,8 @@ The option groups every command shares (:class:`EnvChoice`, :class:`Episodes`, :
 options class inherits the ones it takes, so each flag is written once and means one thing
 in every command; a command redeclares a field to give it its own default or docstring
 (the flag's metavar and the rest stay the group's). The mixins' fields are listed after the
-command's own, under the group's title.
+command's own, under the group's title. A class that inherits a field from two bases with
+different defaults redeclares it: a dataclass takes the default of the base it processes last.
 
 ``RENAMED`` (a class variable: old flag -> what to write now) refuses a flag that was renamed
 or removed with one line naming the new spelling and exit status 2, as argparse refuses a
@@ -266,9 +267,8 @@ def metadata(cls: type, name: str) -> dict[str, Any]:
     """A field's metadata over its declarations, the most derived class's winning."""
     out: dict[str, Any] = {}
     for klass in reversed(cls.__mro__):
-        declared = klass.__dict__.get("__dataclass_fields__", {}).get(name)
-        if declared is not None:
-            out.update(declared.metadata)
+        if name in klass.__dict__.get("__annotations__", {}):  # declared there, not inherited
+            out.update(klass.__dict__["__dataclass_fields__"][name].metadata)
     return out
 
 

@@ -78,8 +78,9 @@ def test_a_shared_flag_is_spelled_and_read_alike_in_every_command() -> None:
     assert "query" in seen["--json"][next(iter(seen["--json"]))]
     every = {flag for p in parsers().values() for a in p._actions for flag in a.option_strings}
     assert not every & {"--episode-seed", "--what", "--probes"}
-    assert [n for n, p in parsers().items() if "--format" in p._option_string_actions] == ["extract"]
-    assert [n for n, p in parsers().items() if "--frames" in p._option_string_actions] == ["train"]
+    having = {f: [n for n, p in parsers().items() if f in p._option_string_actions]
+              for f in ("--format", "--frames")}  # fmt: skip
+    assert having == {"--format": ["extract"], "--frames": ["train"]}  # one meaning each
 
 
 def test_the_options_are_the_commands_dataclass_with_its_defaults() -> None:
@@ -102,7 +103,11 @@ def test_the_options_are_the_commands_dataclass_with_its_defaults() -> None:
     strategy = parsed(["induce", "strategy", "--kb", "k.pl", "--out", "s.pl", "--learner", "tree"])
     assert (strategy.what, strategy.learner, strategy.features) == ("strategy", "tree", None)
     episode = parsed(["plot", "episode", "--recording", "r", "--panels", "6", "--out", "x.png"])
-    assert (episode.plot, episode.panels, episode.seed) == ("episode", 6, None)
+    assert (episode.plot, episode.panels) == ("episode", 6)
+    for plot in ("mhdpa", "predinet", "rvectors", "relations", "episode"):
+        # what a recording fixes is unset unless given (plot refuses it with --recording)
+        got = parsed(["plot", plot, "--recording", "r", "--out", "x.png"])
+        assert (got.env, got.seed, getattr(got, "episodes", None)) == (None, None, None), plot
 
 
 def test_query_json_and_csv_exclude_each_other(capsys: pytest.CaptureFixture[str]) -> None:

@@ -60,7 +60,23 @@ class SourceOptions(EnvName, Seed, PlotOptions):
 
 
 @dataclass(kw_only=True)
-class MhdpaOptions(SourceOptions):
+class Head:
+    """The plots of one head or all."""
+
+    head: int | None = option(None, shown="all")
+    """draw one head"""
+
+
+@dataclass(kw_only=True)
+class MaxSteps:
+    """The plots of a whole played episode."""
+
+    max_steps: int | None = option(None, metavar="N", shown="the env's limit")
+    """with --checkpoint: stop the episode after this many steps"""
+
+
+@dataclass(kw_only=True)
+class MhdpaOptions(Head, SourceOptions):
     plot: ClassVar[str] = "mhdpa"
     step: int = 0
     """state to show"""
@@ -68,26 +84,18 @@ class MhdpaOptions(SourceOptions):
     """entity or object id whose attention to draw: agent, enemy, key(red), lock_red_2"""
     cell: tuple[int, int] | None = option(None, metavar="ROW,COL", exclusive="object", parse=_cell)
     """pick the object by its cell instead (for walls, pits, ...)"""
-    head: int | None = option(None, shown="all")
-    """draw one head"""
 
 
 @dataclass(kw_only=True)
-class PredinetOptions(SourceOptions):
+class PredinetOptions(Head, SourceOptions):
     plot: ClassVar[str] = "predinet"
     step: int = 0
     """state to show"""
-    head: int | None = option(None, shown="all")
-    """draw one head"""
 
 
 @dataclass(kw_only=True)
-class RvectorsOptions(SourceOptions):
+class RvectorsOptions(MaxSteps, Head, SourceOptions):
     plot: ClassVar[str] = "rvectors"
-    head: int | None = option(None, shown="all")
-    """draw one head"""
-    max_steps: int | None = option(None, metavar="N", shown="the env's limit")
-    """with --checkpoint: stop the episode after this many steps"""
 
 
 @dataclass(kw_only=True)
@@ -97,20 +105,18 @@ class RelationsOptions(Episodes, SourceOptions):
     """abs:X, quantile:Q or z:K, as for extract"""
     episodes: int | None = option(None, shown="1")
     """with --checkpoint: episodes to play, seeds S, S+1, ..."""
+    seed: int | None = option(None, shown="0")
+    """with --checkpoint: reset seed of the first episode"""
 
 
 @dataclass(kw_only=True)
-class EpisodeOptions(SourceOptions):
+class EpisodeOptions(MaxSteps, Head, SourceOptions):
     plot: ClassVar[str] = "episode"
     RENAMED: ClassVar[dict[str, str]] = {
         **SourceOptions.RENAMED,
         "--frames": "--frames is now --panels (the states the strip shows; --frames is "
         "train's frame budget)",
     }
-    head: int | None = option(None, shown="all")
-    """draw one head"""
-    max_steps: int | None = option(None, metavar="N", shown="the env's limit")
-    """with --checkpoint: stop the episode after this many steps"""
     steps: str | None = option(None, metavar="START:STOP", shown="all")
     """states to draw, inclusive, e.g. 0:20"""
     panels: int = option(12, metavar="N")
