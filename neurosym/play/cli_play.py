@@ -6,7 +6,9 @@ rules/route.pl's ``route/4`` the action (:mod:`neurosym.play.agent`).
 Episode k is played from ``reset(seed=seed + k)``, as ``neurosym eval`` plays
 it, and scored by the same code, so the two reports compare line by line;
 ``--json`` prints one object with eval's names plus ``fallbacks``,
-``fallback_steps``, ``goals``, ``steps`` and ``steps_per_s``.
+``fallback_steps``, ``goals``, ``steps`` and ``steps_per_s``. ``--map FILE``
+plays a map of one's own on a fixed-map RGW env (``--env rgw1`` or ``rgw2``,
+default rgw2), as eval, extract and report do.
 
 A strategy whose ``%! features:`` line says ``relations`` or ``both`` reads
 the network's relation facts of the live state: give the agent they came
