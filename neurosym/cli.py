@@ -3,13 +3,17 @@
 Each subcommand lives beside the code it drives (``neurosym/<package>/cli_*.py``)
 as a module with two functions:
 
-* ``configure(parser: argparse.ArgumentParser) -> None`` adds its arguments;
-* ``run(args: argparse.Namespace) -> int`` does the work and returns the exit code.
+* ``configure(parser: argparse.ArgumentParser) -> None`` adds its arguments, generated
+  from its options dataclass by :func:`neurosym.flags.add_options` (the flags every
+  command shares, ``--env``, ``--seed``, ``--json``, ..., are written once there);
+* ``run(options) -> int`` does the work with the filled-in options and returns the exit
+  code (``train``, whose settings' flags come from its config classes, gets the namespace).
 
 Only the module of the command being run is imported, so ``neurosym query``
 never pays for importing torch. A :class:`~neurosym.errors.NeurosymError`
 (bad input) is printed as one line and exits with status 1; argparse usage
-errors exit with status 2; Ctrl-C exits with 130; a closed stdout (the reader
+errors exit with status 2, and so does a renamed flag (one line naming the new
+spelling); Ctrl-C exits with 130; a closed stdout (the reader
 of a pipe gone, ``neurosym envs | head -1``) ends the command quietly with 141.
 """
 
@@ -26,49 +30,7 @@ from typing import Any
 from neurosym import __version__
 from neurosym.display import plain
 from neurosym.errors import ConfigError, NeurosymError
-
-
-def add_action_mode(parser: argparse.ArgumentParser) -> None:
-    """``--greedy`` (default) | ``--sample``, stored as ``args.greedy``; eval and extract share it."""
-    mode = parser.add_mutually_exclusive_group()
-    mode.add_argument(
-        "--greedy",
-        dest="greedy",
-        action="store_true",
-        default=True,
-        help="most likely action (default)",
-    )
-    mode.add_argument(
-        "--sample", dest="greedy", action="store_false", help="sample actions from the policy"
-    )
-
-
-def add_env_options(parser: argparse.ArgumentParser) -> None:
-    """``--env NAME`` and ``--map FILE``: where eval and extract play the checkpoint."""
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
-        "shape (default: the checkpoint's own)",
-    )
-    parser.add_argument(
-        "--map",
-        metavar="FILE",
-        help="RGW: play this map file on a fixed-map env (--env rgw1 or rgw2, default rgw2)",
-    )
-    add_env_option(parser)
-
-
-def add_env_option(parser: argparse.ArgumentParser) -> None:
-    """``--env-option KEY=VALUE`` (repeatable): eval, extract, intervene and probe share it."""
-    parser.add_argument(
-        "--env-option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="an option of the env on top of the checkpoint's, e.g. num_mountains=12 on "
-        "rgw-random (repeatable)",
-    )
+from neurosym.flags import Parser, options_of
 
 
 def parse_env_options(items: list[str], env: str | None = None) -> dict[str, Any]:
@@ -124,20 +86,27 @@ def parse_env_options(items: list[str], env: str | None = None) -> dict[str, Any
     return out
 
 
-def play_env(agent: Any, env: str | None, items: list[str]) -> tuple[str, dict[str, Any]]:
+def play_env(
+    agent: Any, env: str | None, items: list[str], map_file: str | None = None
+) -> tuple[str, dict[str, Any]]:
     """(env name, options) for intervene and probe: ``--env`` (default: the agent's own)
-    with the ``--env-option`` items on top, typed and checked (family, observation shape).
+    with the ``--env-option`` items and ``--map`` on top, typed and checked (family,
+    observation shape).
     """
     from neurosym.agent.checkpoint import env_for
     from neurosym.envs import canonical_name
 
+    if map_file is not None:
+        env, overrides = map_option(env, map_file, agent.env_name)
+        extra = parse_env_options(items, env)
+        if "map" in extra:
+            raise ConfigError("give the map once: --map FILE or --env-option map=FILE, not both")
+        return env_for(agent, env, {**(overrides or {}), **extra})
     name = canonical_name(env if env is not None else agent.env_name)
     return env_for(agent, name, parse_env_options(items, name))
 
 
-def play_options(
-    args: argparse.Namespace, trained: str
-) -> tuple[str | None, dict[str, Any] | None]:
+def play_options(args: Any, trained: str) -> tuple[str | None, dict[str, Any] | None]:
     """(env name or None, the user's env options or None) from ``--env``, ``--map``, ``--env-option``."""
     env, overrides = map_option(args.env, args.map, trained)
     extra = parse_env_options(args.env_option, env or trained)
@@ -237,7 +206,7 @@ def _selected_command(argv: Sequence[str]) -> str | None:
 
 def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
     """Build the parser; only the selected subcommand's module is imported."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="neurosym",
         description="Make a reinforcement-learning agent's relational reasoning explicit.",
     )
@@ -263,7 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:
-        code = int(args._run(args) or 0)
+        code = int(args._run(options_of(args)) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at exit
         return code
     except BrokenPipeError:

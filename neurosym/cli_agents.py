@@ -19,17 +19,26 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from neurosym.errors import CheckpointError, ConfigError
+from neurosym.flags import Json, add_options, option
+
+
+@dataclass(kw_only=True)
+class AgentsOptions(Json):
+    """``neurosym agents``'s options."""
+
+    dir: str | None = option(None, metavar="DIR")
+    """list the agents (*.pt) in DIR instead of the shipped ones"""
+    json: bool = False
+    """print one JSON list"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--dir", metavar="DIR", help="list the agents (*.pt) in DIR instead of the shipped ones"
-    )
-    parser.add_argument("--json", action="store_true", help="print one JSON list")
+    add_options(parser, AgentsOptions)
 
 
 def agent_folder(folder: str | None) -> Path:
@@ -108,7 +117,7 @@ WIDTH = 132
 """columns the table is laid out in at least (its rows are about 120 characters)"""
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: AgentsOptions) -> int:
     folder = agent_folder(args.dir)
     files = sorted(folder.glob("*.pt"))
     if not files:

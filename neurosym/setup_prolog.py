@@ -26,9 +26,11 @@ import importlib.resources
 import os
 import subprocess
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from neurosym.errors import NeurosymError
+from neurosym.flags import add_options, option
 from neurosym.prolog.locate import ENV_VAR, SETUP_HINT, SwiProlog, check_swipl, find_swipl
 
 JANUS_REQUIREMENT = "janus-swi>=1.5.3"
@@ -46,15 +48,19 @@ except OSError:
 """
 
 
+@dataclass(kw_only=True)
+class SetupOptions:
+    """``neurosym setup-prolog``'s options."""
+
+    swipl: str | None = option(None, metavar="PATH")
+    """use this swipl binary (SWI-Prolog >= 9.1.12) instead of finding or building one"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--swipl",
-        metavar="PATH",
-        help="use this swipl binary (SWI-Prolog >= 9.1.12) instead of finding or building one",
-    )
+    add_options(parser, SetupOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: SetupOptions) -> int:
     prefix = Path(sys.prefix)
     own = sys.prefix != sys.base_prefix or os.environ.get("CONDA_PREFIX") == sys.prefix
     if not own or not os.access(prefix / "bin", os.W_OK):  # never the system's /usr/bin

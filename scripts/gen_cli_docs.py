@@ -4,7 +4,8 @@
     python scripts/gen_cli_docs.py --check    # exit 1 when docs/cli.md is not what it would write
 
 Each command's parser is built by :func:`neurosym.cli.build_parser` (which
-configures the selected command only), so the page says what the code accepts.
+configures the selected command only, from its options dataclass), so the page says
+what the code accepts.
 tests/test_cli_docs.py fails when the page is stale.
 """
 
@@ -100,7 +101,11 @@ def _render() -> str:
         "",
         "Every `neurosym` command and flag, generated from the argparse parsers by",
         "`python scripts/gen_cli_docs.py` (do not edit by hand; `tests/test_cli_docs.py` fails when",
-        "this page is stale). `neurosym COMMAND --help` prints the same.",
+        "this page is stale). `neurosym COMMAND --help` prints the same. The parsers are built from",
+        "each command's options dataclass, a flag per field with its docstring as help",
+        "(`neurosym/flags.py`); the flags several commands share (`--env`, `--map`, `--env-option`,",
+        "`--episodes`, `--seed`, `--greedy`/`--sample`, `--out`, `--quiet`, `--json`) are defined",
+        "once there and mean the same in each.",
         "",
         "| command | what it does |",
         "| --- | --- |",

@@ -42,7 +42,7 @@ def _into_closed_pipe(*args: object) -> subprocess.CompletedProcess[str]:
         ("envs",),  # a rich table
         ("envs", "--json"),  # print()
         ("eval", "--checkpoint", CHECKPOINTS / "rgw1-predinet.pt", "--episodes", "1"),
-        ("query", "--kb", REPO / "rules" / "tests" / "rgw_facts.pl", "--format", "csv", "true"),
+        ("query", "--kb", REPO / "rules" / "tests" / "rgw_facts.pl", "--csv", "true"),
     ],
     ids=["table", "json", "eval", "query"],
 )

@@ -1,6 +1,6 @@
 /*  boxworld_strategy.pl -- a hand-written Box-World strategy for
     `neurosym play` (not learned; the learned ones come from
-    `neurosym induce --what strategy`).
+    `neurosym induce strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. A lock is worth opening when its box holds the

@@ -1,6 +1,6 @@
 /*  rgw_strategy.pl -- a hand-written Relational-Grid-World strategy for
     `neurosym play` (not learned; the learned ones come from
-    `neurosym induce --what strategy`).
+    `neurosym induce strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. It uses route.pl's route_exists/3 and

@@ -9,26 +9,29 @@ prints the sizes and the largest change of a weight; playing both files with
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
+from typing import Literal
 
-from neurosym.agent.checkpoint import COMPACT_DTYPES
+from neurosym.flags import Out, add_options, option
+
+
+@dataclass(kw_only=True)
+class CompactOptions(Out):
+    """``neurosym compact``'s options."""
+
+    checkpoint: str = option(metavar="CHECKPOINT", positional=True)
+    """checkpoint file (.pt) to compact"""
+    dtype: Literal["bfloat16", "float16"] = "float16"
+    """storage dtype of the weights"""
+    out: str = option(metavar="FILE")
+    """file to write (may be the checkpoint itself: replaced atomically)"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("checkpoint", help="checkpoint file (.pt) to compact")
-    parser.add_argument(
-        "--out",
-        required=True,
-        help="file to write (may be the checkpoint itself: replaced atomically)",
-    )
-    parser.add_argument(
-        "--dtype",
-        choices=sorted(COMPACT_DTYPES),
-        default="float16",
-        help="storage dtype of the weights (default float16)",
-    )
+    add_options(parser, CompactOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: CompactOptions) -> int:
     from neurosym.agent.checkpoint import compact_checkpoint
 
     report = compact_checkpoint(args.checkpoint, args.out, args.dtype)

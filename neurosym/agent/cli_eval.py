@@ -22,22 +22,27 @@ from __future__ import annotations
 import argparse
 import json
 from collections import Counter
+from dataclasses import dataclass
 from typing import Any
 
-from neurosym.cli import add_action_mode, add_env_options, play_options
+from neurosym.cli import play_options
 from neurosym.errors import ConfigError
+from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, add_options, option
 from neurosym.seeds import check_seed
 
 
+@dataclass(kw_only=True)
+class EvalOptions(EnvChoice, Episodes, ActionMode, Json):
+    """``neurosym eval``'s options."""
+
+    checkpoint: str = option(metavar="FILE")
+    """checkpoint file (.pt) written by neurosym train, or a shipped agent's name"""
+    json: bool = False
+    """print one JSON object"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--checkpoint", required=True, help="checkpoint file (.pt) written by neurosym train"
-    )
-    add_env_options(parser)
-    parser.add_argument("--episodes", type=int, default=100, help="episodes to play (100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode (0)")
-    add_action_mode(parser)
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    add_options(parser, EvalOptions)
 
 
 def evaluate(
@@ -122,7 +127,7 @@ def report_of(done: Any) -> dict[str, Any]:
     }
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: EvalOptions) -> int:
     import torch
 
     from neurosym.agent.checkpoint import load_agent

@@ -36,15 +36,14 @@ that used one is refused in one line naming it.
 from __future__ import annotations
 
 import ast
-import inspect
 import math
 import numbers
-import textwrap
 from dataclasses import MISSING, asdict, dataclass, field, fields
 from functools import cache
 from typing import Any
 
 from neurosym.errors import ConfigError
+from neurosym.flags import field_docs, option_name  # noqa: F401 (the train command's too)
 
 MODULES = ("predinet", "mhdpa")
 FAMILIES = ("rgw", "boxworld")
@@ -667,29 +666,6 @@ def field_names(cls: type) -> frozenset[str]:
 def learner_setting_owner() -> dict[str, str]:
     """Every learner setting's name -> the ``--algo`` it belongs to."""
     return {name: algo for algo, kind in LEARNER_CONFIGS.items() for name in field_names(kind)}
-
-
-def option_name(name: str) -> str:
-    """The flag of a setting (``ppo_epochs`` -> ``--ppo-epochs``)."""
-    return "--" + name.replace("_", "-")
-
-
-@cache
-def field_docs(cls: type) -> dict[str, str]:
-    """Each field's docstring (the string literal after it in the class body), whitespace joined."""
-    tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
-    body = tree.body[0].body  # type: ignore[attr-defined]
-    docs: dict[str, str] = {}
-    for node, after in zip(body, body[1:], strict=False):
-        if (
-            isinstance(node, ast.AnnAssign)
-            and isinstance(node.target, ast.Name)
-            and isinstance(after, ast.Expr)
-            and isinstance(after.value, ast.Constant)
-            and isinstance(after.value.value, str)
-        ):
-            docs[node.target.id] = " ".join(after.value.value.split())
-    return docs
 
 
 def field_default(cls: type, name: str) -> Any:

@@ -9,20 +9,27 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 
 from neurosym.envs.registration import ENTRIES, canonical_name
+from neurosym.flags import Json, add_options, option
+
+
+@dataclass(kw_only=True)
+class EnvsOptions(Json):
+    """``neurosym envs``'s options."""
+
+    show: str | None = option(None, metavar="NAME")
+    """print the first state of one environment as text (seed 0)"""
+    json: bool = False
+    """print one JSON object per line"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--json", action="store_true", help="One JSON object per line.")
-    parser.add_argument(
-        "--show",
-        metavar="NAME",
-        help="Print the first state of one environment as text (seed 0).",
-    )
+    add_options(parser, EnvsOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: EnvsOptions) -> int:
     if args.show:
         return _show(args.show)
     if args.json:

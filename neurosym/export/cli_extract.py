@@ -25,11 +25,13 @@ anything is recorded; any env of its family with its shape is fine.
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from neurosym.cli import add_action_mode, add_env_options, play_options
+from neurosym.cli import play_options
 from neurosym.errors import ConfigError
+from neurosym.flags import ActionMode, EnvChoice, Episodes, Out, Quiet, add_options, option
 from neurosym.seeds import check_seed
 
 FORMATS = ("pl", "parquet")
@@ -43,66 +45,37 @@ a new run removes it in the step that publishes the new products"""
 _PAGE_MARK = b"<title>neurosym report: "
 
 
+@dataclass(kw_only=True)
+class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
+    """``neurosym extract``'s options."""
+
+    checkpoint: str = option(metavar="FILE")
+    """trained agent (.pt)"""
+    actions: Literal["agent", "random"] = "agent"
+    """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
+    seed (the network still runs on every state, so its facts are extracted;
+    kb_meta(actions, random))"""
+    threshold: str = option("quantile:0.9", metavar="SPEC")
+    """per-relation threshold for holds/5: quantile:Q, abs:X or z:K"""
+    format: str = option("pl", metavar="LIST")
+    """comma-separated outputs: pl, parquet"""
+    qlf: bool = False
+    """also compile the KB to kb.qlf (fast loading)"""
+    batch: int | None = option(None, metavar="B", shown="64")
+    """environments stepped together"""
+    top_keys: int | None = option(None, metavar="N", shown="1")
+    """MHDPA only: keep each query cell's N strongest keys as attention/6 facts"""
+    verbose: bool = False
+    """print the full report: episodes, fact counts, thresholds, relation tables, every answer"""
+    episodes: int = 20
+    """episodes to record"""
+    out: str | None = option(None, metavar="DIR", shown="kb_out/<env>")
+    """output folder"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the extract options."""
-    parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
-    add_env_options(parser)
-    parser.add_argument(
-        "--episodes", type=int, default=20, metavar="N", help="episodes to record (default: 20)"
-    )
-    parser.add_argument(
-        "--seed",
-        type=int,
-        default=0,
-        metavar="S",
-        help="episode k is played from seed S + k (default: 0)",
-    )
-    add_action_mode(parser)
-    parser.add_argument(
-        "--actions",
-        choices=("agent", "random"),
-        default="agent",
-        help="who chooses the actions: the agent, or uniformly random draws seeded by each "
-        "episode's seed (the network still runs on every state, so its facts are extracted; "
-        "kb_meta(actions, random)) (default: agent)",
-    )
-    parser.add_argument(
-        "--threshold",
-        default="quantile:0.9",
-        metavar="SPEC",
-        help="per-relation threshold for holds/5: quantile:Q, abs:X or z:K (default: quantile:0.9)",
-    )
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: kb_out/<env>)")
-    parser.add_argument(
-        "--format",
-        default="pl",
-        metavar="LIST",
-        help="comma-separated outputs: pl, parquet (default: pl)",
-    )
-    parser.add_argument(
-        "--qlf", action="store_true", help="also compile the KB to kb.qlf (fast loading)"
-    )
-    parser.add_argument(
-        "--batch",
-        type=int,
-        default=None,
-        metavar="B",
-        help="environments stepped together (default: 64)",
-    )
-    parser.add_argument(
-        "--top-keys",
-        type=int,
-        default=None,
-        metavar="N",
-        help="MHDPA only: keep each query cell's N strongest keys as attention/6 facts (default: 1)",
-    )
-    parser.add_argument(
-        "--verbose",
-        action="store_true",
-        help="print the full report: episodes, fact counts, thresholds, relation tables, "
-        "every answer",
-    )
-    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    add_options(parser, ExtractOptions)
 
 
 def parse_formats(text: str) -> tuple[str, ...]:
@@ -116,7 +89,7 @@ def parse_formats(text: str) -> tuple[str, ...]:
     return parts
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: ExtractOptions) -> int:
     """Validate, record, extract, write, then print the summary and the rule answers."""
     from neurosym.export.thresholds import parse_threshold
 

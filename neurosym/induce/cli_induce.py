@@ -1,10 +1,10 @@
 """``neurosym induce``: learn rules back from a knowledge base.
 
-    neurosym induce --kb KB.pl --what world --out world.pl [--holdout KB2.pl]
-    neurosym induce --kb KB.pl --what strategy --out strategy.pl [--features world|relations|both]
+    neurosym induce world --kb KB.pl --out world.pl [--holdout KB2.pl]
+    neurosym induce strategy --kb KB.pl --out strategy.pl [--features world|relations|both]
                     [--holdout KB2.pl | --holdout-share 0.3] [--learner best|tree|covering]
 
-``--what world`` learns, for every event of the env's vocabulary that the KB
+``induce world`` learns, for every event of the env's vocabulary that the KB
 shows, ``predicts(E, T, Event)`` clauses over the state facts and the action
 (:mod:`neurosym.induce.world`), prints per event its clauses, train
 precision/recall, held-out precision/recall with ``--holdout`` and whether
@@ -12,14 +12,14 @@ it is solved perfectly (precision and recall 1.0 held out), and writes the
 clauses as a Prolog file that loads beside a KB of other episodes.
 Events the KB cannot decide are reported as undetermined, not guessed.
 
-``--what strategy`` learns which object the agent goes for next, as
+``induce strategy`` learns which object the agent goes for next, as
 ``goal(E, T, Object)`` clauses whose first answer is the choice
 (:mod:`neurosym.induce.strategy`), prints the clauses and the fidelity (share
 of held-out states whose first answer is the labelled next object) and
 writes them as a Prolog file that loads in plain swipl beside a KB.
 
 Before any learning the options are checked, each refused in one line: a
-flag of ``--what strategy`` given with ``--what world``, an empty ``--out``,
+flag of ``induce strategy`` given to ``induce world`` (exit 2), an empty ``--out``,
 an ``--out`` that is one of the inputs or a published folder's product
 (:func:`neurosym.atomic.refuse_overwrite`) or lies under a file, and a KB
 name that is not UTF-8. A learned file is written only when SWI-Prolog
@@ -32,63 +32,74 @@ from __future__ import annotations
 import argparse
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, ClassVar, Literal
 
 from neurosym.errors import ConfigError
+from neurosym.flags import Out, add_options, option, refuse
+
+
+@dataclass(kw_only=True)
+class InduceOptions(Out):
+    """What ``neurosym induce world`` and ``neurosym induce strategy`` both take."""
+
+    kb: str = option(metavar="FILE")
+    """knowledge base (.pl) to learn from"""
+    holdout: str | None = option(None, metavar="FILE")
+    """a KB of other episodes to score the learned rules on"""
+    out: str = option(metavar="FILE")
+    """learned rules (.pl) to write"""
+
+
+ONLY_STRATEGY = "{flag} belongs to neurosym induce strategy; neurosym induce world does not read it"
+
+
+@dataclass(kw_only=True)
+class WorldOptions(InduceOptions):
+    """``neurosym induce world``'s options."""
+
+    what: ClassVar[str] = "world"
+    RENAMED: ClassVar[dict[str, str]] = {
+        flag: ONLY_STRATEGY.format(flag=flag)
+        for flag in ("--features", "--learner", "--holdout-share")
+    }
+
+
+@dataclass(kw_only=True)
+class StrategyOptions(InduceOptions):
+    """``neurosym induce strategy``'s options."""
+
+    what: ClassVar[str] = "strategy"
+    holdout: str | None = option(None, exclusive="held-out")
+    holdout_share: float | None = option(None, metavar="S", exclusive="held-out", shown="0.3")
+    """without --holdout, score on the last share S of the KB's episodes, learning from the
+    rest"""
+    features: Literal["world", "relations", "both"] | None = option(None, shown="world")
+    """the facts the clauses may read: the world's (at/5, holding/3, ...), the network's
+    relations (attends/8, holds/5, attention/6) or both"""
+    learner: Literal["best", "tree", "covering"] | None = option(None, shown="best")
+    """a scikit-learn decision tree over (state, object) pairs, sequential covering of states,
+    or best: both, keeping the higher training fidelity"""
+
+
+SUBCOMMANDS: dict[str, tuple[type, str]] = {
+    "world": (WorldOptions, "Learn the world's rules: predicts(E, T, Event) clauses per event."),
+    "strategy": (StrategyOptions, "Learn the agent's strategy: goal(E, T, Object) clauses."),
+}
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    """Add the induce options."""
-    parser.add_argument(
-        "--kb", required=True, metavar="FILE", help="knowledge base (.pl) to learn from"
-    )
-    parser.add_argument(
-        "--what", required=True, metavar="WHAT", help=f"what to learn: {', '.join(WHATS)}"
-    )
-    parser.add_argument("--out", required=True, metavar="FILE", help="learned rules (.pl) to write")
-    held = parser.add_mutually_exclusive_group()
-    held.add_argument(
-        "--holdout", metavar="FILE", help="a KB of other episodes to score the learned rules on"
-    )
-    held.add_argument(
-        "--holdout-share",
-        type=float,
-        metavar="S",
-        help="strategy: without --holdout, score on the last share S of the KB's episodes, "
-        "learning from the rest (default: 0.3)",
-    )
-    parser.add_argument(
-        "--features",
-        choices=("world", "relations", "both"),
-        default=None,
-        help="strategy: the facts the clauses may read: the world's (at/5, holding/3, ...), "
-        "the network's relations (attends/8, holds/5, attention/6) or both (default: world)",
-    )
-    parser.add_argument(
-        "--learner",
-        choices=("best", "tree", "covering"),
-        default=None,
-        help="strategy: a scikit-learn decision tree over (state, object) pairs, sequential "
-        "covering of states, or best: both, keeping the higher training fidelity (default: best)",
-    )
+    """Add the induce subcommands, each with its own options."""
+    refuse(parser, {"--what": "--what is now a subcommand: neurosym induce world ... or "
+                    "neurosym induce strategy ..."})  # fmt: skip
+    sub = parser.add_subparsers(dest="what", metavar="WHAT", required=True)
+    for name, (cls, help_text) in SUBCOMMANDS.items():
+        add_options(sub.add_parser(name, help=help_text, description=help_text), cls)
 
 
-STRATEGY_FLAGS = {"features": "--features", "learner": "--learner", "holdout_share": "--holdout-share"}
-"""options only ``--what strategy`` reads: refused with ``--what world`` rather than ignored"""
-
-
-def run(args: argparse.Namespace) -> int:
-    """Check every option and the output before any learning, then dispatch on --what."""
-    learner = WHATS.get(args.what)
-    if learner is None:
-        raise ConfigError(f"--what {args.what!r} is not one of {', '.join(WHATS)}")
-    if args.what != "strategy":
-        for name, flag in STRATEGY_FLAGS.items():
-            if getattr(args, name, None) is not None:
-                raise ConfigError(
-                    f"{flag} belongs to --what strategy; --what {args.what} does not read it "
-                    "(leave it out)"
-                )
+def run(args: InduceOptions) -> int:
+    """Check every option and the output before any learning, then learn what was asked."""
     for name in ("kb", "holdout"):
         path = getattr(args, name)
         if path is None:
@@ -99,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
                 f"--{name} {path} does not exist (give a KB written by neurosym extract)"
             )
     check_out(args.out, [args.kb, args.holdout])
-    return learner(args)
+    return WHATS[args.what](args)
 
 
 def _check_name(flag: str, path: str) -> None:
@@ -140,7 +151,7 @@ def say(text: str) -> None:
         print(plain(line))
 
 
-def run_world(args: argparse.Namespace) -> int:
+def run_world(args: WorldOptions) -> int:
     """Learn world rules, print them with their scores, write them."""
     from neurosym.induce.world import induce_world
 
@@ -187,7 +198,7 @@ def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f}"
 
 
-def run_strategy(args: argparse.Namespace) -> int:
+def run_strategy(args: StrategyOptions) -> int:
     """Learn the agent's next-object strategy, print its clauses and fidelity, write it."""
     from neurosym.induce.strategy import induce_strategy
     from neurosym.induce.strategy_writer import clauses_text
@@ -214,8 +225,8 @@ def run_strategy(args: argparse.Namespace) -> int:
     return 0
 
 
-WHATS: dict[str, Callable[[argparse.Namespace], int]] = {
+WHATS: dict[str, Callable[[Any], int]] = {
     "world": run_world,
     "strategy": run_strategy,
 }
-"""--what -> the function that learns and writes it"""
+"""subcommand -> the function that learns and writes it"""

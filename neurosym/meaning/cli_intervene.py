@@ -1,6 +1,7 @@
 """``neurosym intervene``: controlled experiments on the level and on the heads.
 
-    neurosym intervene --checkpoint ckpt.pt [--env rgw2] [--env-option K=V] [--episodes 100] [--seed 0]
+    neurosym intervene --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--env-option K=V]
+        [--episodes 100] [--seed 0]
         [--sample|--greedy] --out DIR [--no-levels] [--no-ablations] [--json]
 
 Plays the unchanged level and every experiment of
@@ -22,54 +23,40 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
-from neurosym.cli import add_env_option, play_env
+from neurosym.cli import play_env
 from neurosym.errors import ConfigError
+from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, Out, add_options, option
+
+
+@dataclass(kw_only=True)
+class InterveneOptions(EnvChoice, Episodes, ActionMode, Out, Json):
+    """``neurosym intervene``'s options."""
+
+    checkpoint: str = option(metavar="FILE")
+    """trained agent (.pt)"""
+    levels: bool = True
+    """run the level changes (remove the sword, the enemy; swap them)"""
+    ablations: bool = True
+    """run the head ablations"""
+    episodes: int = 100
+    """episodes per experiment"""
+    greedy: bool = False
+    """take the most likely action"""
+    out: str = option(metavar="DIR")
+    """output folder"""
+    json: bool = False
+    """print one JSON object per measure and effect"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the intervene options."""
-    parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
-        "shape (default: the checkpoint's own)",
-    )
-    add_env_option(parser)
-    parser.add_argument(
-        "--episodes",
-        type=int,
-        default=100,
-        metavar="N",
-        help="episodes per experiment (default: 100)",
-    )
-    parser.add_argument(
-        "--seed", type=int, default=0, metavar="S", help="episode k uses seed S + k (default: 0)"
-    )
-    mode = parser.add_mutually_exclusive_group()
-    mode.add_argument(
-        "--sample",
-        dest="greedy",
-        action="store_false",
-        default=False,
-        help="sample actions from the policy (default)",
-    )
-    mode.add_argument("--greedy", dest="greedy", action="store_true", help="most likely action")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    parser.add_argument(
-        "--no-levels", dest="levels", action="store_false", help="skip the level changes"
-    )
-    parser.add_argument(
-        "--no-ablations", dest="ablations", action="store_false", help="skip the head ablations"
-    )
-    parser.add_argument(
-        "--json", action="store_true", help="print one JSON object per measure and effect"
-    )
+    add_options(parser, InterveneOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: InterveneOptions) -> int:
     """Validate, run the experiments, write, print."""
     from neurosym.meaning.output import check_out, publish
 
@@ -86,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
 
     env = canonical_name(args.env) if args.env else None
     agent = load_agent(args.checkpoint, env=env)
-    env, env_kwargs = play_env(agent, env, args.env_option)
+    env, env_kwargs = play_env(agent, env, args.env_option, args.map)
     if env_kwargs.get("edit") is not None:
         raise ConfigError(
             f"--env-option edit={env_kwargs['edit']}: intervene makes the level edits itself "

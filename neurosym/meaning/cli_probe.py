@@ -1,7 +1,7 @@
 """``neurosym probe``: which predicates each head's relations encode, and how selectively.
 
-    neurosym probe --checkpoint ckpt.pt [--env rgw2] [--env-option K=V] [--episodes 200] [--seed 0]
-        [--sample|--greedy] --out DIR [--json] [--no-untrained]
+    neurosym probe --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--env-option K=V]
+        [--episodes 200] [--seed 0] [--sample|--greedy] --out DIR [--json] [--no-untrained]
 
 Records the episodes (sampled by default: greedy episodes of a fixed map are
 all the same one), fits the probes of :mod:`neurosym.meaning.probe` and writes
@@ -14,7 +14,7 @@ into ``--out``:
 * ``probes_skipped.parquet`` -- predicates that could not be probed, with why.
 
 ``--json`` prints one JSON object per probe instead of the summary.
-``neurosym plot probes --probes DIR --out probes.png`` draws the table.
+``neurosym plot probes --probe DIR --out probes.png`` draws the table.
 """
 
 from __future__ import annotations
@@ -22,54 +22,41 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
-from neurosym.cli import add_env_option, play_env
+from neurosym.cli import play_env
 from neurosym.errors import ConfigError
+from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, Out, add_options, option
+
+
+@dataclass(kw_only=True)
+class ProbeOptions(EnvChoice, Episodes, ActionMode, Out, Json):
+    """``neurosym probe``'s options."""
+
+    checkpoint: str = option(metavar="FILE")
+    """trained agent (.pt)"""
+    untrained: bool = True
+    """also probe the untrained network (the baseline of each probe)"""
+    solver: Literal["batched", "sklearn"] = "batched"
+    """batched Newton fits, or one scikit-learn fit per probe (slow)"""
+    episodes: int = 200
+    """episodes to record"""
+    greedy: bool = False
+    """take the most likely action (greedy episodes of a fixed map are all the same one)"""
+    out: str = option(metavar="DIR")
+    """output folder"""
+    json: bool = False
+    """print one JSON object per probe"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the probe options."""
-    parser.add_argument("--checkpoint", required=True, metavar="FILE", help="trained agent (.pt)")
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment, e.g. rgw2: any of the checkpoint's family with its observation "
-        "shape (default: the checkpoint's own)",
-    )
-    add_env_option(parser)
-    parser.add_argument(
-        "--episodes", type=int, default=200, metavar="N", help="episodes to record (default: 200)"
-    )
-    parser.add_argument(
-        "--seed", type=int, default=0, metavar="S", help="episode k uses seed S + k (default: 0)"
-    )
-    mode = parser.add_mutually_exclusive_group()
-    mode.add_argument(
-        "--sample",
-        dest="greedy",
-        action="store_false",
-        default=False,
-        help="sample actions from the policy (default: varied episodes)",
-    )
-    mode.add_argument("--greedy", dest="greedy", action="store_true", help="most likely action")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    parser.add_argument("--json", action="store_true", help="print one JSON object per probe")
-    parser.add_argument(
-        "--no-untrained",
-        dest="untrained",
-        action="store_false",
-        help="skip the untrained network's probes",
-    )
-    parser.add_argument(
-        "--solver",
-        choices=("batched", "sklearn"),
-        default="batched",
-        help="batched Newton fits (default) or one scikit-learn fit per probe (slow)",
-    )
+    add_options(parser, ProbeOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: ProbeOptions) -> int:
     """Validate, record, probe, write, print."""
     from neurosym.meaning.output import check_out, publish
 
@@ -88,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
 
     env = canonical_name(args.env) if args.env else None
     agent = load_agent(args.checkpoint, env=env)
-    env, env_kwargs = play_env(agent, env, args.env_option)
+    env, env_kwargs = play_env(agent, env, args.env_option, args.map)
     report = probe(
         agent,
         env,

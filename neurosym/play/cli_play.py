@@ -6,7 +6,9 @@ rules/route.pl's ``route/4`` the action (:mod:`neurosym.play.agent`).
 Episode k is played from ``reset(seed=seed + k)``, as ``neurosym eval`` plays
 it, and scored by the same code, so the two reports compare line by line;
 ``--json`` prints one object with eval's names plus ``fallbacks``,
-``fallback_steps``, ``goals``, ``steps`` and ``steps_per_s``.
+``fallback_steps``, ``goals``, ``steps`` and ``steps_per_s``. ``--map FILE``
+plays a map of one's own on a fixed-map RGW env (``--env rgw1`` or ``rgw2``,
+default rgw2), as eval, extract and report do.
 
 A strategy whose ``%! features:`` line says ``relations`` or ``both`` reads
 the network's relation facts of the live state: give the agent they came
@@ -29,57 +31,58 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import dataclass
 
-from neurosym.cli import add_env_option, parse_env_options
+from neurosym.cli import map_option, parse_env_options
+from neurosym.flags import EnvChoice, Episodes, Json, add_options, option
+
+
+@dataclass(kw_only=True)
+class PlayOptions(EnvChoice, Episodes, Json):
+    """``neurosym play``'s options."""
+
+    policy: str = option(metavar="FILE")
+    """strategy file defining goal(E, T, Object) (neurosym induce strategy)"""
+    checkpoint: str | None = option(None, metavar="FILE")
+    """the agent whose relation facts the strategy reads (features: relations or both)"""
+    kb: str | None = option(None, metavar="FILE")
+    """the KB the strategy was learned from: its threshold/2 decides which relations hold
+    (holds/5) when the strategy file has none"""
+    env: str | None = option(None, shown="the checkpoint's")
+    """environment, e.g. rgw-random or bw2"""
+    env_option: list[str] = option(factory=list)
+    """an option of the env, e.g. num_mountains=12 on rgw-random (repeatable)"""
+    json: bool = False
+    """print one JSON object"""
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--policy",
-        required=True,
-        metavar="FILE",
-        help="strategy file defining goal(E, T, Object) (neurosym induce --what strategy)",
-    )
-    parser.add_argument(
-        "--env",
-        metavar="NAME",
-        help="environment, e.g. rgw-random or bw2 (default: the checkpoint's)",
-    )
-    parser.add_argument(
-        "--checkpoint",
-        metavar="FILE",
-        help="the agent whose relation facts the strategy reads (features: relations or both)",
-    )
-    parser.add_argument(
-        "--kb",
-        metavar="FILE",
-        help="the KB the strategy was learned from: its threshold/2 decides which relations "
-        "hold (holds/5) when the strategy file has none",
-    )
-    parser.add_argument("--episodes", type=int, default=100, help="episodes to play (100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode (0)")
-    add_env_option(parser)
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    add_options(parser, PlayOptions)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: PlayOptions) -> int:
     from neurosym.errors import ConfigError
     from neurosym.play.evaluate import play_policy
 
-    if args.env is None and args.checkpoint is None:
+    env, overrides = map_option(args.env, args.map, args.env or "rgw2")
+    if env is None and args.checkpoint is None:
         raise ConfigError("give the env to play (--env NAME, e.g. rgw-random)")
     checkpoint = None
     if args.checkpoint is not None:
         from neurosym.shipped import checkpoint_file
 
         checkpoint = checkpoint_file(args.checkpoint)
-    options = parse_env_options(args.env_option, args.env)
+    options = parse_env_options(args.env_option, env)
+    if overrides:
+        if "map" in options:
+            raise ConfigError("give the map once: --map FILE or --env-option map=FILE, not both")
+        options = {**overrides, **options}
     if checkpoint is not None:
         import torch
 
         torch.set_num_threads(1)
     report = play_policy(
-        args.policy, args.env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb
+        args.policy, env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb
     )
     if args.json:
         print(json.dumps(report))

@@ -1,7 +1,7 @@
 """``neurosym query``: run a Prolog goal against knowledge base files and print the answers.
 
     neurosym query --kb kb_out/rgw2/kb.pl --rules rgw "holds(E, T, R, agent, B)"
-    neurosym query --kb kb.pl --bind A=sword --format json "holds(E, T, R, A, B)"
+    neurosym query --kb kb.pl --bind A=sword --json "holds(E, T, R, A, B)"
 
 One column per output variable (names starting with ``_`` are left out);
 compound values print as their canonical Prolog text. A goal without output
@@ -36,68 +36,69 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from neurosym.errors import ConfigError, FactError
+from neurosym.flags import Json, add_options, option
 
-FORMATS = ("table", "json", "csv")
 INTERRUPTED = 130  # Ctrl-C
 BROKEN_PIPE = 141  # stdout's reader went away (128 + SIGPIPE)
 MAX_INFERENCES = (1 << 63) - 1
 MAX_STACK_MB = 1 << 20  # 1 TB
 
 
-def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("goal", metavar="GOAL", help="Prolog goal, e.g. 'object(Id, Type)'.")
-    parser.add_argument(
-        "--kb", action="append", required=True, metavar="FILE",
-        help="Fact file (.pl or .qlf) to load as data (facts only, nothing runs); repeatable.",
-    )  # fmt: skip
+def _rule_names() -> str:
     from neurosym.shipped import shipped_rule_names
 
-    shipped = ", ".join(shipped_rule_names()) or "none found"
-    parser.add_argument(
-        "--rules", action="append", default=[], metavar="FILE",
-        help=f"Rule file to load as code, before the facts, or a shipped one by name ({shipped}); "
-        "repeatable.",
-    )  # fmt: skip
-    parser.add_argument(
-        "--trust", action="append", default=[], metavar="FILE",
-        help="Load this --kb file as code (its directives run; any .qlf); repeatable. Default: none.",
-    )  # fmt: skip
-    parser.add_argument(
-        "--timeout", type=float, default=None, metavar="SECONDS",
-        help="Stop the goal after SECONDS of wall time (default: none).",
-    )  # fmt: skip
-    parser.add_argument(
-        "--max-inferences", type=int, default=None, metavar="N",
-        help="Stop the goal after N inferences (default: none).",
-    )  # fmt: skip
-    parser.add_argument(
-        "--stack-limit", type=float, default=None, metavar="MB",
-        help="Prolog stack the goal may use, in MB (default: SWI-Prolog's 1024).",
-    )  # fmt: skip
-    parser.add_argument(
-        "--bind", action="append", default=[], metavar="NAME=TERM",
-        help="Bind variable NAME to a value given as Prolog term text (repeatable).",
-    )  # fmt: skip
-    parser.add_argument(
-        "--format", choices=FORMATS, default="table", help="Output format (default: table)."
-    )
-    parser.add_argument(
-        "--limit",
-        type=int,
-        default=None,
-        metavar="N",
-        help="Print at most N answers (default: all).",
-    )
-    parser.add_argument(
-        "--qlf", action="store_true", help="Load .pl fact files through .qlf (compiled when stale)."
-    )
+    return ", ".join(shipped_rule_names()) or "none found"
 
 
-def _bounds(args: argparse.Namespace) -> dict[str, Any]:
+@dataclass(kw_only=True)
+class QueryOptions(Json):
+    """``neurosym query``'s options."""
+
+    RENAMED: ClassVar[dict[str, str]] = {
+        "--format": "--format is now --json or --csv (the table is the default)",
+    }
+    goal: str = option(metavar="GOAL", positional=True)
+    """Prolog goal, e.g. 'object(Id, Type)'"""
+    kb: list[str] = option(metavar="FILE")
+    """fact file (.pl or .qlf) to load as data (facts only, nothing runs); repeatable"""
+    rules: list[str] = option(factory=list, metavar="FILE", fill=lambda: {"shipped": _rule_names()})
+    """rule file to load as code, before the facts, or a shipped one by name ({shipped});
+    repeatable"""
+    trust: list[str] = option(factory=list, metavar="FILE", shown="none")
+    """load this --kb file as code (its directives run; any .qlf); repeatable"""
+    timeout: float | None = option(None, metavar="SECONDS", shown="none")
+    """stop the goal after SECONDS of wall time"""
+    max_inferences: int | None = option(None, metavar="N", shown="none")
+    """stop the goal after N inferences"""
+    stack_limit: float | None = option(None, metavar="MB", shown="SWI-Prolog's 1024")
+    """Prolog stack the goal may use, in MB"""
+    bind: list[str] = option(factory=list, metavar="NAME=TERM")
+    """bind variable NAME to a value given as Prolog term text (repeatable)"""
+    limit: int | None = option(None, metavar="N", shown="all")
+    """print at most N answers"""
+    qlf: bool = False
+    """load .pl fact files through .qlf (compiled when stale)"""
+    json: bool = option(False, exclusive="format")
+    """print the answers as one JSON list of objects (default: a table)"""
+    csv: bool = option(False, exclusive="format", group="output")
+    """print the answers as CSV, a header row first"""
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    add_options(parser, QueryOptions)
+
+
+def output_format(args: QueryOptions) -> str:
+    """table, json or csv, as --json and --csv say."""
+    return "json" if args.json else "csv" if args.csv else "table"
+
+
+def _bounds(args: QueryOptions) -> dict[str, Any]:
     """--timeout / --max-inferences / --stack-limit as KnowledgeBase.solve's keywords, checked."""
     from neurosym.prolog.knowledge_base import MAX_TIMEOUT
 
@@ -232,7 +233,7 @@ def _watch(read_fd: int) -> None:
             os._exit(INTERRUPTED)
 
 
-def _solve(args: argparse.Namespace, bounds: dict[str, Any], inputs: dict[str, Any]) -> Any:
+def _solve(args: QueryOptions, bounds: dict[str, Any], inputs: dict[str, Any]) -> Any:
     """Load the KB and run the goal: (names, rows, load warnings)."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
     from neurosym.shipped import rule_file
@@ -253,7 +254,7 @@ def _warning_text(caught: warnings.WarningMessage) -> str:
     return str(caught.message)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: QueryOptions) -> int:
     if args.limit is not None and args.limit < 1:
         raise ConfigError(f"--limit must be at least 1, not {args.limit}")
     bounds = _bounds(args)
@@ -267,7 +268,7 @@ def run(args: argparse.Namespace) -> int:
     names, rows, notes = _interruptible(lambda: _solve(args, bounds, inputs))
     for note in notes:
         print(f"neurosym query: warning: {note}", file=sys.stderr)
-    text = render(names, [dict(zip(names, row, strict=True)) for row in rows], args.format)
+    text = render(names, [dict(zip(names, row, strict=True)) for row in rows], output_format(args))
     try:
         sys.stdout.write(text)
         sys.stdout.flush()

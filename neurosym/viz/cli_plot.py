@@ -2,7 +2,7 @@
 
 Every subcommand draws from one of two sources:
 
-* ``--checkpoint FILE [--env NAME] [--episode-seed S]`` plays one greedy
+* ``--checkpoint FILE [--env NAME] [--seed S]`` plays one greedy
   episode from ``reset(seed=S)`` with the model's introspection on (full maps);
 * ``--recording DIR [--episode E]`` reads a recording saved by
   ``neurosym extract`` / ``Recording.save`` (attention keeps only the strongest cells).
@@ -15,132 +15,13 @@ functions in :mod:`neurosym.viz`.
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
-_SUBCOMMANDS = {
-    "mhdpa": "MHDPA: per head, the attention of one object on every cell and of every cell on it.",
-    "predinet": "PrediNet: per head, the attention maps a1 and a2 over the grid at one step.",
-    "rvectors": "PrediNet: the R vector of every head at every step of an episode, as a heat map.",
-    "relations": "PrediNet: each relation's distribution of values, its threshold marked.",
-    "episode": "An episode as a strip of states (PNG/SVG) or an animated GIF, with route and head arrows.",
-    "probes": "Probe selectivity (accuracy - control), heads x predicates, from `neurosym probe`.",
-}
-
+from neurosym.flags import EnvName, Episodes, Out, Seed, add_options, option
 
 MIN_DPI, MAX_DPI = 1, 1200
 """--dpi range: a 4-head figure at 1200 dpi is about 12,700 pixels wide (matplotlib's limit: 65,536)"""
-
-
-def configure(parser: argparse.ArgumentParser) -> None:
-    """Add the plot subcommands and their options."""
-    sub = parser.add_subparsers(dest="plot", metavar="PLOT", required=True)
-    for name, help_text in _SUBCOMMANDS.items():
-        cmd = sub.add_parser(name, help=help_text, description=help_text)
-        if name == "probes":
-            _probes_options(cmd)
-            continue
-        _source_options(cmd, gif=name == "episode")
-        if name in ("mhdpa", "predinet"):
-            cmd.add_argument("--step", type=int, default=0, help="state to show (default: 0)")
-        if name == "mhdpa":
-            which = cmd.add_mutually_exclusive_group()
-            which.add_argument(
-                "--object",
-                default=None,
-                help="entity or object id whose attention to draw: agent, enemy, key(red), lock_red_2 (default: agent)",
-            )
-            which.add_argument(
-                "--cell",
-                type=_cell,
-                default=None,
-                metavar="ROW,COL",
-                help="pick the object by its cell instead (for walls, pits, ...)",
-            )
-        if name != "relations":
-            cmd.add_argument("--head", type=int, default=None, help="draw one head (default: all)")
-        if name in ("rvectors", "episode"):
-            cmd.add_argument(
-                "--max-steps",
-                type=int,
-                default=None,
-                metavar="N",
-                help="with --checkpoint: stop the episode after this many steps (default: the env's limit)",
-            )
-        if name == "relations":
-            cmd.add_argument(
-                "--threshold",
-                default="quantile:0.9",
-                help="abs:X, quantile:Q or z:K, as for extract (default: quantile:0.9)",
-            )
-            cmd.add_argument(
-                "--episodes",
-                type=int,
-                default=None,
-                help="with --checkpoint: episodes to play, seeds S, S+1, ... (default: 1)",
-            )
-        if name == "episode":
-            cmd.add_argument(
-                "--steps",
-                default=None,
-                metavar="START:STOP",
-                help="states to draw, inclusive, e.g. 0:20 (default: all)",
-            )
-            cmd.add_argument(
-                "--frames",
-                type=int,
-                default=12,
-                help="PNG/SVG strip: states shown, evenly spaced (default: 12)",
-            )
-            cmd.add_argument(
-                "--every", type=int, default=1, help="GIF: draw every k-th state (default: 1)"
-            )
-            cmd.add_argument(
-                "--fps", type=float, default=4.0, help="GIF: frames per second (default: 4)"
-            )
-
-
-def _probes_options(cmd: argparse.ArgumentParser) -> None:
-    cmd.add_argument(
-        "--probes", required=True, metavar="DIR", help="a `neurosym probe` output folder"
-    )
-    cmd.add_argument(
-        "--relation",
-        default="all",
-        help="relation to show: all (the whole vector), 0, 1, ... or best (default: all)",
-    )
-    cmd.add_argument("--top", type=int, default=25, help="predicates shown at most (default: 25)")
-    cmd.add_argument("--out", required=True, metavar="FILE", help="image to write (.png or .svg)")
-    cmd.add_argument(
-        "--dpi", type=float, default=100.0, help="resolution of PNG output (default: 100)"
-    )
-
-
-def _source_options(cmd: argparse.ArgumentParser, *, gif: bool) -> None:
-    source = cmd.add_mutually_exclusive_group(required=True)
-    source.add_argument("--checkpoint", metavar="FILE", help="play this checkpoint (greedy)")
-    source.add_argument("--recording", metavar="DIR", help="read this saved recording")
-    cmd.add_argument(
-        "--env", default=None, help="with --checkpoint: environment (default: the checkpoint's)"
-    )
-    cmd.add_argument(
-        "--episode-seed",
-        type=int,
-        default=None,
-        metavar="S",
-        help="with --checkpoint: reset seed of the episode (default: 0)",
-    )
-    cmd.add_argument(
-        "--episode",
-        type=int,
-        default=None,
-        metavar="E",
-        help="with --recording: episode number (default: the first)",
-    )
-    kinds = ".png, .svg or .gif" if gif else ".png or .svg"
-    cmd.add_argument("--out", required=True, metavar="FILE", help=f"image to write ({kinds})")
-    cmd.add_argument(
-        "--dpi", type=float, default=100.0, help="resolution of PNG output (default: 100)"
-    )
 
 
 def _cell(text: str) -> tuple[int, int]:
@@ -151,7 +32,135 @@ def _cell(text: str) -> tuple[int, int]:
     return row, col
 
 
-def run(args: argparse.Namespace) -> int:
+@dataclass(kw_only=True)
+class PlotOptions(Out):
+    """What every plot takes: the image to write."""
+
+    out: str = option(metavar="FILE")
+    """image to write (.png or .svg)"""
+    dpi: float = option(100.0, group="output")
+    """resolution of PNG output"""
+
+
+@dataclass(kw_only=True)
+class SourceOptions(EnvName, Seed, PlotOptions):
+    """A plot of an episode: played from a checkpoint, or read from a recording."""
+
+    RENAMED: ClassVar[dict[str, str]] = {"--episode-seed": "--episode-seed is now --seed"}
+    checkpoint: str | None = option(None, metavar="FILE", exclusive="source", required_one=True)
+    """play this checkpoint (greedy)"""
+    recording: str | None = option(None, metavar="DIR", exclusive="source")
+    """read this saved recording"""
+    episode: int | None = option(None, metavar="E", shown="the first")
+    """with --recording: episode number"""
+    env: str | None = option(None, shown="the checkpoint's")
+    """with --checkpoint: environment"""
+    seed: int | None = option(None, shown="0")
+    """with --checkpoint: reset seed of the episode"""
+
+
+@dataclass(kw_only=True)
+class Head:
+    """The plots of one head or all."""
+
+    head: int | None = option(None, shown="all")
+    """draw one head"""
+
+
+@dataclass(kw_only=True)
+class MaxSteps:
+    """The plots of a whole played episode."""
+
+    max_steps: int | None = option(None, metavar="N", shown="the env's limit")
+    """with --checkpoint: stop the episode after this many steps"""
+
+
+@dataclass(kw_only=True)
+class MhdpaOptions(Head, SourceOptions):
+    plot: ClassVar[str] = "mhdpa"
+    step: int = 0
+    """state to show"""
+    object: str | None = option(None, exclusive="object", shown="agent")
+    """entity or object id whose attention to draw: agent, enemy, key(red), lock_red_2"""
+    cell: tuple[int, int] | None = option(None, metavar="ROW,COL", exclusive="object", parse=_cell)
+    """pick the object by its cell instead (for walls, pits, ...)"""
+
+
+@dataclass(kw_only=True)
+class PredinetOptions(Head, SourceOptions):
+    plot: ClassVar[str] = "predinet"
+    step: int = 0
+    """state to show"""
+
+
+@dataclass(kw_only=True)
+class RvectorsOptions(MaxSteps, Head, SourceOptions):
+    plot: ClassVar[str] = "rvectors"
+
+
+@dataclass(kw_only=True)
+class RelationsOptions(Episodes, SourceOptions):
+    plot: ClassVar[str] = "relations"
+    threshold: str = option("quantile:0.9", metavar="SPEC")
+    """abs:X, quantile:Q or z:K, as for extract"""
+    episodes: int | None = option(None, shown="1")
+    """with --checkpoint: episodes to play, seeds S, S+1, ..."""
+    seed: int | None = option(None, shown="0")
+    """with --checkpoint: reset seed of the first episode"""
+
+
+@dataclass(kw_only=True)
+class EpisodeOptions(MaxSteps, Head, SourceOptions):
+    plot: ClassVar[str] = "episode"
+    RENAMED: ClassVar[dict[str, str]] = {
+        **SourceOptions.RENAMED,
+        "--frames": "--frames is now --panels (the states the strip shows; --frames is "
+        "train's frame budget)",
+    }
+    steps: str | None = option(None, metavar="START:STOP", shown="all")
+    """states to draw, inclusive, e.g. 0:20"""
+    panels: int = option(12, metavar="N")
+    """PNG/SVG strip: states shown, evenly spaced"""
+    every: int = 1
+    """GIF: draw every k-th state"""
+    fps: float = 4.0
+    """GIF: frames per second"""
+    out: str = option(metavar="FILE")
+    """image to write (.png, .svg or .gif)"""
+
+
+@dataclass(kw_only=True)
+class ProbesOptions(PlotOptions):
+    plot: ClassVar[str] = "probes"
+    RENAMED: ClassVar[dict[str, str]] = {
+        "--probes": "--probes is now --probe (as in neurosym report)"
+    }
+    probe: str = option(metavar="DIR")
+    """a `neurosym probe` output folder"""
+    relation: str = "all"
+    """relation to show: all (the whole vector), 0, 1, ... or best"""
+    top: int = 25
+    """predicates shown at most"""
+
+
+_SUBCOMMANDS: dict[str, tuple[type, str]] = {
+    "mhdpa": (MhdpaOptions, "MHDPA: per head, the attention of one object on every cell and of every cell on it."),
+    "predinet": (PredinetOptions, "PrediNet: per head, the attention maps a1 and a2 over the grid at one step."),
+    "rvectors": (RvectorsOptions, "PrediNet: the R vector of every head at every step of an episode, as a heat map."),
+    "relations": (RelationsOptions, "PrediNet: each relation's distribution of values, its threshold marked."),
+    "episode": (EpisodeOptions, "An episode as a strip of states (PNG/SVG) or an animated GIF, with route and head arrows."),
+    "probes": (ProbesOptions, "Probe selectivity (accuracy - control), heads x predicates, from `neurosym probe`."),
+}  # fmt: skip
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the plot subcommands, each with its own options."""
+    sub = parser.add_subparsers(dest="plot", metavar="PLOT", required=True)
+    for name, (cls, help_text) in _SUBCOMMANDS.items():
+        add_options(sub.add_parser(name, help=help_text, description=help_text), cls)
+
+
+def run(args: Any) -> int:
     """Load the source, draw the requested picture and write it."""
     from neurosym.display import plain
     from neurosym.errors import ConfigError
@@ -169,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
 
         if args.top < 1:
             raise ConfigError(f"--top must be at least 1, got {args.top}")
-        fig = probes_figure(load_probe_table(args.probes), args.relation, args.top)
+        fig = probes_figure(load_probe_table(args.probe), args.relation, args.top)
         path = save_figure(fig, args.out, dpi=args.dpi)
         print(f"wrote {plain(args.out)} ({_pixels(path) if fmt == 'png' else 'svg'})")
         return 0
@@ -179,13 +188,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _load_source(args: argparse.Namespace) -> Any:
+def _load_source(args: Any) -> Any:
     from neurosym.errors import ConfigError
 
     if args.recording is not None:
         played = (
             ("--env", args.env),
-            ("--episode-seed", args.episode_seed),
+            ("--seed", args.seed),
             ("--max-steps", getattr(args, "max_steps", None)),
             ("--episodes", getattr(args, "episodes", None)),
         )
@@ -197,19 +206,19 @@ def _load_source(args: argparse.Namespace) -> Any:
         return Recording.load(args.recording)
     if args.episode is not None:
         raise ConfigError(
-            "--episode goes with --recording; with --checkpoint pick the episode by --episode-seed"
+            "--episode goes with --recording; with --checkpoint pick the episode by --seed"
         )
     from neurosym.agent.checkpoint import load_agent
 
     return load_agent(args.checkpoint)
 
 
-def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
+def _draw(args: Any, source: Any, fmt: str) -> str:
     """Draw and write; returns a short description of what was written."""
     from neurosym.viz import attention, episode, predinet, relations
     from neurosym.viz.output import save_figure
 
-    where = {"episode": args.episode, "seed": args.episode_seed or 0}
+    where = {"episode": args.episode, "seed": args.seed or 0}
     if args.plot == "mhdpa":
         fig = attention.mhdpa_figure(
             source,
@@ -253,7 +262,7 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
             args.env,
             head=args.head,
             steps=episode.parse_steps(args.steps),
-            frames=args.frames,
+            frames=args.panels,
             max_steps=_positive(args.max_steps),
             **where,
         )

@@ -24,63 +24,49 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from neurosym.cli import add_action_mode, add_env_options, play_options
+from neurosym.cli import play_options
 from neurosym.errors import ConfigError
+from neurosym.flags import ActionMode, EnvChoice, Episodes, Out, Quiet, add_options, option
 from neurosym.publish import check_out
 
 CHECKPOINT_ONLY = ("env", "map", "episodes", "seed", "batch", "top_keys")
 
 
+@dataclass(kw_only=True)
+class ReportOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
+    """``neurosym report``'s options."""
+
+    checkpoint: str | None = option(None, metavar="FILE", exclusive="source", required_one=True)
+    """trained agent (.pt) to record"""
+    recording: str | None = option(None, metavar="DIR", exclusive="source")
+    """report the folder `neurosym extract --out DIR` wrote"""
+    threshold: str | None = option(None, metavar="SPEC")
+    """threshold for holds/5: quantile:Q, abs:X or z:K (default: the extract's, else
+    quantile:0.9)"""
+    batch: int | None = option(None, metavar="B", hidden=True)
+    top_keys: int | None = option(None, metavar="N", shown="1")
+    """MHDPA: keep each query cell's N strongest keys"""
+    probe: str | None = option(None, metavar="DIR")
+    """add the probes `neurosym probe --out DIR` wrote"""
+    intervene: str | None = option(None, metavar="DIR")
+    """add the experiments `neurosym intervene --out DIR` wrote"""
+    episodes: int | None = option(None, shown="20")
+    """episodes to record"""
+    seed: int | None = option(None, shown="0")
+    out: str | None = option(None, metavar="DIR")
+    """output folder (default: --recording's folder, or kb_out/<env> with --checkpoint)"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the report options."""
-    source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--checkpoint", metavar="FILE", help="trained agent (.pt) to record")
-    source.add_argument(
-        "--recording", metavar="DIR", help="report the folder `neurosym extract --out DIR` wrote"
-    )
-    add_env_options(parser)
-    parser.add_argument(
-        "--episodes", type=int, default=None, metavar="N", help="episodes to record (default: 20)"
-    )
-    parser.add_argument(
-        "--seed", type=int, default=None, metavar="S", help="episode k uses seed S + k (default: 0)"
-    )
-    add_action_mode(parser)
-    parser.add_argument(
-        "--threshold",
-        default=None,
-        metavar="SPEC",
-        help="threshold for holds/5: quantile:Q, abs:X or z:K (default: the extract's, "
-        "else quantile:0.9)",
-    )
-    parser.add_argument("--batch", type=int, default=None, metavar="B", help=argparse.SUPPRESS)
-    parser.add_argument(
-        "--top-keys",
-        type=int,
-        default=None,
-        metavar="N",
-        help="MHDPA: keep each query cell's N strongest keys (default: 1)",
-    )
-    parser.add_argument(
-        "--probe", metavar="DIR", help="add the probes `neurosym probe --out DIR` wrote"
-    )
-    parser.add_argument(
-        "--intervene",
-        metavar="DIR",
-        help="add the experiments `neurosym intervene --out DIR` wrote",
-    )
-    parser.add_argument(
-        "--out",
-        metavar="DIR",
-        help="output folder (default: --recording's folder, or kb_out/<env> with --checkpoint)",
-    )
-    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    add_options(parser, ReportOptions)
 
 
-def _extras(args: argparse.Namespace) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
+def _extras(args: ReportOptions) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
     """The probe and experiment sections, read before anything is recorded (bad folders fail fast)."""
     from neurosym.webreport.extras import intervene_section, probe_section
 
@@ -89,7 +75,7 @@ def _extras(args: argparse.Namespace) -> tuple[dict[str, Any] | None, dict[str, 
     return probes, experiments
 
 
-def _check(args: argparse.Namespace) -> None:
+def _check(args: ReportOptions) -> None:
     if args.recording is not None:
         given = [name for name in CHECKPOINT_ONLY if getattr(args, name) is not None]
         given += ["env_option"] if args.env_option else []
@@ -106,7 +92,7 @@ def _check(args: argparse.Namespace) -> None:
             raise ConfigError(f"{flag} must be at least {low}, got {value}")
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: ReportOptions) -> int:
     """Validate, then report a recording or record the checkpoint and report it."""
     _check(args)
     if args.out is not None:
@@ -125,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _from_recording(args: argparse.Namespace, probes: Any, experiments: Any) -> Path:
+def _from_recording(args: ReportOptions, probes: Any, experiments: Any) -> Path:
     from neurosym.webreport.build import (
         load_agent_or_note,
         load_extract,
@@ -155,7 +141,7 @@ def _from_recording(args: argparse.Namespace, probes: Any, experiments: Any) -> 
     return write_report(Path(args.out), context)
 
 
-def _from_checkpoint(args: argparse.Namespace, probes: Any, experiments: Any) -> Path:
+def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path:
     from neurosym.agent.checkpoint import env_for, load_agent
     from neurosym.export.facts import DEFAULT_THRESHOLD, extract_facts
     from neurosym.export.recorder import record

@@ -55,7 +55,7 @@ def test_query_takes_a_shipped_rule_file_by_name(run_neurosym, tmp_path: Path) -
     kb = tmp_path / "kb.pl"
     kb.write_text("episode(0, 3, 11.0, terminal).\nevent(0, 1, picked(sword)).\n"
                   "event(0, 2, defeated(enemy)).\n")  # fmt: skip
-    proc = run_neurosym("query", "--kb", kb, "--rules", "rgw", "--format", "csv",
+    proc = run_neurosym("query", "--kb", kb, "--rules", "rgw", "--csv",
                         "sword_before_enemy(E)")  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "E\n0\n"

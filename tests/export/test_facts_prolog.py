@@ -229,7 +229,7 @@ def test_kb_meta_names_the_env_options(tmp_path: Path, run_neurosym) -> None:  #
         got = {str(r["K"]): r["V"] for r in kb.query("kb_meta(env_option(K), V)")}
     assert got == {"classic": "false", "map": "my map.txt", "max_steps": "none",
                    "num_mountains": 12, "scale": 0.5}  # fmt: skip
-    proc = run_neurosym("query", "--kb", path, "--format", "json", "kb_meta(env_option(map), V)")
+    proc = run_neurosym("query", "--kb", path, "--json", "kb_meta(env_option(map), V)")
     assert (proc.returncode, proc.stdout.strip()) == (0, '[{"V": "my map.txt"}]'), proc.stderr
     table = pd.read_parquet(facts.to_parquet(tmp_path / "facts") / "kb_meta.parquet")
     assert dict(zip(table["key"], table["value"], strict=True))["env_option(map)"] == "my map.txt"

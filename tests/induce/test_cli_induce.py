@@ -1,4 +1,4 @@
-"""`neurosym induce --what world` and `neurosym extract --actions random`, run as commands."""
+"""`neurosym induce world` and `neurosym extract --actions random`, run as commands."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 def test_induce_prints_each_event_and_writes_the_rules(run_neurosym, kbs, tmp_path: Path) -> None:
     train, held = kbs
     out = tmp_path / "world.pl"
-    done = run_neurosym("induce", "--kb", train, "--what", "world", "--out", out, "--holdout", held)
+    done = run_neurosym("induce", "world", "--kb", train, "--out", out, "--holdout", held)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert lines[0].startswith(f"learned from {train} (env rgw-random, 60 episodes, ")
@@ -43,7 +43,7 @@ def test_induce_prints_each_event_and_writes_the_rules(run_neurosym, kbs, tmp_pa
 
 
 def test_without_holdout_only_train_scores(run_neurosym, kbs, tmp_path: Path) -> None:
-    done = run_neurosym("induce", "--kb", kbs[0], "--what", "world", "--out", tmp_path / "w.pl")
+    done = run_neurosym("induce", "world", "--kb", kbs[0], "--out", tmp_path / "w.pl")
     assert done.returncode == 0, done.stderr
     assert "held-out" not in done.stdout and "held out" not in done.stdout
 
@@ -52,15 +52,11 @@ def test_without_holdout_only_train_scores(run_neurosym, kbs, tmp_path: Path) ->
     ("args", "message"),
     [
         (
-            ["--kb", "missing.pl", "--what", "world"],
+            ["world", "--kb", "missing.pl"],
             "neurosym induce: error: --kb missing.pl does not exist",
         ),
         (
-            ["--kb", "KB", "--what", "rules"],
-            "neurosym induce: error: --what 'rules' is not one of ",
-        ),
-        (
-            ["--kb", "EMPTY", "--what", "world"],
+            ["world", "--kb", "EMPTY"],
             "has no step/4 facts: nothing to learn world rules from",
         ),
     ],

@@ -37,13 +37,13 @@ def test_an_atom_is_written_as_an_atom_and_escapes_are_shown(
     """'Wall' stays an atom (as a variable it predicted every state); ESC never reaches the terminal."""
     kb = hostile_world_kb(world_kb, tmp_path / "wall.pl", wall="'Wall'")
     out = tmp_path / "world.pl"
-    code, stdout, _ = induce(capsys, "--kb", kb, "--what", "world", "--out", out)
+    code, stdout, _ = induce(capsys, "world", "--kb", kb, "--out", out)
     assert code == 0
     assert "  predicts(E, T, bumped(wall)) :- ahead(E, T, 'Wall')." in stdout.splitlines()
     assert states(kb, out) == states(kb) != set()
     osc = "'\\e]8;;http://x\\e\\\\wall\\e]8;;\\e\\\\'"  # a hyperlink: OSC 8 ... ST
     kb = hostile_world_kb(world_kb, tmp_path / "osc.pl", wall=osc)
-    code, stdout, _ = induce(capsys, "--kb", kb, "--what", "world", "--out", out)
+    code, stdout, _ = induce(capsys, "world", "--kb", kb, "--out", out)
     assert code == 0 and "\x1b" not in stdout
     assert r"  predicts(E, T, bumped(wall)) :- ahead(E, T, '\x1b\]8;;http://x\x1b\\\wall\x1b\]8;;\x1b\\\')." in stdout.splitlines()
     assert states(kb, out) == states(kb) != set()  # world.pl loads, and means what it says
@@ -90,7 +90,7 @@ def test_a_held_out_kb_of_another_family_is_refused(
 ) -> None:
     out = tmp_path / "s.pl"
     for what in ("strategy", "world"):
-        code, _, err = induce(capsys, "--kb", bw_kb, "--what", what, "--holdout", world_kb, "--out", out)
+        code, _, err = induce(capsys, what, "--kb", bw_kb, "--holdout", world_kb, "--out", out)
         assert code == 1 and err == (
             f"neurosym induce: error: held-out KB {world_kb} is a rgw KB; the rules learned from "
             f"{bw_kb} are boxworld rules: give a held-out KB of the same env family\n"
@@ -123,7 +123,7 @@ def test_an_output_that_is_an_input_is_refused(
     ]
     for source, out, why in cases:
         for flags in (["--kb", source], ["--kb", bw_kb, "--holdout", source]):
-            code, _, err = induce(capsys, *flags, "--what", "world", "--out", out)
+            code, _, err = induce(capsys, "world", *flags, "--out", out)
             assert code == 1 and len(err.splitlines()) == 1, err
             assert err.startswith(f"neurosym induce: error: --out {out} {why}"), err
     assert kb.read_bytes() == before and (run / "kb.pl").read_bytes() == before
@@ -140,7 +140,7 @@ def test_a_file_name_that_is_not_utf8_is_one_line(
     name = os.fsdecode(bytes(tmp_path) + b"/kb\xff.pl")
     Path(name).write_bytes(bw_kb.read_bytes())
     for flags in (["--kb", name], ["--kb", bw_kb, "--holdout", name]):
-        code, _, err = induce(capsys, *flags, "--what", "strategy", "--out", tmp_path / "s.pl")
+        code, _, err = induce(capsys, "strategy", *flags, "--out", tmp_path / "s.pl")
         assert code == 1
         assert err == (
             f"neurosym induce: error: {flags[-2]} {tmp_path}/kb\\udcff.pl: the file name is not valid "
@@ -151,17 +151,11 @@ def test_a_file_name_that_is_not_utf8_is_one_line(
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--what", "world", "--features", "world"],
-         "--features belongs to --what strategy; --what world does not read it (leave it out)"),
-        (["--what", "world", "--learner", "tree"],
-         "--learner belongs to --what strategy; --what world does not read it (leave it out)"),
-        (["--what", "world", "--holdout-share", "0.3"],
-         "--holdout-share belongs to --what strategy; --what world does not read it (leave it out)"),
-        (["--what", "strategy", "--out", ""],
+        (["strategy", "--out", ""],
          "--out is empty: give the file to write the learned rules to (a .pl)"),
-        (["--what", "world", "--out", ""],
+        (["world", "--out", ""],
          "--out is empty: give the file to write the learned rules to (a .pl)"),
-        (["--what", "strategy", "--out", "{file}/x.pl"],
+        (["strategy", "--out", "{file}/x.pl"],
          "--out {file}/x.pl: {file} is not a folder, so the rules cannot be written there"),
     ],
 )  # fmt: skip
@@ -173,9 +167,24 @@ def test_flags_are_used_or_refused_before_the_learning(
     args = [a.format(file=file) for a in args]
     if "--out" not in args:
         args += ["--out", str(tmp_path / "x.pl")]
-    code, out, err = induce(capsys, "--kb", bw_kb, *args)
+    code, out, err = induce(capsys, args[0], "--kb", bw_kb, *args[1:])
     assert (code, out) == (1, "")  # nothing learned
     assert err == f"neurosym induce: error: {message.format(file=file)}\n"
+
+
+@pytest.mark.parametrize("flag", ["--features=world", "--learner=tree", "--holdout-share=0.3"])
+def test_a_strategy_flag_is_refused_by_induce_world(
+    bw_kb: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], flag: str
+) -> None:
+    """Each subcommand has only its own flags: a strategy one given to world is one line, exit 2."""
+    with pytest.raises(SystemExit) as exited:
+        induce(capsys, "world", "--kb", bw_kb, flag, "--out", tmp_path / "x.pl")
+    name = flag.split("=")[0]
+    assert exited.value.code == 2 and capsys.readouterr().err == (
+        f"neurosym induce world: error: {name} belongs to neurosym induce strategy; "
+        "neurosym induce world does not read it\n"
+    )
+    assert not (tmp_path / "x.pl").exists()
 
 
 def test_both_kinds_make_the_folders_of_out(
@@ -183,7 +192,7 @@ def test_both_kinds_make_the_folders_of_out(
 ) -> None:
     for what, kb in (("strategy", bw_kb), ("world", world_kb)):
         out = tmp_path / what / "missing" / "dir" / "x.pl"
-        code, stdout, err = induce(capsys, "--kb", kb, "--what", what, "--out", out)
+        code, stdout, err = induce(capsys, what, "--kb", kb, "--out", out)
         assert code == 0, err
         assert stdout.splitlines()[-1] == f"wrote {out}" and out.is_file()
     rules = induce_world(world_kb)

@@ -1,4 +1,4 @@
-"""``neurosym induce --what strategy`` on real files: output, the written file, error lines."""
+"""``neurosym induce strategy`` on real files: output, the written file, error lines."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 def test_cli_learns_prints_and_writes(run_neurosym, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     train, test = kbs
     out = tmp_path / "strategy.pl"
-    r = run_neurosym("induce", "--kb", train, "--what", "strategy", "--holdout", test, "--out", out)
+    r = run_neurosym("induce", "strategy", "--kb", train, "--holdout", test, "--out", out)
     assert r.returncode == 0, r.stderr
     assert "fidelity 1.0000 on" in r.stdout and f"wrote {out}" in r.stdout
     text = out.read_text()
@@ -29,7 +29,7 @@ def test_cli_holdout_share_and_relations(run_neurosym, kbs: tuple[Path, Path], t
     train, _ = kbs
     out = tmp_path / "s.pl"
     r = run_neurosym(
-        "induce", "--kb", train, "--what", "strategy", "--features", "relations",
+        "induce", "strategy", "--kb", train, "--features", "relations",
         "--holdout-share", "0.5", "--out", out,
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
@@ -40,21 +40,24 @@ def test_cli_holdout_share_and_relations(run_neurosym, kbs: tuple[Path, Path], t
 @pytest.mark.parametrize(
     ("args", "code", "message"),
     [
-        (["--kb", "missing.pl", "--what", "strategy"], 1,
+        (["strategy", "--kb", "missing.pl"], 1,
          "neurosym induce: error: --kb missing.pl does not exist (give a KB written by neurosym extract)"),
-        (["--what", "plans"], 1, "neurosym induce: error: --what 'plans' is not one of"),
-        (["--what", "strategy", "--holdout-share", "1.5"], 1,
+        (["plans"], 2, "neurosym induce: error: argument WHAT: invalid choice: 'plans' (choose from "
+         "'world', 'strategy')"),
+        (["strategy", "--holdout-share", "1.5"], 1,
          "neurosym induce: error: --holdout-share must be between 0 and 1 (exclusive), got 1.5"),
-        (["--what", "strategy", "--features", "colour"], 2, "invalid choice: 'colour'"),
+        (["strategy", "--features", "colour"], 2, "invalid choice: 'colour'"),
+        (["--what", "strategy"], 2, "neurosym induce: error: --what is now a subcommand: neurosym "
+         "induce world ... or neurosym induce strategy ..."),
     ],
 )  # fmt: skip
 def test_cli_errors_are_one_line(run_neurosym, kbs, tmp_path: Path, args, code, message) -> None:  # type: ignore[no-untyped-def]
     train, _ = kbs
-    full = ["--kb", train, *args] if "--kb" not in args else args
+    full = [*args[:1], "--kb", train, *args[1:]] if "--kb" not in args else args
     r = run_neurosym("induce", *full, "--out", tmp_path / "s.pl")
     assert r.returncode == code
     assert message in r.stderr
-    if code == 1:
+    if code == 1 or "--what" in args:
         assert len(r.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "s.pl").exists()
 
@@ -77,7 +80,7 @@ def test_induce_imports_neither_torch_nor_the_envs() -> None:
 
 def test_cli_refuses_a_folder_as_out_before_learning(run_neurosym, kbs, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     train, _ = kbs
-    r = run_neurosym("induce", "--kb", train, "--what", "strategy", "--out", tmp_path)
+    r = run_neurosym("induce", "strategy", "--kb", train, "--out", tmp_path)
     assert r.returncode == 1
     assert r.stderr.startswith("neurosym induce: error: ") and len(r.stderr.strip().splitlines()) == 1
     assert "learned from" not in r.stdout

@@ -43,7 +43,7 @@ def test_probe_writes_a_kb_the_table_and_json(run_neurosym, tmp_path: Path, swip
     loads(swipl, out / "kb.pl", RULES / "meaning.pl")
 
     picture = tmp_path / "probes.png"
-    drawn = run_neurosym("plot", "probes", "--probes", out, "--out", picture)
+    drawn = run_neurosym("plot", "probes", "--probe", out, "--out", picture)
     assert drawn.returncode == 0, drawn.stderr
     assert picture.read_bytes()[:4] == b"\x89PNG"
 

@@ -61,7 +61,7 @@ def test_kb_facts_cannot_change_a_route(
     kb = tmp_path / "kb.pl"
     kb.write_text(DATA_KB + (HOSTILE if hostile else ""))
     goal = "route(0, 0, terminal, A, C)"
-    proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--format", "csv")
+    proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--csv")
     assert (proc.returncode, proc.stdout.split()) == (0, ["A,C", "right,2"]), proc.stderr
     code = tmp_path / "states.pl"
     code.write_text(FACTS.read_text() + (HOSTILE if hostile else ""))

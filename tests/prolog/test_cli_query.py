@@ -36,14 +36,14 @@ def kb_files(tmp_path: Path) -> tuple[Path, Path]:
 def test_json_and_csv(run_neurosym, kb_files: tuple[Path, Path]) -> None:
     facts, rules = kb_files
     proc = run_neurosym(
-        "query", "--kb", facts, "--rules", rules, "--format", "json", "event(E, T, Ev), path(1, P)"
+        "query", "--kb", facts, "--rules", rules, "--json", "event(E, T, Ev), path(1, P)"
     )
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout) == [
         {"E": 0, "T": 3, "Ev": "picked(sword)", "P": ["a", "f(x)"]},
         {"E": 0, "T": 5, "Ev": "opened(lock(red))", "P": ["a", "f(x)"]},
     ]
-    proc = run_neurosym("query", "--kb", facts, "--format", "csv", "object(Id, Type)")
+    proc = run_neurosym("query", "--kb", facts, "--csv", "object(Id, Type)")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "Id,Type\nagent,agent\ns1,sword\nIt's,key(red)\n"
 
@@ -56,10 +56,10 @@ def test_table_limit_and_bind(run_neurosym, kb_files: tuple[Path, Path]) -> None
     assert any("E" in ln and "I" in ln for ln in lines[:3])
     assert any("sword" in ln for ln in lines)
     assert lines[-1] == "1 answer"
-    proc = run_neurosym("query", "--kb", facts, "--limit", "1", "--format", "csv", "object(Id, _)")
+    proc = run_neurosym("query", "--kb", facts, "--limit", "1", "--csv", "object(Id, _)")
     assert proc.stdout == "Id\nagent\n"
     proc = run_neurosym(
-        "query", "--kb", facts, "--bind", "Ev=opened(lock(red))", "--bind", "E=0", "--format", "csv",
+        "query", "--kb", facts, "--bind", "Ev=opened(lock(red))", "--bind", "E=0", "--csv",
         "event(E, T, Ev)",
     )  # fmt: skip
     assert proc.stdout == "T\n5\n", proc.stderr
@@ -123,7 +123,7 @@ def test_load_warnings_go_to_stderr(run_neurosym, kb_files: tuple[Path, Path]) -
     facts, _ = kb_files
     rules = facts.parent / "w.pl"
     rules.write_text("p(X) :- true.\n")
-    proc = run_neurosym("query", "--kb", facts, "--rules", rules, "--format", "csv", "p(1)")
+    proc = run_neurosym("query", "--kb", facts, "--rules", rules, "--csv", "p(1)")
     assert proc.returncode == 0
     assert proc.stdout == "\n\n"  # no output variables: an empty header, one empty row
     assert proc.stderr == f"neurosym query: warning: {rules}:1: Singleton variables: [X]\n"
@@ -206,7 +206,7 @@ def test_sword_enemy_link_prints_its_list(run_neurosym, tmp_path: Path) -> None:
 def test_json_writes_infinities_as_text(run_neurosym, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, "--format", "json", "X is inf, Y is -inf, Z is nan")
+    proc = run_neurosym("query", "--kb", facts, "--json", "X is inf, Y is -inf, Z is nan")
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout) == [{"X": "inf", "Y": "-inf", "Z": "nan"}]
 
@@ -214,7 +214,7 @@ def test_json_writes_infinities_as_text(run_neurosym, tmp_path: Path) -> None:
 def test_answers_holding_variables_print_with_names(run_neurosym, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, "--format", "json", "X = f(Y, Z, [Y])")
+    proc = run_neurosym("query", "--kb", facts, "--json", "X = f(Y, Z, [Y])")
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout) == [{"X": "f(_G1,_G2,[_G1])", "Y": None, "Z": None}]
     proc = run_neurosym("query", "--kb", facts, "X = f(Y)")
@@ -236,7 +236,7 @@ def test_answers_python_cannot_take_are_one_line_and_print_nothing(
 ) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, "--format", fmt, goal)
+    proc = run_neurosym("query", "--kb", facts, *{"table": []}.get(fmt, [f"--{fmt}"]), goal)
     assert proc.returncode == 1
     assert proc.stdout == ""
     assert proc.stderr == f"neurosym query: error: {message}" + proc.stderr.split(message, 1)[1]
@@ -278,7 +278,7 @@ def test_a_goal_ending_in_a_full_stop_or_comment_is_one_goal(run_neurosym, tmp_p
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
     for goal in ("ok(X).", "ok(X). % a comment", "X = 'a. b'"):
-        proc = run_neurosym("query", "--kb", facts, "--format", "csv", goal)
+        proc = run_neurosym("query", "--kb", facts, "--csv", goal)
         assert proc.returncode == 0, proc.stderr
 
 
@@ -318,7 +318,8 @@ def test_a_closed_pipe_ends_quietly(tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("".join(f"ok({i}).\n" for i in range(20000)))
     for fmt in ("csv", "json", "table"):
-        proc = _popen(tmp_path, "--kb", facts, "--format", fmt, "ok(X)", stdout=subprocess.PIPE)
+        proc = _popen(tmp_path, "--kb", facts, *{"table": []}.get(fmt, [f"--{fmt}"]), "ok(X)",
+                      stdout=subprocess.PIPE)  # fmt: skip
         proc.stdout.close()  # the reader is gone before anything is written
         _, err = proc.communicate(timeout=120)
         assert err == "" and proc.returncode == 141, (fmt, err)

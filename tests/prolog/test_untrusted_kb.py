@@ -156,7 +156,7 @@ def test_trust_and_rules_load_the_same_file_as_code(run_neurosym, tmp_path, mark
         assert kb.count("ok(_)") == 2
     assert marker.exists()
     marker.unlink()
-    proc = run_neurosym("query", "--kb", path, "--trust", path, "--format", "csv", "ok(X)")
+    proc = run_neurosym("query", "--kb", path, "--trust", path, "--csv", "ok(X)")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "X\n1\n3\n"
     assert marker.exists()
@@ -317,7 +317,7 @@ def test_the_cli_refuses_a_foreign_qlf_and_trust_loads_it(
     assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
     assert "a .qlf is compiled code" in proc.stderr and f"--trust {qlf.name}" in proc.stderr
     assert not marker.exists()
-    proc = run_neurosym("query", "--kb", qlf, "--trust", qlf, "--format", "csv", "ok(X)")
+    proc = run_neurosym("query", "--kb", qlf, "--trust", qlf, "--csv", "ok(X)")
     assert proc.returncode == 0 and proc.stdout == "X\n666\n", proc.stderr
     assert marker.exists()
 

@@ -87,7 +87,7 @@ CASES = [
     ("predinet.png", "recording", ["predinet", "--episode", "1", "--step", "3"], (424, 232, 1)),
     ("rvectors.png", "predinet", ["rvectors", "--max-steps", "6"], (320, 296, 1)),
     ("relations.png", "recording", ["relations", "--threshold", "z:1"], (432, 216, 1)),
-    ("episode.png", "recording", ["episode", "--frames", "4", "--head", "1"], (332, 132, 1)),
+    ("episode.png", "recording", ["episode", "--panels", "4", "--head", "1"], (332, 132, 1)),
     ("episode.gif", "mhdpa", ["episode", "--max-steps", "5", "--fps", "8"], (320, 368, 6)),
 ]
 
@@ -173,8 +173,8 @@ def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> 
             "--episode 5 is not in the recording: it has episodes 0, 1",
         ),
         (
-            ["predinet", "--recording", "{recording}", "--episode-seed", "2"],
-            "--episode-seed goes with --checkpoint",
+            ["predinet", "--recording", "{recording}", "--seed", "2"],
+            "--seed goes with --checkpoint",
         ),
         (
             ["rvectors", "--recording", "{recording}", "--max-steps", "3"],

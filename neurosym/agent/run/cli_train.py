@@ -19,8 +19,8 @@ import ast
 import functools
 import os
 import shlex
-from dataclasses import Field, fields
-from typing import Any
+from dataclasses import Field, dataclass, fields
+from typing import Any, Literal
 
 from neurosym.agent.config import (
     A3CConfig,
@@ -35,6 +35,7 @@ from neurosym.agent.config import (
 from neurosym.agent.run.options import RunOptions
 from neurosym.cli import parse_env_options
 from neurosym.errors import ConfigError
+from neurosym.flags import EnvOptions, Out, Quiet, add_flags, option
 
 SETTINGS: tuple[tuple[str, type, str], ...] = (
     (
@@ -190,44 +191,36 @@ def set_names_help() -> str:
     return "\n".join(lines)
 
 
+@dataclass(kw_only=True)
+class TrainCommand(EnvOptions, Out, Quiet):
+    """``neurosym train``'s own flags (the settings' come from the config classes)."""
+
+    module: Literal["predinet", "mhdpa"] | None = None
+    """relational module (required unless --resume or --init-from)"""
+    resume: bool = False
+    """continue the run in --out from its checkpoint"""
+    init_from: str | None = option(None, metavar="CHECKPOINT")
+    """start a new run from this checkpoint's weights and model (a curriculum: e.g. a bw1 agent
+    on bw2); any env of its family with its observation shape; frames count afresh"""
+    algo: Literal["a3c", "ppo", "imitate"] | None = None
+    """learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or imitate
+    (DAgger from the env's optimal planner; RGW only)"""
+    preset: Literal["default", "thesis"] = option("default", shown="")
+    """settings to start from: default (what learns best here) or thesis (Table 4 exactly)"""
+    settings: list[str] = option(factory=list, flag="--set", metavar="NAME=VALUE")
+    """any other setting of neurosym/agent/config.py, e.g. --set attention_gain=32 (repeatable)"""
+    env: str | None = option(None, metavar="NAME", shown="")
+    """environment short name or id, e.g. rgw2 (required unless --resume)"""
+    env_option: list[str] = option(factory=list)
+    """keyword argument for the env, e.g. obs_mode=grey (repeatable)"""
+    out: str = option(metavar="DIR")
+    """run directory: checkpoint.pt and metrics.csv go here"""
+    quiet: bool = False
+    """no progress bar"""
+
+
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--env", help="environment short name or id, e.g. rgw2 (required unless --resume)"
-    )
-    parser.add_argument(
-        "--module", choices=("predinet", "mhdpa"),
-        help="relational module (required unless --resume or --init-from)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--out", required=True, help="run directory: checkpoint.pt and metrics.csv go here"
-    )
-    parser.add_argument(
-        "--resume", action="store_true", help="continue the run in --out from its checkpoint"
-    )
-    parser.add_argument(
-        "--init-from", metavar="CHECKPOINT",
-        help="start a new run from this checkpoint's weights and model (a curriculum: e.g. a bw1 "
-        "agent on bw2); any env of its family with its observation shape; frames count afresh",
-    )  # fmt: skip
-    parser.add_argument(
-        "--algo", choices=("a3c", "ppo", "imitate"),
-        help="learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or "
-        "imitate (DAgger from the env's optimal planner; RGW only)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--preset", choices=("default", "thesis"), default="default",
-        help="settings to start from: default (what learns best here) or thesis (Table 4 exactly)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--set", action="append", default=[], metavar="NAME=VALUE", dest="settings",
-        help="any other setting of neurosym/agent/config.py, e.g. --set attention_gain=32 "
-        "(repeatable)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--env-option", action="append", default=[], metavar="KEY=VALUE",
-        help="keyword argument for the env, e.g. obs_mode=grey (repeatable)",
-    )  # fmt: skip
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_flags(parser, TrainCommand)
     parser.epilog = set_names_help()
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     groups = {key: parser.add_argument_group(title) for key, title in GROUPS.items()}
