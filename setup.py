@@ -18,6 +18,8 @@ setup(
     package_data={
         "neurosym": ["setup_swipl.sh"],  # `neurosym setup-prolog` builds SWI-Prolog with it
         "neurosym.envs": ["maps/*.txt"],
+        "neurosym.induce": ["pl/*.pl"],  # the Prolog text learned files carry
+        "neurosym.play": ["pl/*.pl"],  # the Prolog half of neurosym play
         "neurosym.webreport": ["templates/*"],
         "neurosym.rules": ["*.pl"],
         "neurosym.checkpoints": ["*.pt"],

@@ -40,11 +40,18 @@
     Helpers start with route_pl_, so this file loads beside the other rule
     files and beside a learned strategy (whose own helpers start with route_).
 
-    The routes route/5 remembers live in module route (route:memo_/5, keyed
-    by the module that loaded this file), out of reach of the facts: a KB,
-    which holds facts for predicates without a module, cannot plant answers
-    there. The file itself is plain Prolog (no module header), so that it
-    loads into a KB module, into user, and beside other rule files alike.
+    route_moves/4,5 count moves instead, for the route features of a learned
+    strategy (`neurosym induce --what strategy`): a breadth-first search
+    that enters no object on the way but the sword, and no teleport jump.
+    One search from a cell answers for every object of the state: it runs
+    once per state and start cell, and its answers are remembered.
+
+    The routes route/5 and route_moves/5 remember live in module route
+    (route:memo_/5 and route:moves_/5, keyed by the module that loaded this
+    file), out of reach of the facts: a KB, which holds facts for
+    predicates without a module, cannot plant answers there. The file
+    itself is plain Prolog (no module header), so that it loads into a KB
+    module, into user, and beside other rule files alike.
 */
 
 :- use_module(library(heaps)).
@@ -99,15 +106,25 @@ route(E, T, Goal, Action, Cost) :-
 route_forget(E) :-
     context_module(M),
     route_pl_memo_ready_,
-    retractall(route:memo_(M, E, _, _, _)).
+    retractall(route:memo_(M, E, _, _, _)),
+    retractall(route:moves_(_, E, M, _, _)),
+    retractall(route:grid_(E, M, _, _, _)).
 
-%   The memo is declared when first used, not by a directive: a directive
-%   would tie it to this file, and unloading one copy of the file (a closed
-%   KB) would take the other copies' memo with it.
+%   The memos are declared when first used, not by a directive: a directive
+%   would tie them to this file, and unloading one copy of the file (a
+%   closed KB) would take the other copies' memos with them.
 route_pl_memo_ready_ :-
     (   current_predicate(route:memo_/5)
     ->  true
     ;   dynamic(route:memo_/5)
+    ),
+    (   current_predicate(route:moves_/5)
+    ->  true
+    ;   dynamic(route:moves_/5)
+    ),
+    (   current_predicate(route:grid_/5)
+    ->  true
+    ;   dynamic(route:grid_/5)
     ).
 
 route_pl_(E, T, Goal, Action, Cost) :-
@@ -157,6 +174,149 @@ safe_step(E, T, Action) :-
     Cell is R1 * Cols + C1,
     \+ get_assoc(Cell, Blocked, _),
     !.
+
+%!  route_moves(+E, +T, +Goal, -Moves) is det.
+%
+%   Moves on a shortest path from the agent to the cell of object Goal in
+%   state T of episode E that enters no object on the way but the sword (a
+%   contact-free approach: no enemy, pit, teleport end, terminal, key or lock
+%   is entered before Goal) and no wall; mountains count one move like any
+%   cell. 999 when there is no such path, or Goal or the agent is not on the
+%   map. The features of a learned strategy read it (route_length/4).
+%
+%       ?- route_moves(0, 0, sword, D).
+%       D = 4.
+
+route_moves(E, T, Goal, Moves) :-
+    (   at(E, T, agent, R, C)
+    ->  route_moves(E, T, R-C, Goal, Moves)
+    ;   Moves = 999
+    ).
+
+%!  route_moves(+E, +T, +From, +Goal, -Moves) is det.
+%
+%   As route_moves/4, from cell From (Row-Col) instead of the agent's cell
+%   (a teleport end's, say). One breadth-first search from From answers for
+%   every object of the state; it is remembered, keyed by the loading
+%   module, E, T and From, until route_forget/1.
+
+route_moves(E, T, From, Goal, Moves) :-
+    context_module(M),
+    (   ground(E-T-From)
+    ->  route_pl_memo_ready_,
+        (   route:moves_(T, E, M, From, Table)
+        ->  true
+        ;   route_pl_moves_(M, E, T, From, Table),
+            assertz(route:moves_(T, E, M, From, Table))
+        )
+    ;   route_pl_moves_(M, E, T, From, Table)
+    ),
+    (   get_assoc(Goal, Table, Moves0)
+    ->  Moves = Moves0
+    ;   Moves = 999
+    ).
+
+%   route_pl_moves_(+M, +E, +T, +From, -Table): assoc of each object on
+%   the map (its first at/5 fact) to its moves from From: one more than the
+%   nearest of its neighbours the search reached, else 999.
+route_pl_moves_(M, E, T, R0-C0, Table) :-
+    findall(Id-(R-C), at(E, T, Id, R, C), Objects),
+    (   route_pl_grid_(M, E, Rows, Cols, Adj),
+        route_pl_inside_(R0-C0, Rows, Cols)
+    ->  N is Rows * Cols,
+        functor(Cells, cells, N),
+        forall(( member(Id-(R-C), Objects), Id \== agent, \+ route_pl_passable_(Id),
+                 route_pl_inside_(R-C, Rows, Cols) ),
+               ( I is R * Cols + C + 1, nb_setarg(I, Cells, x) )),
+        S is R0 * Cols + C0 + 1,
+        nb_setarg(S, Cells, 0),
+        route_pl_bfs_([S], 0, Adj, Cells),
+        Search = search(Rows, Cols, Adj, Cells)
+    ;   Search = none
+    ),
+    empty_assoc(A0),
+    foldl(route_pl_moves_put_(Search), Objects, A0, Table).
+
+route_pl_moves_put_(Search, Id-(R-C), A0, A) :-
+    (   get_assoc(Id, A0, _)
+    ->  A = A0
+    ;   route_pl_moves_to_(Search, R, C, Moves),
+        put_assoc(Id, A0, Moves, A)
+    ).
+
+route_pl_moves_to_(search(Rows, Cols, Adj, Cells), R, C, Moves) :-
+    route_pl_inside_(R-C, Rows, Cols),
+    !,
+    I is R * Cols + C + 1,
+    arg(I, Adj, Neighbours),
+    foldl(route_pl_nearer_(Cells), Neighbours, 999, Near),
+    (   Near < 999 -> Moves is Near + 1 ; Moves = 999 ).
+route_pl_moves_to_(_, _, _, 999).
+
+route_pl_nearer_(Cells, I, D0, D) :-
+    arg(I, Cells, V),
+    (   integer(V), V < D0 -> D = V ; D = D0 ).
+
+%   Objects a contact-free path may cross: the sword (a type sword, or a
+%   compound of that name).
+route_pl_passable_(Id) :-
+    object(Id, Type),
+    (   compound(Type) -> functor(Type, sword, _) ; Type == sword ),
+    !.
+
+%   route_pl_grid_(+M, +E, -Rows, -Cols, -Adj): episode E's map as a term
+%   with one argument per cell (Row * Cols + Col + 1): the list of the
+%   cells a step from it enters, inside the grid and not a wall (terrain
+%   other than mountain). Built once per episode and remembered, keyed by
+%   the loading module and E, until route_forget/1.
+route_pl_grid_(M, E, Rows, Cols, Adj) :-
+    (   route:grid_(E, M, Rows0, Cols0, Adj0)
+    ->  Rows = Rows0, Cols = Cols0, Adj = Adj0
+    ;   grid(E, Rows, Cols),
+        !,
+        route_pl_adjacency_(E, Rows, Cols, Adj),
+        assertz(route:grid_(E, M, Rows, Cols, Adj))
+    ).
+
+route_pl_adjacency_(E, Rows, Cols, Adj) :-
+    N is Rows * Cols,
+    functor(Walls, walls, N),
+    forall(( terrain(E, Type, R, C), Type \== mountain, route_pl_inside_(R-C, Rows, Cols) ),
+           ( I is R * Cols + C + 1, nb_setarg(I, Walls, x) )),
+    functor(Adj, adj, N),
+    forall(between(1, N, I),
+           ( Cell is I - 1, R is Cell // Cols, C is Cell mod Cols,
+             findall(J, ( route_pl_move_(_, R-C, R1-C1),
+                          route_pl_inside_(R1-C1, Rows, Cols),
+                          J is R1 * Cols + C1 + 1,
+                          arg(J, Walls, W), var(W) ),
+                     Js),
+             nb_setarg(I, Adj, Js) )).
+
+%   route_pl_bfs_(+Frontier, +D, +Adj, !Cells): the cells D moves away are
+%   Frontier (argument indices); mark their unmarked neighbours D + 1, and
+%   go on. Cells: the moves to each cell reached, x for a blocked one.
+route_pl_bfs_([], _, _, _) :- !.
+route_pl_bfs_(Frontier, D, Adj, Cells) :-
+    D1 is D + 1,
+    route_pl_bfs_level_(Frontier, D1, Adj, Cells, Next, []),
+    route_pl_bfs_(Next, D1, Adj, Cells).
+
+route_pl_bfs_level_([], _, _, _, Next, Next).
+route_pl_bfs_level_([I|Is], D, Adj, Cells, Next0, Next) :-
+    arg(I, Adj, Neighbours),
+    route_pl_bfs_visit_(Neighbours, D, Cells, Next0, Next1),
+    route_pl_bfs_level_(Is, D, Adj, Cells, Next1, Next).
+
+route_pl_bfs_visit_([], _, _, Next, Next).
+route_pl_bfs_visit_([J|Js], D, Cells, Next0, Next) :-
+    arg(J, Cells, V),
+    (   var(V)
+    ->  nb_setarg(J, Cells, D),
+        Next0 = [J|Next1]
+    ;   Next0 = Next1
+    ),
+    route_pl_bfs_visit_(Js, D, Cells, Next1, Next).
 
 % --------------------------------------------------------------- helpers
 

@@ -121,8 +121,11 @@ def test_the_wheel_needs_no_prolog_to_install_and_says_in_one_line_what_to_run(
 
 def test_the_wheel_carries_the_rule_files_and_the_agents(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
-    rules = {n for n in names if n.endswith(".pl")}
+    rules = {n for n in names if n.startswith("neurosym/rules/") and n.endswith(".pl")}
     assert rules == {f"neurosym/rules/{p.name}" for p in (REPO / "rules").glob("*.pl")}
+    for part in ("induce", "play"):  # the Prolog text of induce's learned files, play's module
+        pl = {f"neurosym/{part}/pl/{p.name}" for p in (REPO / "neurosym" / part / "pl").glob("*.pl")}
+        assert pl and pl <= names
     agents = {n for n in names if n.endswith(".pt")}
     assert agents == {f"neurosym/checkpoints/{p.name}" for p in (REPO / "checkpoints").glob("*.pt")}
     assert "neurosym/envs/maps/rgw2.txt" in names

@@ -18,10 +18,12 @@
       r0   .  X  W  .  T
       r1   .  .  W  .  .
       r2   A  .  W  X  .
+    Episode 5 (RGW, 1 x 4): A S . T, the sword between the agent and the
+    terminal.
 */
 
 :- dynamic object/2, at/5, holding/3, terrain/4, grid/3.
-:- discontiguous at/5, holding/3, terrain/4.
+:- discontiguous at/5, holding/3, terrain/4, grid/3.
 
 object(sword, sword).
 object(enemy, enemy).
@@ -67,3 +69,8 @@ at(4, 0, agent, 2, 0).
 at(4, 0, teleport_1, 0, 1).
 at(4, 0, teleport_2, 2, 3).
 at(4, 0, terminal, 0, 4).
+
+grid(5, 1, 4).
+at(5, 0, agent, 0, 0).
+at(5, 0, sword, 0, 1).
+at(5, 0, terminal, 0, 3).

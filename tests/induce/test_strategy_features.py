@@ -17,7 +17,7 @@ def check_features_agree(kb: Path, strategy_file: Path, features: str) -> int:
     """Compare each feature on every labelled pair of ``kb``; return how many features were checked."""
     names, tab = table(load_trace(kb), features)
     pairs = list(zip(tab.pairs["E"], tab.pairs["T"], tab.pairs["O"], strict=True))
-    with KnowledgeBase(kb, rules=[strategy_file]) as prolog:
+    with KnowledgeBase(kb, rules=["route", strategy_file]) as prolog:
         for j, f in enumerate(names):
             if f.numeric:
                 rows = prolog.query(f"goal_candidate(E, T, O), {f.goal}")
