@@ -108,7 +108,8 @@ route_forget(E) :-
     route_pl_memo_ready_,
     retractall(route:memo_(M, E, _, _, _)),
     retractall(route:moves_(_, E, M, _, _)),
-    retractall(route:grid_(E, M, _, _, _)).
+    retractall(route:grid_(E, M, _, _, _, _)),
+    retractall(route:searched_(E, M, _, _, _, _)).
 
 %   The memos are declared when first used, not by a directive: a directive
 %   would tie them to this file, and unloading one copy of the file (a
@@ -122,9 +123,13 @@ route_pl_memo_ready_ :-
     ->  true
     ;   dynamic(route:moves_/5)
     ),
-    (   current_predicate(route:grid_/5)
+    (   current_predicate(route:grid_/6)
     ->  true
-    ;   dynamic(route:grid_/5)
+    ;   dynamic(route:grid_/6)
+    ),
+    (   current_predicate(route:searched_/6)
+    ->  true
+    ;   dynamic(route:searched_/6)
     ).
 
 route_pl_(E, T, Goal, Action, Cost) :-
@@ -135,8 +140,10 @@ route_pl_(E, T, Goal, Action, Cost) :-
     \+ object(Goal, pit),
     \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
     !,
+    context_module(M),
+    route_pl_memo_ready_,
     route_pl_mode_(Mode),
-    route_pl_map_(E, T, Goal, Mode, GR-GC, Map),
+    route_pl_map_(M, E, T, Goal, Mode, GR-GC, Map),
     route_pl_search_(R0-C0, Map, Action, Cost),
     !.
 
@@ -201,15 +208,13 @@ route_moves(E, T, Goal, Moves) :-
 %   module, E, T and From, until route_forget/1.
 
 route_moves(E, T, From, Goal, Moves) :-
+    must_be(ground, E-T-From),
     context_module(M),
-    (   ground(E-T-From)
-    ->  route_pl_memo_ready_,
-        (   route:moves_(T, E, M, From, Table)
-        ->  true
-        ;   route_pl_moves_(M, E, T, From, Table),
-            assertz(route:moves_(T, E, M, From, Table))
-        )
-    ;   route_pl_moves_(M, E, T, From, Table)
+    route_pl_memo_ready_,
+    (   route:moves_(T, E, M, From, Table)
+    ->  true
+    ;   route_pl_moves_(M, E, T, From, Table),
+        assertz(route:moves_(T, E, M, From, Table))
     ),
     (   get_assoc(Goal, Table, Moves0)
     ->  Moves = Moves0
@@ -221,21 +226,36 @@ route_moves(E, T, From, Goal, Moves) :-
 %   nearest of its neighbours the search reached, else 999.
 route_pl_moves_(M, E, T, R0-C0, Table) :-
     findall(Id-(R-C), at(E, T, Id, R, C), Objects),
-    (   route_pl_grid_(M, E, Rows, Cols, Adj),
+    (   route_pl_grid_(M, E, Rows, Cols, Adj, Cells0),
         route_pl_inside_(R0-C0, Rows, Cols)
-    ->  N is Rows * Cols,
-        functor(Cells, cells, N),
-        forall(( member(Id-(R-C), Objects), Id \== agent, \+ route_pl_passable_(Id),
-                 route_pl_inside_(R-C, Rows, Cols) ),
-               ( I is R * Cols + C + 1, nb_setarg(I, Cells, x) )),
-        S is R0 * Cols + C0 + 1,
-        nb_setarg(S, Cells, 0),
-        route_pl_bfs_([S], 0, Adj, Cells),
+    ->  S is R0 * Cols + C0 + 1,
+        findall(I, ( member(Id-(R-C), Objects), Id \== agent, \+ route_pl_passable_(Id),
+                     route_pl_inside_(R-C, Rows, Cols), I is R * Cols + C + 1 ),
+                Blocked0),
+        sort(Blocked0, Blocked),
+        route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells),
         Search = search(Rows, Cols, Adj, Cells)
     ;   Search = none
     ),
     empty_assoc(A0),
     foldl(route_pl_moves_put_(Search), Objects, A0, Table).
+
+%   route_pl_searched_(+M, +E, +Start, +Blocked, +Adj, +Cells0, -Cells): the
+%   search from cell Start (argument index) with the cells Blocked closed,
+%   Cells0 the episode's terrain. It depends on nothing else (the agent's
+%   cell is free), so it is remembered by episode, start and the blocked
+%   cells (a teleport end's search serves every state until an object
+%   moves or goes), until route_forget/1.
+route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells) :-
+    term_hash(Blocked, H),
+    (   route:searched_(E, M, S, H, Blocked, Cells1)
+    ->  Cells = Cells1
+    ;   forall(member(I, Blocked), nb_setarg(I, Cells0, x)),
+        nb_setarg(S, Cells0, 0),
+        route_pl_bfs_([S], 0, Adj, Cells0),
+        assertz(route:searched_(E, M, S, H, Blocked, Cells0)),
+        Cells = Cells0
+    ).
 
 route_pl_moves_put_(Search, Id-(R-C), A0, A) :-
     (   get_assoc(Id, A0, _)
@@ -264,38 +284,45 @@ route_pl_passable_(Id) :-
     (   compound(Type) -> functor(Type, sword, _) ; Type == sword ),
     !.
 
-%   route_pl_grid_(+M, +E, -Rows, -Cols, -Adj): episode E's map as a term
-%   with one argument per cell (Row * Cols + Col + 1): the list of the
-%   cells a step from it enters, inside the grid and not a wall (terrain
-%   other than mountain). Built once per episode and remembered, keyed by
-%   the loading module and E, until route_forget/1.
-route_pl_grid_(M, E, Rows, Cols, Adj) :-
-    (   route:grid_(E, M, Rows0, Cols0, Adj0)
-    ->  Rows = Rows0, Cols = Cols0, Adj = Adj0
+%   route_pl_grid_(+M, +E, -Rows, -Cols, -Adj, -Cells): episode E's map as
+%   two terms with one argument per cell (Row * Cols + Col + 1). Adj: the
+%   list of the cells a step from it enters inside the grid, in the order
+%   up, right, down, left. Cells: a fresh copy (the caller may change it)
+%   of the cells' terrain: mountain, wall (any other terrain), unbound for
+%   a free cell. Built once per episode and remembered, keyed by the
+%   loading module and E, until route_forget/1.
+route_pl_grid_(M, E, Rows, Cols, Adj, Cells) :-
+    (   route:grid_(E, M, Rows0, Cols0, Adj0, Cells0)
+    ->  Rows = Rows0, Cols = Cols0, Adj = Adj0, Cells = Cells0
     ;   grid(E, Rows, Cols),
         !,
-        route_pl_adjacency_(E, Rows, Cols, Adj),
-        assertz(route:grid_(E, M, Rows, Cols, Adj))
+        route_pl_terrain_(E, Rows, Cols, Cells),
+        route_pl_adjacency_(Rows, Cols, Adj),
+        assertz(route:grid_(E, M, Rows, Cols, Adj, Cells))
     ).
 
-route_pl_adjacency_(E, Rows, Cols, Adj) :-
+route_pl_terrain_(E, Rows, Cols, Cells) :-
     N is Rows * Cols,
-    functor(Walls, walls, N),
-    forall(( terrain(E, Type, R, C), Type \== mountain, route_pl_inside_(R-C, Rows, Cols) ),
-           ( I is R * Cols + C + 1, nb_setarg(I, Walls, x) )),
+    functor(Cells, cells, N),
+    forall(terrain(E, Type, R, C),
+           ( I is R * Cols + C + 1,
+             ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )).
+
+route_pl_adjacency_(Rows, Cols, Adj) :-
+    N is Rows * Cols,
     functor(Adj, adj, N),
     forall(between(1, N, I),
            ( Cell is I - 1, R is Cell // Cols, C is Cell mod Cols,
              findall(J, ( route_pl_move_(_, R-C, R1-C1),
                           route_pl_inside_(R1-C1, Rows, Cols),
-                          J is R1 * Cols + C1 + 1,
-                          arg(J, Walls, W), var(W) ),
+                          J is R1 * Cols + C1 + 1 ),
                      Js),
              nb_setarg(I, Adj, Js) )).
 
 %   route_pl_bfs_(+Frontier, +D, +Adj, !Cells): the cells D moves away are
-%   Frontier (argument indices); mark their unmarked neighbours D + 1, and
-%   go on. Cells: the moves to each cell reached, x for a blocked one.
+%   Frontier (argument indices); mark their free and mountain neighbours
+%   D + 1, and go on. Cells: the moves to each cell reached, wall or x for
+%   a blocked one.
 route_pl_bfs_([], _, _, _) :- !.
 route_pl_bfs_(Frontier, D, Adj, Cells) :-
     D1 is D + 1,
@@ -311,7 +338,7 @@ route_pl_bfs_level_([I|Is], D, Adj, Cells, Next0, Next) :-
 route_pl_bfs_visit_([], _, _, Next, Next).
 route_pl_bfs_visit_([J|Js], D, Cells, Next0, Next) :-
     arg(J, Cells, V),
-    (   var(V)
+    (   ( var(V) ; V == mountain )
     ->  nb_setarg(J, Cells, D),
         Next0 = [J|Next1]
     ;   Next0 = Next1
@@ -338,20 +365,17 @@ route_pl_inside_(R-C, Rows, Cols) :-
 route_pl_mode_(strict).
 route_pl_mode_(jumps).
 
-%   route_pl_map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs,
-%   as map(Rows, Cols, Cells, MountainCost, TargetCell). Cells is a term
-%   with one argument per cell (Row * Cols + Col + 1), so that a search looks
-%   a cell up with arg/3: unbound for a free cell, wall (walls, and objects
-%   a path may not enter), mountain, or jump(Landing) for a teleport end.
-route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target)) :-
-    grid(E, Rows, Cols),
+%   route_pl_map_(+M, +E, +T, +Goal, +Mode, +Target, -Map): what a search
+%   needs, as map(Rows, Cols, Cells, MountainCost, TargetCell, Adj). Cells
+%   is a term with one argument per cell (Row * Cols + Col + 1), so that a
+%   search looks a cell up with arg/3: unbound for a free cell, wall (walls,
+%   and objects a path may not enter), mountain, or jump(Landing) for a
+%   teleport end; it starts as a fresh copy of the episode's terrain
+%   (route_pl_grid_/6). Adj: each cell's neighbours inside the grid.
+route_pl_map_(M, E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target, Adj)) :-
+    route_pl_grid_(M, E, Rows, Cols, Adj, Cells),
     Mountain is 1 + Rows * Cols,
     Target is GR * Cols + GC,
-    N is Rows * Cols,
-    functor(Cells, cells, N),
-    forall(terrain(E, Type, R, C),
-           ( I is R * Cols + C + 1,
-             ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )),
     forall(( at(E, T, Id, R, C), Id \== agent, Id \== Goal, \+ route_pl_open_(E, T, Id) ),
            ( I is R * Cols + C + 1, nb_setarg(I, Cells, wall) )),
     route_pl_jumps_(E, T, Goal, Mode, Cols, Cells).
@@ -398,14 +422,14 @@ route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 %   target is always enterable. Done cells are marked in a term with one
 %   argument per cell.
 route_pl_search_(R0-C0, Map, Action, Cost) :-
-    Map = map(Rows, Cols, _, _, _),
+    Map = map(Rows, Cols, _, _, _, _),
     Start is R0 * Cols + C0,
     N is Rows * Cols,
     functor(Done, done, N),
     S1 is Start + 1,
     nb_setarg(S1, Done, x),
     empty_heap(Heap0),
-    route_pl_expand_(Start, none, 0, Map, Done, Heap0, Heap1),
+    route_pl_expand_start_(Start, Map, Done, Heap0, Heap1),
     route_pl_loop_(Heap1, Map, Done, Action, Cost).
 
 route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
@@ -422,19 +446,44 @@ route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
         route_pl_loop_(Heap2, Map, Done, Action, Cost)
     ).
 
-%   Neighbours in the order up, right, down, left; a path's first action is
-%   its first move (First is none at the start).
-route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
+%   From the start: each neighbour's move is the first action of the paths
+%   through it.
+route_pl_expand_start_(Cell, Map, Done, Heap0, Heap) :-
     arg(2, Map, Cols),
     R is Cell // Cols, C is Cell mod Cols,
     Up is R - 1, Down is R + 1, Left is C - 1, Right is C + 1,
-    route_pl_neighbour_(Up, C, up, First, D, Map, Done, Heap0, Heap1),
-    route_pl_neighbour_(R, Right, right, First, D, Map, Done, Heap1, Heap2),
-    route_pl_neighbour_(Down, C, down, First, D, Map, Done, Heap2, Heap3),
-    route_pl_neighbour_(R, Left, left, First, D, Map, Done, Heap3, Heap).
+    route_pl_neighbour_(Up, C, up, none, 0, Map, Done, Heap0, Heap1),
+    route_pl_neighbour_(R, Right, right, none, 0, Map, Done, Heap1, Heap2),
+    route_pl_neighbour_(Down, C, down, none, 0, Map, Done, Heap2, Heap3),
+    route_pl_neighbour_(R, Left, left, none, 0, Map, Done, Heap3, Heap).
+
+%   Past the start, a path keeps its first action: the neighbours come from
+%   the episode's adjacency (Adj), their order does not matter (a queue
+%   key holds cost and first action, so equal keys are equal paths).
+route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
+    arg(6, Map, Adj),
+    I is Cell + 1,
+    arg(I, Adj, Neighbours),
+    route_pl_move_index_(First, MI),
+    route_pl_adjacent_(Neighbours, First, MI, D, Map, Done, Heap0, Heap).
+
+route_pl_adjacent_([], _, _, _, _, _, Heap, Heap).
+route_pl_adjacent_([J|Js], First, MI, D, Map, Done, Heap0, Heap) :-
+    Map = map(_, _, Cells, Mountain, Target, _),
+    Cell0 is J - 1,
+    (   arg(J, Cells, Kind),
+        route_pl_enter_(Kind, Cell0, Target, Mountain, Cell, Step),
+        I is Cell + 1,
+        arg(I, Done, Seen),
+        var(Seen)
+    ->  Key is (D + Step) * 4 + MI,
+        add_to_heap(Heap0, Key, Cell-First, Heap1)
+    ;   Heap1 = Heap0
+    ),
+    route_pl_adjacent_(Js, First, MI, D, Map, Done, Heap1, Heap).
 
 route_pl_neighbour_(R, C, Move, First, D, Map, Done, Heap0, Heap) :-
-    Map = map(Rows, Cols, Cells, Mountain, Target),
+    Map = map(Rows, Cols, Cells, Mountain, Target, _),
     (   R >= 0, R < Rows, C >= 0, C < Cols,
         Cell0 is R * Cols + C,
         I0 is Cell0 + 1,

@@ -33,8 +33,8 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError, FactError
-from neurosym.induce.strategy_data import KINDS, Trace
 from neurosym.induce.prolog_text import pl_text
+from neurosym.induce.strategy_data import KINDS, Trace
 from neurosym.induce.strategy_route import UNREACHABLE, shortcuts, trace_routes
 from neurosym.terms import Term, TermArg, Var, atom_text, format_value, parse_term
 

@@ -32,7 +32,8 @@ State = tuple[int, int]
 
 @dataclass
 class Routes:
-    """Route lengths per state: from the agent, and from each teleport end's cell."""
+    """Route lengths per state: from the agent, and from each teleport end's cell (an object
+    a route does not reach is left out: :data:`UNREACHABLE`)."""
 
     direct: dict[tuple[int, int, str], int]
     """(E, T, O) -> moves from the agent to O"""

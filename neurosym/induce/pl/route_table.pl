@@ -19,8 +19,8 @@ assert_trace(Objects, Ats, Terrain, Grids) :-
 
 %!  trace_route(-E, -T, -From, -O, -D) is nondet.
 %   In each state (E, T) with the agent on the map, the route length D (route_moves/5)
-%   to each object O other than the agent, from the agent's cell (From = agent) and from
-%   each teleport end's cell (From = that end).
+%   to each object O other than the agent that a route reaches (D < 999), from the
+%   agent's cell (From = agent) and from each teleport end's cell (From = that end).
 trace_route(E, T, From, O, D) :-
     findall(E0-T0, at(E0, T0, agent, _, _), States0),
     sort(States0, States),
@@ -31,7 +31,8 @@ trace_route(E, T, From, O, D) :-
     ),
     at(E, T, O, _, _),
     O \== agent,
-    route_moves(E, T, Cell, O, D).
+    route_moves(E, T, Cell, O, D),
+    D < 999.
 
 teleport_end_(Id) :-
     object(Id, Type),
