@@ -36,7 +36,8 @@
     to the first action in the order up, right, down, left.
 
     Dijkstra's search over library(heaps); the map and the visited cells are
-    terms with one argument per cell, read with arg/3.
+    terms with one argument per cell, read with arg/3. Each episode's
+    terrain and cell neighbours are built once (route_pl_grid_/6).
     Helpers start with route_pl_, so this file loads beside the other rule
     files and beside a learned strategy (whose own helpers start with route_).
 
@@ -46,10 +47,11 @@
     One search from a cell answers for every object of the state: it runs
     once per state and start cell, and its answers are remembered.
 
-    The routes route/5 and route_moves/5 remember live in module route
-    (route:memo_/5 and route:moves_/5, keyed by the module that loaded this
-    file), out of reach of the facts: a KB, which holds facts for
-    predicates without a module, cannot plant answers there. The file
+    What route/5 and route_moves/5 remember (routes, move counts, searches,
+    each episode's map) lives in module route (route:memo_/5, moves_/5,
+    searched_/6, grid_/6, keyed by the module that loaded this file), out of
+    reach of the facts: a KB, which holds facts for predicates without a
+    module, cannot plant answers there. The file
     itself is plain Prolog (no module header), so that it loads into a KB
     module, into user, and beside other rule files alike.
 */
@@ -97,11 +99,11 @@ route(E, T, Goal, Action, Cost) :-
 
 %!  route_forget(+E) is det.
 %
-%   Forget the routes remembered for episode E. route/5 remembers its answer
-%   for each state and goal, since a state's facts do not change (in a KB,
-%   and in the live states of `neurosym play`, which calls this when an
-%   episode ends); call it after changing the facts of a state it was asked
-%   about.
+%   Forget what was remembered for episode E. route/5 remembers its answer
+%   for each state and goal, route_moves/5 its searches, both the episode's
+%   map, since a state's facts do not change (in a KB, and in the live
+%   states of `neurosym play`, which calls this when an episode ends); call
+%   it after changing the facts of an episode it was asked about.
 
 route_forget(E) :-
     context_module(M),
