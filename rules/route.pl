@@ -48,10 +48,10 @@
     once per state and start cell, and its answers are remembered.
 
     What route/5 and route_moves/5 remember (routes, move counts, searches,
-    each episode's map) lives in module route (route:memo_/5, moves_/5,
+    each episode's map) lives in module route_pl_cache (memo_/5, moves_/5,
     searched_/6, grid_/6, keyed by the module that loaded this file), out of
     reach of the facts: a KB, which holds facts for predicates without a
-    module, cannot plant answers there. The file
+    module (in its own module, or in user), cannot plant answers there. The file
     itself is plain Prolog (no module header), so that it loads into a KB
     module, into user, and beside other rule files alike.
 */
@@ -85,13 +85,13 @@ route(E, T, Goal, Action, Cost) :-
     !,
     context_module(M),
     route_pl_memo_ready_,
-    (   route:memo_(M, E, T, Goal, Found)
+    (   route_pl_cache:memo_(M, E, T, Goal, Found)
     ->  true
     ;   (   route_pl_(E, T, Goal, A, C)
         ->  Found = found(A, C)
         ;   Found = none
         ),
-        assertz(route:memo_(M, E, T, Goal, Found))
+        assertz(route_pl_cache:memo_(M, E, T, Goal, Found))
     ),
     Found = found(Action, Cost).
 route(E, T, Goal, Action, Cost) :-
@@ -108,30 +108,24 @@ route(E, T, Goal, Action, Cost) :-
 route_forget(E) :-
     context_module(M),
     route_pl_memo_ready_,
-    retractall(route:memo_(M, E, _, _, _)),
-    retractall(route:moves_(_, E, M, _, _)),
-    retractall(route:grid_(E, M, _, _, _, _)),
-    retractall(route:searched_(E, M, _, _, _, _)).
+    retractall(route_pl_cache:memo_(M, E, _, _, _)),
+    retractall(route_pl_cache:moves_(_, E, M, _, _)),
+    retractall(route_pl_cache:grid_(E, M, _, _, _, _)),
+    retractall(route_pl_cache:searched_(E, M, _, _, _, _)).
 
 %   The memos are declared when first used, not by a directive: a directive
 %   would tie them to this file, and unloading one copy of the file (a
-%   closed KB) would take the other copies' memos with them.
+%   closed KB) would take the other copies' memos with them. Their module
+%   inherits from system only, not from user: facts of the same names in
+%   user (a KB consulted in plain swipl) stay out of sight. The flag is a
+%   global variable (per thread), which no fact can set.
 route_pl_memo_ready_ :-
-    (   current_predicate(route:memo_/5)
+    (   nb_current(route_pl_memo_ready, true)
     ->  true
-    ;   dynamic(route:memo_/5)
-    ),
-    (   current_predicate(route:moves_/5)
-    ->  true
-    ;   dynamic(route:moves_/5)
-    ),
-    (   current_predicate(route:grid_/6)
-    ->  true
-    ;   dynamic(route:grid_/6)
-    ),
-    (   current_predicate(route:searched_/6)
-    ->  true
-    ;   dynamic(route:searched_/6)
+    ;   set_module(route_pl_cache:base(system)),
+        dynamic([ route_pl_cache:memo_/5, route_pl_cache:moves_/5,
+                  route_pl_cache:searched_/6, route_pl_cache:grid_/6 ]),
+        nb_setval(route_pl_memo_ready, true)
     ).
 
 route_pl_(E, T, Goal, Action, Cost) :-
@@ -213,10 +207,10 @@ route_moves(E, T, From, Goal, Moves) :-
     must_be(ground, E-T-From),
     context_module(M),
     route_pl_memo_ready_,
-    (   route:moves_(T, E, M, From, Table)
+    (   route_pl_cache:moves_(T, E, M, From, Table)
     ->  true
     ;   route_pl_moves_(M, E, T, From, Table),
-        assertz(route:moves_(T, E, M, From, Table))
+        assertz(route_pl_cache:moves_(T, E, M, From, Table))
     ),
     (   get_assoc(Goal, Table, Moves0)
     ->  Moves = Moves0
@@ -250,12 +244,12 @@ route_pl_moves_(M, E, T, R0-C0, Table) :-
 %   moves or goes), until route_forget/1.
 route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells) :-
     term_hash(Blocked, H),
-    (   route:searched_(E, M, S, H, Blocked, Cells1)
+    (   route_pl_cache:searched_(E, M, S, H, Blocked, Cells1)
     ->  Cells = Cells1
     ;   forall(member(I, Blocked), nb_setarg(I, Cells0, x)),
         nb_setarg(S, Cells0, 0),
         route_pl_bfs_([S], 0, Adj, Cells0),
-        assertz(route:searched_(E, M, S, H, Blocked, Cells0)),
+        assertz(route_pl_cache:searched_(E, M, S, H, Blocked, Cells0)),
         Cells = Cells0
     ).
 
@@ -294,13 +288,13 @@ route_pl_passable_(Id) :-
 %   a free cell. Built once per episode and remembered, keyed by the
 %   loading module and E, until route_forget/1.
 route_pl_grid_(M, E, Rows, Cols, Adj, Cells) :-
-    (   route:grid_(E, M, Rows0, Cols0, Adj0, Cells0)
+    (   route_pl_cache:grid_(E, M, Rows0, Cols0, Adj0, Cells0)
     ->  Rows = Rows0, Cols = Cols0, Adj = Adj0, Cells = Cells0
     ;   grid(E, Rows, Cols),
         !,
         route_pl_terrain_(E, Rows, Cols, Cells),
         route_pl_adjacency_(Rows, Cols, Adj),
-        assertz(route:grid_(E, M, Rows, Cols, Adj, Cells))
+        assertz(route_pl_cache:grid_(E, M, Rows, Cols, Adj, Cells))
     ).
 
 route_pl_terrain_(E, Rows, Cols, Cells) :-

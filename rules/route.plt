@@ -130,8 +130,9 @@ test(moves_remembered_until_forgotten,
     route_forget(5),
     route_moves(5, 0, terminal, D2).
 
-% The memos live in module route: facts named like them where the KB's
-% facts are (here user) do not change an answer.
+% The memos live in module route_pl_cache: facts named like them where the
+% KB's facts are (here user), asserted after the memos were first used, do
+% not change an answer (tests/route_facts.pl holds some from the start).
 test(kb_facts_cannot_reach_the_memos,
      [ true(Answers == [7, down-7, 4, down-8]),
        setup(( route_forget(0),
