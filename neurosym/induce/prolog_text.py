@@ -13,5 +13,5 @@ from importlib import resources
 @cache
 def pl_text(name: str) -> str:
     """The text of ``neurosym/induce/pl/NAME`` after its opening comment."""
-    text = resources.files("neurosym.induce").joinpath("pl", name).read_text(encoding="utf-8")
+    text = (resources.files("neurosym.induce") / "pl" / name).read_text(encoding="utf-8")
     return text.split("*/\n", 1)[1]

@@ -2,10 +2,13 @@
 
 Every feature is a literal over ``E, T, O`` (state and candidate) that the
 learned file can state: a binary one is a goal that holds or not, a numeric
-one a goal that binds ``V``. :data:`BACKGROUND` defines, in Prolog, every
-predicate these goals use; it is copied into each learned file, so the file
-needs nothing but the KB's facts. The Python side computes the same values
-(tests check that the two agree through SWI-Prolog).
+one a goal that binds ``V``. :data:`BACKGROUND` (neurosym/induce/pl/strategy_features.pl)
+and the route features' :data:`~neurosym.induce.strategy_route.PROLOG` define, in
+Prolog, every predicate these goals use; they are copied into each learned file,
+which needs the KB's facts and, for the route features, rules/route.pl (whose
+``route_moves/4`` gives the route lengths, here and when the file plays). The
+Python side computes the same values (tests check that the two agree through
+SWI-Prolog).
 
 Feature sets:
 

@@ -48,7 +48,7 @@ def trace_routes(trace: Trace) -> Routes:
     """Every state's route lengths, from rules/route.pl over the trace's facts (asserted in a KB of their own)."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
-    table = resources.files("neurosym.induce").joinpath("pl", "route_table.pl")
+    table = resources.files("neurosym.induce") / "pl" / "route_table.pl"
     with resources.as_file(table) as path, KnowledgeBase(None, rules=["route", path]) as kb:
         kb.query(
             "assert_trace(Objects, Ats, Terrain, Grids)",
