@@ -21,6 +21,8 @@ setup(
         "neurosym": ["setup_swipl.sh"],  # `neurosym setup-prolog` builds SWI-Prolog with it
         "neurosym.envs": ["maps/*.txt"],
         "neurosym.prolog": ["pl/*.pl"],  # the bridge's Prolog modules (not their .plt tests)
+        "neurosym.induce": ["pl/*.pl"],  # the Prolog text learned files carry
+        "neurosym.play": ["pl/*.pl"],  # the Prolog half of neurosym play
         "neurosym.webreport": ["templates/*"],
         "neurosym.rules": ["*.pl"],
         "neurosym.checkpoints": ["*.pt"],

@@ -13,7 +13,9 @@ Lines, in order:
   strategy's ``success_rate`` and ``fallback_steps``;
 * ``route`` : route/4 alone on a live rgw-random state, mean ms per call over
   ``--calls`` calls with route.pl's memory of routes cleared before each,
-  and the same remembered (the cost a strategy pays when it asks again).
+  and the same remembered (the cost a strategy pays when it asks again);
+  ``moves_fresh_ms`` and ``moves_remembered_ms`` the same for
+  route_moves/4 (the route length of a learned strategy's features).
 
     python bench/play.py                                    # the shipped examples
     python bench/play.py --policy strategy.pl --env rgw-random --episodes 300
@@ -85,13 +87,36 @@ def bench_route(calls: int) -> None:
         for _ in range(calls):
             agent.kb.query("route(0, 0, terminal, A)")
         remembered = (time.perf_counter() - start) / calls
+        moves = _timed(agent.kb, "route_moves(0, 0, terminal, D)", calls)
         venv.close()
     emit(
         what="route",
         fresh_ms=round(1000 * statistics.mean(fresh), 3),
         remembered_ms=round(1000 * remembered, 3),
+        **moves,
         calls=calls,
     )
+
+
+def _timed(kb: Any, goal: str, calls: int) -> dict[str, float]:
+    """Mean ms of ``goal`` with route.pl's memory of episode 0 cleared before each call, and
+    remembered (``{}`` where route.pl has no such predicate: an older checkout)."""
+    if not kb.query("current_predicate(route_moves/4)"):
+        return {}
+    fresh = []
+    for _ in range(calls):
+        kb.query("route_forget(0)")
+        start = time.perf_counter()
+        kb.query(goal)
+        fresh.append(time.perf_counter() - start)
+    start = time.perf_counter()
+    for _ in range(calls):
+        kb.query(goal)
+    remembered = (time.perf_counter() - start) / calls
+    return {
+        "moves_fresh_ms": round(1000 * statistics.mean(fresh), 3),
+        "moves_remembered_ms": round(1000 * remembered, 3),
+    }
 
 
 def main() -> None:

@@ -36,15 +36,24 @@
     to the first action in the order up, right, down, left.
 
     Dijkstra's search over library(heaps); the map and the visited cells are
-    terms with one argument per cell, read with arg/3.
+    terms with one argument per cell, read with arg/3. Each episode's
+    terrain and cell neighbours are built once (route_pl_grid_/6).
     Helpers start with route_pl_, so this file loads beside the other rule
     files and beside a learned strategy (whose own helpers start with route_).
 
-    The routes route/5 remembers live in module route (route:memo_/5, keyed
-    by the module that loaded this file), out of reach of the facts: a KB,
-    which holds facts for predicates without a module, cannot plant answers
-    there. The file itself is plain Prolog (no module header), so that it
-    loads into a KB module, into user, and beside other rule files alike.
+    route_moves/4,5 count moves instead, for the route features of a learned
+    strategy (`neurosym induce --what strategy`): a breadth-first search
+    that enters no object on the way but the sword, and no teleport jump.
+    One search from a cell answers for every object of the state: it runs
+    once per state and start cell, and its answers are remembered.
+
+    What route/5 and route_moves/5 remember (routes, move counts, searches,
+    each episode's map) lives in module route_pl_cache (memo_/5, moves_/5,
+    searched_/6, grid_/6, keyed by the module that loaded this file), out of
+    reach of the facts: a KB, which holds facts for predicates without a
+    module (in its own module, or in user), cannot plant answers there. The file
+    itself is plain Prolog (no module header), so that it loads into a KB
+    module, into user, and beside other rule files alike.
 */
 
 :- use_module(library(heaps)).
@@ -76,13 +85,13 @@ route(E, T, Goal, Action, Cost) :-
     !,
     context_module(M),
     route_pl_memo_ready_,
-    (   route:memo_(M, E, T, Goal, Found)
+    (   route_pl_cache:memo_(M, E, T, Goal, Found)
     ->  true
     ;   (   route_pl_(E, T, Goal, A, C)
         ->  Found = found(A, C)
         ;   Found = none
         ),
-        assertz(route:memo_(M, E, T, Goal, Found))
+        assertz(route_pl_cache:memo_(M, E, T, Goal, Found))
     ),
     Found = found(Action, Cost).
 route(E, T, Goal, Action, Cost) :-
@@ -90,24 +99,33 @@ route(E, T, Goal, Action, Cost) :-
 
 %!  route_forget(+E) is det.
 %
-%   Forget the routes remembered for episode E. route/5 remembers its answer
-%   for each state and goal, since a state's facts do not change (in a KB,
-%   and in the live states of `neurosym play`, which calls this when an
-%   episode ends); call it after changing the facts of a state it was asked
-%   about.
+%   Forget what was remembered for episode E. route/5 remembers its answer
+%   for each state and goal, route_moves/5 its searches, both the episode's
+%   map, since a state's facts do not change (in a KB, and in the live
+%   states of `neurosym play`, which calls this when an episode ends); call
+%   it after changing the facts of an episode it was asked about.
 
 route_forget(E) :-
     context_module(M),
     route_pl_memo_ready_,
-    retractall(route:memo_(M, E, _, _, _)).
+    retractall(route_pl_cache:memo_(M, E, _, _, _)),
+    retractall(route_pl_cache:moves_(_, E, M, _, _)),
+    retractall(route_pl_cache:grid_(E, M, _, _, _, _)),
+    retractall(route_pl_cache:searched_(E, M, _, _, _, _)).
 
-%   The memo is declared when first used, not by a directive: a directive
-%   would tie it to this file, and unloading one copy of the file (a closed
-%   KB) would take the other copies' memo with it.
+%   The memos are declared when first used, not by a directive: a directive
+%   would tie them to this file, and unloading one copy of the file (a
+%   closed KB) would take the other copies' memos with them. Their module
+%   inherits from system only, not from user: facts of the same names in
+%   user (a KB consulted in plain swipl) stay out of sight. The flag is a
+%   global variable (per thread), which no fact can set.
 route_pl_memo_ready_ :-
-    (   current_predicate(route:memo_/5)
+    (   nb_current(route_pl_memo_ready, true)
     ->  true
-    ;   dynamic(route:memo_/5)
+    ;   set_module(route_pl_cache:base(system)),
+        dynamic([ route_pl_cache:memo_/5, route_pl_cache:moves_/5,
+                  route_pl_cache:searched_/6, route_pl_cache:grid_/6 ]),
+        nb_setval(route_pl_memo_ready, true)
     ).
 
 route_pl_(E, T, Goal, Action, Cost) :-
@@ -118,8 +136,10 @@ route_pl_(E, T, Goal, Action, Cost) :-
     \+ object(Goal, pit),
     \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
     !,
+    context_module(M),
+    route_pl_memo_ready_,
     route_pl_mode_(Mode),
-    route_pl_map_(E, T, Goal, Mode, GR-GC, Map),
+    route_pl_map_(M, E, T, Goal, Mode, GR-GC, Map),
     route_pl_search_(R0-C0, Map, Action, Cost),
     !.
 
@@ -158,6 +178,169 @@ safe_step(E, T, Action) :-
     \+ get_assoc(Cell, Blocked, _),
     !.
 
+%!  route_moves(+E, +T, +Goal, -Moves) is det.
+%
+%   Moves on a shortest path from the agent to the cell of object Goal in
+%   state T of episode E that enters no object on the way but the sword (a
+%   contact-free approach: no enemy, pit, teleport end, terminal, key or lock
+%   is entered before Goal) and no wall; mountains count one move like any
+%   cell. 999 when there is no such path, or Goal or the agent is not on the
+%   map. The features of a learned strategy read it (route_length/4).
+%
+%       ?- route_moves(0, 0, sword, D).
+%       D = 4.
+
+route_moves(E, T, Goal, Moves) :-
+    (   at(E, T, agent, R, C)
+    ->  route_moves(E, T, R-C, Goal, Moves)
+    ;   Moves = 999
+    ).
+
+%!  route_moves(+E, +T, +From, +Goal, -Moves) is det.
+%
+%   As route_moves/4, from cell From (Row-Col) instead of the agent's cell
+%   (a teleport end's, say). One breadth-first search from From answers for
+%   every object of the state; it is remembered, keyed by the loading
+%   module, E, T and From, until route_forget/1.
+
+route_moves(E, T, From, Goal, Moves) :-
+    must_be(ground, E-T-From),
+    context_module(M),
+    route_pl_memo_ready_,
+    (   route_pl_cache:moves_(T, E, M, From, Table)
+    ->  true
+    ;   route_pl_moves_(M, E, T, From, Table),
+        assertz(route_pl_cache:moves_(T, E, M, From, Table))
+    ),
+    (   get_assoc(Goal, Table, Moves0)
+    ->  Moves = Moves0
+    ;   Moves = 999
+    ).
+
+%   route_pl_moves_(+M, +E, +T, +From, -Table): assoc of each object on
+%   the map (its first at/5 fact) to its moves from From: one more than the
+%   nearest of its neighbours the search reached, else 999.
+route_pl_moves_(M, E, T, R0-C0, Table) :-
+    findall(Id-(R-C), at(E, T, Id, R, C), Objects),
+    (   route_pl_grid_(M, E, Rows, Cols, Adj, Cells0),
+        route_pl_inside_(R0-C0, Rows, Cols)
+    ->  S is R0 * Cols + C0 + 1,
+        findall(I, ( member(Id-(R-C), Objects), Id \== agent, \+ route_pl_passable_(Id),
+                     route_pl_inside_(R-C, Rows, Cols), I is R * Cols + C + 1 ),
+                Blocked0),
+        sort(Blocked0, Blocked),
+        route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells),
+        Search = search(Rows, Cols, Adj, Cells)
+    ;   Search = none
+    ),
+    empty_assoc(A0),
+    foldl(route_pl_moves_put_(Search), Objects, A0, Table).
+
+%   route_pl_searched_(+M, +E, +Start, +Blocked, +Adj, +Cells0, -Cells): the
+%   search from cell Start (argument index) with the cells Blocked closed,
+%   Cells0 the episode's terrain. It depends on nothing else (the agent's
+%   cell is free), so it is remembered by episode, start and the blocked
+%   cells (a teleport end's search serves every state until an object
+%   moves or goes), until route_forget/1.
+route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells) :-
+    term_hash(Blocked, H),
+    (   route_pl_cache:searched_(E, M, S, H, Blocked, Cells1)
+    ->  Cells = Cells1
+    ;   forall(member(I, Blocked), nb_setarg(I, Cells0, x)),
+        nb_setarg(S, Cells0, 0),
+        route_pl_bfs_([S], 0, Adj, Cells0),
+        assertz(route_pl_cache:searched_(E, M, S, H, Blocked, Cells0)),
+        Cells = Cells0
+    ).
+
+route_pl_moves_put_(Search, Id-(R-C), A0, A) :-
+    (   get_assoc(Id, A0, _)
+    ->  A = A0
+    ;   route_pl_moves_to_(Search, R, C, Moves),
+        put_assoc(Id, A0, Moves, A)
+    ).
+
+route_pl_moves_to_(search(Rows, Cols, Adj, Cells), R, C, Moves) :-
+    route_pl_inside_(R-C, Rows, Cols),
+    !,
+    I is R * Cols + C + 1,
+    arg(I, Adj, Neighbours),
+    foldl(route_pl_nearer_(Cells), Neighbours, 999, Near),
+    (   Near < 999 -> Moves is Near + 1 ; Moves = 999 ).
+route_pl_moves_to_(_, _, _, 999).
+
+route_pl_nearer_(Cells, I, D0, D) :-
+    arg(I, Cells, V),
+    (   integer(V), V < D0 -> D = V ; D = D0 ).
+
+%   Objects a contact-free path may cross: the sword (a type sword, or a
+%   compound of that name).
+route_pl_passable_(Id) :-
+    object(Id, Type),
+    (   compound(Type) -> functor(Type, sword, _) ; Type == sword ),
+    !.
+
+%   route_pl_grid_(+M, +E, -Rows, -Cols, -Adj, -Cells): episode E's map as
+%   two terms with one argument per cell (Row * Cols + Col + 1). Adj: the
+%   list of the cells a step from it enters inside the grid, in the order
+%   up, right, down, left. Cells: a fresh copy (the caller may change it)
+%   of the cells' terrain: mountain, wall (any other terrain), unbound for
+%   a free cell. Built once per episode and remembered, keyed by the
+%   loading module and E, until route_forget/1.
+route_pl_grid_(M, E, Rows, Cols, Adj, Cells) :-
+    (   route_pl_cache:grid_(E, M, Rows0, Cols0, Adj0, Cells0)
+    ->  Rows = Rows0, Cols = Cols0, Adj = Adj0, Cells = Cells0
+    ;   grid(E, Rows, Cols),
+        !,
+        route_pl_terrain_(E, Rows, Cols, Cells),
+        route_pl_adjacency_(Rows, Cols, Adj),
+        assertz(route_pl_cache:grid_(E, M, Rows, Cols, Adj, Cells))
+    ).
+
+route_pl_terrain_(E, Rows, Cols, Cells) :-
+    N is Rows * Cols,
+    functor(Cells, cells, N),
+    forall(terrain(E, Type, R, C),
+           ( I is R * Cols + C + 1,
+             ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )).
+
+route_pl_adjacency_(Rows, Cols, Adj) :-
+    N is Rows * Cols,
+    functor(Adj, adj, N),
+    forall(between(1, N, I),
+           ( Cell is I - 1, R is Cell // Cols, C is Cell mod Cols,
+             findall(J, ( route_pl_move_(_, R-C, R1-C1),
+                          route_pl_inside_(R1-C1, Rows, Cols),
+                          J is R1 * Cols + C1 + 1 ),
+                     Js),
+             nb_setarg(I, Adj, Js) )).
+
+%   route_pl_bfs_(+Frontier, +D, +Adj, !Cells): the cells D moves away are
+%   Frontier (argument indices); mark their free and mountain neighbours
+%   D + 1, and go on. Cells: the moves to each cell reached, wall or x for
+%   a blocked one.
+route_pl_bfs_([], _, _, _) :- !.
+route_pl_bfs_(Frontier, D, Adj, Cells) :-
+    D1 is D + 1,
+    route_pl_bfs_level_(Frontier, D1, Adj, Cells, Next, []),
+    route_pl_bfs_(Next, D1, Adj, Cells).
+
+route_pl_bfs_level_([], _, _, _, Next, Next).
+route_pl_bfs_level_([I|Is], D, Adj, Cells, Next0, Next) :-
+    arg(I, Adj, Neighbours),
+    route_pl_bfs_visit_(Neighbours, D, Cells, Next0, Next1),
+    route_pl_bfs_level_(Is, D, Adj, Cells, Next1, Next).
+
+route_pl_bfs_visit_([], _, _, Next, Next).
+route_pl_bfs_visit_([J|Js], D, Cells, Next0, Next) :-
+    arg(J, Cells, V),
+    (   ( var(V) ; V == mountain )
+    ->  nb_setarg(J, Cells, D),
+        Next0 = [J|Next1]
+    ;   Next0 = Next1
+    ),
+    route_pl_bfs_visit_(Js, D, Cells, Next1, Next).
+
 % --------------------------------------------------------------- helpers
 
 route_pl_move_(up,    R-C, R1-C) :- R1 is R - 1.
@@ -178,20 +361,17 @@ route_pl_inside_(R-C, Rows, Cols) :-
 route_pl_mode_(strict).
 route_pl_mode_(jumps).
 
-%   route_pl_map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs,
-%   as map(Rows, Cols, Cells, MountainCost, TargetCell). Cells is a term
-%   with one argument per cell (Row * Cols + Col + 1), so that a search looks
-%   a cell up with arg/3: unbound for a free cell, wall (walls, and objects
-%   a path may not enter), mountain, or jump(Landing) for a teleport end.
-route_pl_map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target)) :-
-    grid(E, Rows, Cols),
+%   route_pl_map_(+M, +E, +T, +Goal, +Mode, +Target, -Map): what a search
+%   needs, as map(Rows, Cols, Cells, MountainCost, TargetCell, Adj). Cells
+%   is a term with one argument per cell (Row * Cols + Col + 1), so that a
+%   search looks a cell up with arg/3: unbound for a free cell, wall (walls,
+%   and objects a path may not enter), mountain, or jump(Landing) for a
+%   teleport end; it starts as a fresh copy of the episode's terrain
+%   (route_pl_grid_/6). Adj: each cell's neighbours inside the grid.
+route_pl_map_(M, E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target, Adj)) :-
+    route_pl_grid_(M, E, Rows, Cols, Adj, Cells),
     Mountain is 1 + Rows * Cols,
     Target is GR * Cols + GC,
-    N is Rows * Cols,
-    functor(Cells, cells, N),
-    forall(terrain(E, Type, R, C),
-           ( I is R * Cols + C + 1,
-             ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )),
     forall(( at(E, T, Id, R, C), Id \== agent, Id \== Goal, \+ route_pl_open_(E, T, Id) ),
            ( I is R * Cols + C + 1, nb_setarg(I, Cells, wall) )),
     route_pl_jumps_(E, T, Goal, Mode, Cols, Cells).
@@ -238,14 +418,14 @@ route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 %   target is always enterable. Done cells are marked in a term with one
 %   argument per cell.
 route_pl_search_(R0-C0, Map, Action, Cost) :-
-    Map = map(Rows, Cols, _, _, _),
+    Map = map(Rows, Cols, _, _, _, _),
     Start is R0 * Cols + C0,
     N is Rows * Cols,
     functor(Done, done, N),
     S1 is Start + 1,
     nb_setarg(S1, Done, x),
     empty_heap(Heap0),
-    route_pl_expand_(Start, none, 0, Map, Done, Heap0, Heap1),
+    route_pl_expand_start_(Start, Map, Done, Heap0, Heap1),
     route_pl_loop_(Heap1, Map, Done, Action, Cost).
 
 route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
@@ -262,19 +442,44 @@ route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
         route_pl_loop_(Heap2, Map, Done, Action, Cost)
     ).
 
-%   Neighbours in the order up, right, down, left; a path's first action is
-%   its first move (First is none at the start).
-route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
+%   From the start: each neighbour's move is the first action of the paths
+%   through it.
+route_pl_expand_start_(Cell, Map, Done, Heap0, Heap) :-
     arg(2, Map, Cols),
     R is Cell // Cols, C is Cell mod Cols,
     Up is R - 1, Down is R + 1, Left is C - 1, Right is C + 1,
-    route_pl_neighbour_(Up, C, up, First, D, Map, Done, Heap0, Heap1),
-    route_pl_neighbour_(R, Right, right, First, D, Map, Done, Heap1, Heap2),
-    route_pl_neighbour_(Down, C, down, First, D, Map, Done, Heap2, Heap3),
-    route_pl_neighbour_(R, Left, left, First, D, Map, Done, Heap3, Heap).
+    route_pl_neighbour_(Up, C, up, none, 0, Map, Done, Heap0, Heap1),
+    route_pl_neighbour_(R, Right, right, none, 0, Map, Done, Heap1, Heap2),
+    route_pl_neighbour_(Down, C, down, none, 0, Map, Done, Heap2, Heap3),
+    route_pl_neighbour_(R, Left, left, none, 0, Map, Done, Heap3, Heap).
+
+%   Past the start, a path keeps its first action: the neighbours come from
+%   the episode's adjacency (Adj), their order does not matter (a queue
+%   key holds cost and first action, so equal keys are equal paths).
+route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
+    arg(6, Map, Adj),
+    I is Cell + 1,
+    arg(I, Adj, Neighbours),
+    route_pl_move_index_(First, MI),
+    route_pl_adjacent_(Neighbours, First, MI, D, Map, Done, Heap0, Heap).
+
+route_pl_adjacent_([], _, _, _, _, _, Heap, Heap).
+route_pl_adjacent_([J|Js], First, MI, D, Map, Done, Heap0, Heap) :-
+    Map = map(_, _, Cells, Mountain, Target, _),
+    Cell0 is J - 1,
+    (   arg(J, Cells, Kind),
+        route_pl_enter_(Kind, Cell0, Target, Mountain, Cell, Step),
+        I is Cell + 1,
+        arg(I, Done, Seen),
+        var(Seen)
+    ->  Key is (D + Step) * 4 + MI,
+        add_to_heap(Heap0, Key, Cell-First, Heap1)
+    ;   Heap1 = Heap0
+    ),
+    route_pl_adjacent_(Js, First, MI, D, Map, Done, Heap1, Heap).
 
 route_pl_neighbour_(R, C, Move, First, D, Map, Done, Heap0, Heap) :-
-    Map = map(Rows, Cols, Cells, Mountain, Target),
+    Map = map(Rows, Cols, Cells, Mountain, Target, _),
     (   R >= 0, R < Rows, C >= 0, C < Cols,
         Cell0 is R * Cols + C,
         I0 is Cell0 + 1,

@@ -90,4 +90,63 @@ test(default_goal_boxworld_lock, G == lock_red) :-
 test(default_goal_boxworld_key, G == key_blue) :-
     default_goal(3, 0, G).
 
+% route_moves/4,5: moves of a contact-free path; a mountain is one move.
+test(moves_over_the_mountain, D == 4) :-
+    route_moves(0, 0, sword, D).
+
+test(moves_past_pit_and_teleport, D == 7) :-
+    route_moves(0, 0, terminal, D).
+
+% The sword's cell may be crossed; route/4 takes the sword as an object.
+test(moves_cross_the_sword, D == 3) :-
+    route_moves(5, 0, terminal, D).
+
+% An enemy blocks a contact-free path, even when the agent holds the sword.
+test(moves_blocked_by_the_enemy, D-D1 == 999-999) :-
+    route_moves(2, 0, terminal, D),
+    route_moves(2, 1, terminal, D1).
+
+test(moves_boxworld_around_the_key, D == 6) :-
+    route_moves(3, 1, lock_red, D).
+
+% The wall column closes the terminal off: no teleport jump in a count.
+test(moves_unreachable, D == 999) :-
+    route_moves(4, 0, terminal, D).
+
+test(moves_not_on_the_map, D == 999) :-
+    route_moves(0, 0, enemy, D).
+
+test(moves_from_a_teleport_end, D == 3) :-
+    route_moves(4, 0, 2-3, terminal, D).
+
+% One search per state and start cell is remembered until route_forget/1:
+% a wall added later is seen only after it.
+test(moves_remembered_until_forgotten,
+     [ true(D0-D1-D2 == 3-3-999),
+       cleanup(( retractall(user:terrain(5, wall, 0, 2)), route_forget(5) ))]) :-
+    route_moves(5, 0, terminal, D0),
+    assertz(user:terrain(5, wall, 0, 2)),
+    route_moves(5, 0, terminal, D1),
+    route_forget(5),
+    route_moves(5, 0, terminal, D2).
+
+% The memos live in module route_pl_cache: facts named like them where the
+% KB's facts are (here user), asserted after the memos were first used, do
+% not change an answer (tests/route_facts.pl holds some from the start).
+test(kb_facts_cannot_reach_the_memos,
+     [ true(Answers == [7, down-7, 4, down-8]),
+       setup(( route_forget(0),
+              assertz(user:moves_(0, 0, user, 0-0, t(terminal-1, sword-1))),
+              assertz(user:moves_(0, 0, user, 0-0, _)),
+              assertz(user:memo_(user, 0, 0, terminal, found(up, 1))),
+              assertz(user:memo_(user, 0, 0, sword, none)) )),
+      cleanup(( retractall(user:moves_(_, _, _, _, _)),
+                retractall(user:memo_(_, _, _, _, _)),
+                route_forget(0) ))]) :-
+    route_moves(0, 0, terminal, D1),
+    route(0, 0, terminal, A1, C1),
+    route_moves(0, 0, sword, D2),
+    route(0, 0, sword, A2, C2),
+    Answers = [D1, A1-C1, D2, A2-C2].
+
 :- end_tests(route).

@@ -124,8 +124,8 @@ def test_the_wheel_carries_the_rule_files_and_the_agents(wheel: Path) -> None:
     rules = {n for n in names if n.endswith(".pl") and n.startswith("neurosym/rules/")}
     assert rules == {f"neurosym/rules/{p.name}" for p in (REPO / "rules").glob("*.pl")}
     modules = {n for n in names if n.endswith(".pl") and not n.startswith("neurosym/rules/")}
-    assert modules == {  # the bridge's Prolog modules (their .plt files stay behind, see below)
-        f"neurosym/prolog/pl/{p.name}" for p in (REPO / "neurosym/prolog/pl").glob("*.pl")
+    assert modules == {  # the package's Prolog modules (their .plt files stay behind, see below)
+        f"neurosym/{p.relative_to(REPO / 'neurosym')}" for p in (REPO / "neurosym").glob("*/pl/*.pl")
     }
     agents = {n for n in names if n.endswith(".pt")}
     assert agents == {f"neurosym/checkpoints/{p.name}" for p in (REPO / "checkpoints").glob("*.pt")}

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from pathlib import Path
 
 from neurosym.display import plain
 from neurosym.errors import OutputError
@@ -24,71 +25,11 @@ from neurosym.terms import Term
 
 MODULE = "neurosym_readback"
 
-SOURCE = r"""
-:- module(neurosym_readback, [readback/4]).
+FILE = Path(__file__).with_name("pl") / "neurosym_readback.pl"
+"""The module's source, shipped as package data."""
 
-%   readback(+Text, +Kinds, +Texts, -Result): read Text term by term and compare it with
-%   the terms of the parts (Kinds: code, every term of the text; term: exactly one term).
-%   Result: "" when they are the same, else a string saying where they differ.
-readback(Text, Kinds, Texts, Result) :-
-    catch(readback_(Text, Kinds, Texts, Result), E, error_text_(E, Result)).
-
-readback_(Text, Kinds, Texts, Result) :-
-    terms_of_(Text, Got),
-    parts_(Kinds, Texts, Wants),
-    append(Wants, Want),
-    compare_(Got, Want, 1, Result).
-
-error_text_(error(format(F, A), _), Result) :- !,
-    format(string(Result), F, A).
-error_text_(error(syntax_error(What), stream(_, Line, _, _)), Result) :- !,
-    format(string(Result), 'syntax error: ~w on line ~d', [What, Line]).
-error_text_(E, Result) :-
-    format(string(Result), '~q', [E]).
-
-parts_([], [], []).
-parts_([K|Ks], [T|Ts], [Terms|Rest]) :-
-    atom_string(Kind, K),
-    part_(Kind, T, Terms),
-    parts_(Ks, Ts, Rest).
-
-part_(code, Text, Terms) :- terms_of_(Text, Terms).
-part_(term, Text, [Term]) :-
-    (   terms_of_(Text, [Term0]) -> Term = Term0 ; throw(error(format('not one term: ~s', [Text]), _)) ).
-
-terms_of_(Text, Terms) :-
-    setup_call_cleanup(open_string(Text, S), read_all_(S, Terms), close(S)).
-
-read_all_(S, Terms) :-
-    read_term(S, T, [ variable_names(Vs), quasi_quotations(QQ), syntax_errors(error),
-                      module(neurosym_readback) ]),
-    (   QQ \== []
-    ->  throw(error(format('a quasi-quotation', []), _))
-    ;   T == end_of_file
-    ->  Terms = []
-    ;   name_vars_(Vs),
-        Terms = [T|Rest],
-        read_all_(S, Rest)
-    ).
-
-name_vars_([]).
-name_vars_([Name=Var|Vs]) :- Var = '$VAR'(Name), name_vars_(Vs).
-
-compare_([], [], _, "") :- !.
-compare_([G|_], [], I, Result) :- !,
-    text_(G, GT), format(string(Result), 'term ~d, ~s, is not one of them', [I, GT]).
-compare_([], [W|_], I, Result) :- !,
-    text_(W, WT), format(string(Result), 'term ~d, ~s, is missing', [I, WT]).
-compare_([G|Gs], [W|Ws], I, Result) :-
-    (   G =@= W
-    ->  I1 is I + 1, compare_(Gs, Ws, I1, Result)
-    ;   text_(G, GT), text_(W, WT),
-        format(string(Result), 'term ~d reads as ~s, not ~s', [I, GT, WT])
-    ).
-
-text_(T, Text) :-
-    format(string(Text), '~W', [T, [quoted(true), numbervars(true), ignore_ops(true)]]).
-"""
+SOURCE = FILE.read_text(encoding="utf-8")
+"""Its text, for a janus_with that consults text (one that reads ``FILE`` needs only that)."""
 
 
 def comment(text: str) -> str:
@@ -132,7 +73,7 @@ def check_reads_back(text: str, parts: list[Part], path: str | os.PathLike[str])
 
 
 def _module():  # type: ignore[no-untyped-def]
-    """This module as janus_with's embedded Prolog module (its MODULE and SOURCE)."""
+    """This module as janus_with's embedded Prolog module (its MODULE, FILE and SOURCE)."""
     import sys
 
     return sys.modules[__name__]

@@ -2,10 +2,13 @@
 
 Every feature is a literal over ``E, T, O`` (state and candidate) that the
 learned file can state: a binary one is a goal that holds or not, a numeric
-one a goal that binds ``V``. :data:`BACKGROUND` defines, in Prolog, every
-predicate these goals use; it is copied into each learned file, so the file
-needs nothing but the KB's facts. The Python side computes the same values
-(tests check that the two agree through SWI-Prolog).
+one a goal that binds ``V``. :data:`BACKGROUND` (neurosym/induce/pl/strategy_features.pl)
+and the route features' :data:`~neurosym.induce.strategy_route.PROLOG` define, in
+Prolog, every predicate these goals use; they are copied into each learned file,
+which needs the KB's facts and, for the route features, rules/route.pl (whose
+``route_moves/4`` gives the route lengths, here and when the file plays). The
+Python side computes the same values (tests check that the two agree through
+SWI-Prolog).
 
 Feature sets:
 
@@ -33,14 +36,9 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError, FactError
+from neurosym.induce.prolog_text import pl_text
 from neurosym.induce.strategy_data import KINDS, Trace
-from neurosym.induce.strategy_route import (
-    PASSABLE_KINDS,
-    PASSABLE_TERRAIN,
-    UNREACHABLE,
-    route_lengths,
-    shortcuts,
-)
+from neurosym.induce.strategy_route import UNREACHABLE, shortcuts, trace_routes
 from neurosym.terms import Term, TermArg, Var, atom_text, format_value, parse_term
 
 FEATURE_SETS = ("world", "relations", "both")
@@ -85,100 +83,8 @@ def _kv(kind: str) -> TermArg:
         ) from None
 
 
-BACKGROUND = r"""
-%!  goal_candidate(?E, ?T, -O) is nondet.
-%   The objects on the map in state T (at/5, not the agent), in the standard order of their ids.
-goal_candidate(E, T, O) :-
-    setof(O1, R^C^(at(E, T, O1, R, C), O1 \== agent), Os),
-    member(O, Os).
-
-%!  object_kind(?O, ?Kind) is nondet.
-%   The kind of object O: its type, or the type's functor (key, lock) for key(C), lock(C).
-object_kind(O, K) :- object(O, Ty), ( compound(Ty) -> functor(Ty, K, _) ; K = Ty ).
-
-%!  object_colour(?O, ?C) is nondet.
-object_colour(O, C) :- object(O, Ty), compound(Ty), arg(1, Ty, C).
-
-%!  holding_kind(+E, +T, ?Kind) is nondet.
-holding_kind(E, T, K) :- holding(E, T, I), ( compound(I) -> functor(I, K, _) ; K = I ).
-
-%!  on_map(+E, +T, ?Kind) is semidet.
-%   An object of this kind is on the map in state T.
-on_map(E, T, K) :- once((goal_candidate(E, T, O), object_kind(O, K))).
-
-%!  agent_distance(+E, +T, +O, -D) is semidet.
-%   Manhattan distance from the agent to object O in state T.
-agent_distance(E, T, O, D) :-
-    at(E, T, agent, R0, C0), at(E, T, O, R, C), !,
-    D is abs(R - R0) + abs(C - C0).
-
-%!  nearest_of_kind(+E, +T, +O) is semidet.
-%   No object of O's kind is strictly nearer to the agent.
-nearest_of_kind(E, T, O) :-
-    object_kind(O, K), agent_distance(E, T, O, D),
-    \+ ( goal_candidate(E, T, O2), O2 \== O, object_kind(O2, K),
-         agent_distance(E, T, O2, D2), D2 < D ).
-
-%!  nearest_object(+E, +T, +O) is semidet.
-%   No object is strictly nearer to the agent.
-nearest_object(E, T, O) :-
-    agent_distance(E, T, O, D),
-    \+ ( goal_candidate(E, T, O2), O2 \== O, agent_distance(E, T, O2, D2), D2 < D ).
-
-%!  lock_of_held_key(+E, +T, +O) is semidet.
-%   Box-World: O is a lock of the colour of the key the agent holds.
-lock_of_held_key(E, T, O) :-
-    object_kind(O, lock), object_colour(O, C), holding(E, T, key(C)), !.
-
-%!  key_fits_lock(+E, +T, +O) is semidet.
-%   Box-World: O is a key and a lock of its colour is on the map.
-key_fits_lock(E, T, O) :-
-    object_kind(O, key), object_colour(O, C),
-    once(( goal_candidate(E, T, L), object(L, lock(C)) )).
-
-%!  loose(+E, +T, +O) is semidet.
-%   Box-World: O is a key with no lock to its right (not a box's content).
-loose(E, T, O) :-
-    object_kind(O, key), at(E, T, O, R, C), !, C1 is C + 1,
-    \+ ( at(E, T, L, R, C1), object_kind(L, lock) ).
-
-%!  box_content(+E, +T, +Lock, -Content) is semidet.
-%   Box-World: the object in the cell left of the lock.
-box_content(E, T, L, X) :-
-    object_kind(L, lock), at(E, T, L, R, C), !, C0 is C - 1,
-    at(E, T, X, R, C0), X \== agent, !.
-
-%!  box_holds_gem(+E, +T, +O) is semidet.
-box_holds_gem(E, T, O) :- box_content(E, T, O, X), object_kind(X, gem).
-
-%!  box_holds_useful_key(+E, +T, +O) is semidet.
-%   Box-World: O's box holds a key of a colour some other lock on the map takes.
-box_holds_useful_key(E, T, O) :-
-    box_content(E, T, O, X), object_kind(X, key), object_colour(X, C),
-    once(( goal_candidate(E, T, L), L \== O, object(L, lock(C)) )).
-
-%!  attended_by(+E, +T, ?H, ?Arg, +O) is nondet.
-%   PrediNet: head H's argument Arg attends the cell of object O (the cell mapped through at/5).
-attended_by(E, T, H, A, O) :- at(E, T, O, R, C), attends(E, T, H, A, _, R, C, _).
-
-%!  related(+E, +T, ?J, ?Pos, +O) is nondet.
-%   PrediNet: relation J holds with O's entity (its object/2 type) as argument Pos (1 or 2).
-related(E, T, J, 1, O) :- object(O, Ty), holds(E, T, r(J), Ty, _).
-related(E, T, J, 2, O) :- object(O, Ty), holds(E, T, r(J), _, Ty).
-
-%!  agent_query_attends(+E, +T, ?H, +O) is nondet.
-%   MHDPA: head H's query from the agent's cell attends O's entity (its object/2 type).
-agent_query_attends(E, T, H, O) :- object(O, Ty), attention(E, T, H, agent, Ty, _).
-
-%!  query_attends_agent(+E, +T, ?H, +O) is nondet.
-%   MHDPA: head H's query from O's entity attends the agent.
-query_attends_agent(E, T, H, O) :- object(O, Ty), attention(E, T, H, Ty, agent, _).
-
-%!  attending_queries(+E, +T, +H, +O, -N) is det.
-%   MHDPA: how many of head H's query cells attend O's entity.
-attending_queries(E, T, H, O, N) :-
-    object(O, Ty), aggregate_all(count, attention(E, T, H, _, Ty, _), N).
-"""
+BACKGROUND = pl_text("strategy_features.pl")
+"""The feature predicates' Prolog text a learned strategy carries (neurosym/induce/pl/)."""
 
 
 def _kind(ty: str) -> str:
@@ -278,40 +184,22 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
 
 def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: list[str], add) -> None:  # type: ignore[no-untyped-def]
     """Route features (:mod:`neurosym.induce.strategy_route`): reachable, route length, nearest reachable."""
-    size = {int(e): (int(r), int(c)) for e, r, c in trace.grid.itertuples(index=False)}
-    walls: dict[int, set[tuple[int, int]]] = {}
-    terrain = trace.terrain
-    for e, ty, r, c in zip(terrain["E"], terrain["Ty"], terrain["R"], terrain["C"], strict=True):
-        if ty not in PASSABLE_TERRAIN:
-            walls.setdefault(int(e), set()).add((int(r), int(c)))
-    lengths: dict[tuple[int, int, str], int] = {}
+    routes = trace_routes(trace)
     cuts: dict[tuple[int, int, str], set[str]] = {}
     ties: dict[tuple[int, int, str], set[str]] = {}
     for (e, t), group in trace.at.groupby(["E", "T"], sort=False):
-        cells = {o: (int(r), int(c)) for o, r, c in zip(group["O"], group["R"], group["C"], strict=True)}
-        if "agent" not in cells:
-            continue
-        start = cells.pop("agent")
-        closed = walls.get(int(e), set()) | {
-            rc for o, rc in cells.items() if _kind(types[o]) not in PASSABLE_KINDS
-        }
-        if int(e) in size:
-            found = route_lengths(start, cells, size[int(e)], closed)
-            kind_of = {o: _kind(types[o]) for o in cells}
-            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed).items():
-                cuts[(int(e), int(t), o)] = ks
-            for o, ks in shortcuts(start, cells, kind_of, size[int(e)], closed, ties=True).items():
-                ties[(int(e), int(t), o)] = ks
-        else:
-            found = dict.fromkeys(cells, UNREACHABLE)
-        for o, d in found.items():
-            lengths[(int(e), int(t), o)] = d
+        objects = [o for o in dict.fromkeys(group["O"]) if o != "agent"]
+        kind_of = {o: _kind(types[o]) for o in objects}
+        state = (int(e), int(t))
+        for o, ks in shortcuts(routes, state, objects, kind_of).items():
+            cuts[(*state, o)] = ks
+        for o, ks in shortcuts(routes, state, objects, kind_of, ties=True).items():
+            ties[(*state, o)] = ks
     by_state: dict[tuple[int, int], list[str]] = {}
     for e, t, o in zip(pairs["E"], pairs["T"], pairs["O"], strict=True):
         by_state.setdefault((e, t), []).append(o)
 
-    def length(e: int, t: int, o: str) -> int:
-        return lengths.get((e, t, o), UNREACHABLE)
+    length = routes.length
 
     def nearest(e: int, t: int, o: str, r: int, c: int) -> float:
         d, k = length(e, t, o), _kind(types[o])

@@ -12,6 +12,9 @@ from neurosym.errors import ConfigError
 from neurosym.induce.strategy import induce_strategy
 from neurosym.induce.strategy_data import load_trace
 
+ROUTE = Path(__file__).resolve().parents[2] / "rules" / "route.pl"
+"""rules/route.pl, whose route_moves/4 a learned file's route features call"""
+
 
 @pytest.fixture(scope="module")
 def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
@@ -59,7 +62,7 @@ def _prolog_choices(swipl: Path, kb: Path, strategy: Path) -> dict[tuple[int, in
         "( goal(E, T, O) -> format('~w ~w ~w~n', [E, T, O]) ; format('~w ~w none~n', [E, T]) ))"
     )
     out = subprocess.run(
-        [str(swipl), "-q", "-g", f"consult('{kb}'), consult('{strategy}')", "-g", goal, "-t", "halt"],
+        [str(swipl), "-q", "-g", f"consult('{kb}'), consult('{ROUTE}'), consult('{strategy}')", "-g", goal, "-t", "halt"],
         capture_output=True, text=True, check=True, timeout=120,
     ).stdout  # fmt: skip
     rows = [line.split() for line in out.splitlines()]

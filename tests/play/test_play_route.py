@@ -35,11 +35,16 @@ def test_no_route_past_an_unarmed_enemy() -> None:
 
 
 HOSTILE = (
-    ":- dynamic route_pl_memo_/4.\n"
+    ":- dynamic route_pl_memo_/4, memo_/5, moves_/5, searched_/6, grid_/6.\n"
     "route_pl_memo_(0, 0, terminal, found(jump_into_pit, 1)).\n"
     "route_pl_memo_(0, 0, sword, none).\n"
+    "memo_(user, 0, 0, terminal, found(left, 1)).\n"
+    "moves_(0, 0, user, 0-0, t(terminal, 1, t, t)).\n"
+    "searched_(0, user, 1, 0, [], cells(0, 1, 1)).\n"
+    "grid_(0, user, 1, 1, adj([]), cells(wall)).\n"
 )
-"""facts for the cache route.pl once kept in the loading module: planted answers"""
+"""facts named like route.pl's caches (the one it once kept in the loading module, and the
+ones of module route_pl_cache): planted answers"""
 
 
 DATA_KB = (
@@ -60,17 +65,20 @@ def test_kb_facts_cannot_change_a_route(
     a fact KB through neurosym query, and route.plt's states in plain swipl (kb.pl, route.pl)."""
     kb = tmp_path / "kb.pl"
     kb.write_text(DATA_KB + (HOSTILE if hostile else ""))
-    goal = "route(0, 0, terminal, A, C)"
+    goal = "route(0, 0, terminal, A, C), route_moves(0, 0, terminal, D)"
     proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--csv")
-    assert (proc.returncode, proc.stdout.split()) == (0, ["A,C", "right,2"]), proc.stderr
+    assert (proc.returncode, proc.stdout.split()) == (0, ["A,C,D", "right,2,2"]), proc.stderr
     code = tmp_path / "states.pl"
     code.write_text(FACTS.read_text() + (HOSTILE if hostile else ""))
-    shown = "forall((member(G, [terminal, sword]), route(0, 0, G, A, C)), writeln(G-A-C))"
+    shown = (
+        "forall((member(G, [terminal, sword]), route(0, 0, G, A, C), route_moves(0, 0, G, D)), "
+        "writeln(G-A-C-D))"
+    )
     plain = subprocess.run(
         [str(swipl), "-q", "-g", shown, "-t", "halt", str(code), str(ROOT / "rules" / "route.pl")],
         capture_output=True, text=True, timeout=60, check=False,
     )  # fmt: skip
-    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7\nsword-down-8\n"), plain.stderr
+    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7-7\nsword-down-8-4\n"), plain.stderr
 
 
 def _only(tmp_path: Path, body: str) -> Path:
