@@ -28,9 +28,6 @@ MODULE = "neurosym_readback"
 FILE = Path(__file__).with_name("pl") / "neurosym_readback.pl"
 """The module's source, shipped as package data."""
 
-SOURCE = FILE.read_text(encoding="utf-8")
-"""Its text, for a janus_with that consults text (one that reads ``FILE`` needs only that)."""
-
 
 def comment(text: str) -> str:
     """``text`` as one ``%`` comment line: control characters and newlines shown as escapes,
@@ -73,7 +70,7 @@ def check_reads_back(text: str, parts: list[Part], path: str | os.PathLike[str])
 
 
 def _module():  # type: ignore[no-untyped-def]
-    """This module as janus_with's embedded Prolog module (its MODULE, FILE and SOURCE)."""
+    """This module as janus_with's embedded Prolog module (its MODULE and FILE)."""
     import sys
 
     return sys.modules[__name__]

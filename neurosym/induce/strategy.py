@@ -129,7 +129,7 @@ def _learn(
 
 
 def family(trace: Trace) -> str:
-    """The env family of a trace (``rgw`` or ``boxworld``), as ``--what world`` tells it."""
+    """The env family of a trace (``rgw`` or ``boxworld``), as ``induce world`` tells it."""
     from neurosym.induce.examples import env_family
 
     env = trace.meta.get("env", "")

@@ -123,8 +123,9 @@ goal(E, T, Object): the object the agent goes for next in state T of episode E.
 The clauses are a decision list: the FIRST answer of goal/3 is the choice.
 Where and how it was learned, and its scores, follow in the % lines below.
 
-Load it beside a KB of the same schema (every predicate below is defined here):
-  ?- consult('kb.pl'), consult('strategy.pl'), goal(0, 0, O).
+Load it beside a KB of the same schema and rules/route.pl (its route lengths
+call route_moves/4 there; every other predicate below is defined here):
+  ?- consult('kb.pl'), consult('rules/route.pl'), consult('strategy.pl'), goal(0, 0, O).
 */
 """
 """The PlDoc header: fixed text only (data goes in one-line ``%`` comments)."""
@@ -144,7 +145,7 @@ def render_parts(strategy: Strategy) -> tuple[str, list[Part]]:
     if strategy.features not in READS:
         raise ConfigError(f"unknown feature set {strategy.features!r}; use one of {', '.join(READS)}")
     notes = [
-        f"Learned by `neurosym induce --what strategy` from {strategy.kb}",
+        f"Learned by `neurosym induce strategy` from {strategy.kb}",
         f"(checkpoint {meta.get('checkpoint', '?')}, env {meta.get('env', '?')}, "
         f"module {meta.get('module', '?')}).",
         f"Features: {strategy.features} (reads {READS[strategy.features]}).",

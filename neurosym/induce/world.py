@@ -159,7 +159,7 @@ def _fmt(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f}"
 
 
-HEADER = """/** <module> World rules learned from recorded facts (neurosym induce --what world)
+HEADER = """/** <module> World rules learned from recorded facts (neurosym induce world)
 
 predicts(E, T, Event) holds when the step of state T of episode E has event Event.
 Load beside a KB of the same schema (step/4, at/5, object/2, holding/3, terrain/4,

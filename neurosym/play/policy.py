@@ -1,6 +1,6 @@
 """A strategy file for ``neurosym play``: its path and the fact sets it reads.
 
-A strategy (``neurosym induce --what strategy``, or one written by hand)
+A strategy (``neurosym induce strategy``, or one written by hand)
 defines ``goal(E, T, Object)`` and declares near its top, in a line of its
 own, which facts it reads::
 
@@ -46,7 +46,7 @@ def read_policy(path: str | os.PathLike[str]) -> Policy:
     if not file.is_file():
         raise ConfigError(
             f"no such policy file: {file} (give a strategy .pl that defines goal(E, T, Object), "
-            "e.g. one written by neurosym induce --what strategy)"
+            "e.g. one written by neurosym induce strategy)"
         )
     try:
         with file.open(encoding="utf-8") as handle:

@@ -48,6 +48,3 @@ MODULE = "neurosym_play"
 
 FILE = Path(__file__).with_name("pl") / "neurosym_play.pl"
 """The module's source, shipped as package data."""
-
-SOURCE = FILE.read_text(encoding="utf-8")
-"""Its text, for a janus_with that consults text (one that reads ``FILE`` needs only that)."""

@@ -139,10 +139,10 @@ _consult_lock = threading.Lock()
 def janus_with(*modules: ModuleType) -> ModuleType:
     """janus with each embedded Prolog module consulted, in order, once per process.
 
-    Each is a Python module holding its Prolog module's ``MODULE`` name and either
-    ``FILE``, the path of a ``.pl`` file shipped in the package (then ``SETUP``, when
-    there, is a ``(goal, inputs)`` pair run once right after the file is loaded), or
-    ``SOURCE``, the Prolog text itself."""
+    Each is a Python module holding its Prolog module's ``MODULE`` name and
+    ``FILE``, the path of its ``.pl`` file shipped in the package, and
+    optionally ``SETUP``, a ``(goal, inputs)`` pair run once right after the
+    file is loaded."""
     janus = import_janus()
     if any(m.MODULE not in _consulted for m in modules):
         with _consult_lock:
@@ -154,12 +154,8 @@ def janus_with(*modules: ModuleType) -> ModuleType:
 
 
 def _consult(janus: ModuleType, module: ModuleType) -> None:
-    """Load one embedded Prolog module: its ``FILE`` (and ``SETUP``) or its ``SOURCE``."""
-    file = getattr(module, "FILE", None)
-    if file is None:
-        janus.consult(f"/neurosym/{module.MODULE}.pl", data=module.SOURCE)
-        return
-    janus.consult(str(file))
+    """Load one embedded Prolog module: its ``FILE``, then its ``SETUP`` goal if it has one."""
+    janus.consult(str(module.FILE))
     setup = getattr(module, "SETUP", None)
     if setup is not None:
         janus.query_once(*setup)

@@ -22,7 +22,7 @@ def test_cli_learns_prints_and_writes(run_neurosym, kbs: tuple[Path, Path], tmp_
     assert "fidelity 1.0000 on" in r.stdout and f"wrote {out}" in r.stdout
     text = out.read_text()
     assert text.startswith("%! features: world\n")
-    assert f"Learned by `neurosym induce --what strategy` from {train}" in text
+    assert f"Learned by `neurosym induce strategy` from {train}" in text
 
 
 def test_cli_holdout_share_and_relations(run_neurosym, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]

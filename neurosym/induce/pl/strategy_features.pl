@@ -1,6 +1,6 @@
 /*  strategy_features.pl -- the predicates a learned strategy's features call.
 
-    `neurosym induce --what strategy` copies the text below this comment,
+    `neurosym induce strategy` copies the text below this comment,
     byte for byte, into every learned strategy file (then the text of
     strategy_route.pl): the world features (kinds, Manhattan distances,
     Box-World's keys and locks) and the network's relation features. They

@@ -1,6 +1,6 @@
 /*  strategy_route.pl -- the route features of a learned strategy.
 
-    `neurosym induce --what strategy` copies the text below this comment,
+    `neurosym induce strategy` copies the text below this comment,
     byte for byte, into every learned strategy file, after the text of
     strategy_features.pl. The routes themselves are rules/route.pl's
     route_moves/4,5 (one breadth-first search per state and start cell,

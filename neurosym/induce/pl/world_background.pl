@@ -1,6 +1,6 @@
 /*  world_background.pl -- the background knowledge world rules are learned over.
 
-    `neurosym induce --what world` grounds these predicates on the training
+    `neurosym induce world` grounds these predicates on the training
     KB (neurosym/induce/examples.py) and copies the text below this comment,
     byte for byte, into every learned world.pl, so that the file needs
     nothing but a KB's state facts (step/4, at/5, object/2, holding/3,
