@@ -13,14 +13,41 @@
 
     Time: event(E, T, Ev) is the transition from state T to T+1, so "before"
     compares those T. Meeting the enemy is defeated(enemy) or hurt_by(enemy).
-    Helpers end in _ and start with rgw_, so this file loads beside the other
-    rule files without clashes.
+
+    A module (rgw), loaded once per process: its predicates read the facts
+    of the module they are called from (module transparent, see
+    lib/kb_common.pl), user in plain swipl, the KB's own module in
+    neurosym.prolog.KnowledgeBase. Its helpers stay inside it, so it loads
+    beside the other rule files without clashes. A copy to edit needs lib/
+    beside it, and another module name.
 */
+
+:- module(rgw,
+          [ sword_before_enemy/1,
+            teleport_before_enemy/1,
+            enemy_beaten_with_sword/1,
+            visit_order/2,
+            optimal_order/1,
+            orders_sword_before_enemy/1,
+            sword_enemy_direct/1,
+            sword_enemy_via/1,
+            sword_enemy_link/1
+          ]).
 
 :- use_module(library(lists)).
 :- use_module(library(pairs)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
+:- use_module(lib/kb_common).
+
+% Each exported predicate finds the facts' module (M) and passes it to its
+% worker (name_/N+1), which reads the facts as M:Fact. The transparent
+% clause itself makes no meta-call: a goal it passed to findall/3 and the
+% like would be looked up in M, where this module's helpers are not.
+:- module_transparent
+    sword_before_enemy/1, teleport_before_enemy/1, enemy_beaten_with_sword/1,
+    visit_order/2, optimal_order/1, orders_sword_before_enemy/1,
+    sword_enemy_direct/1, sword_enemy_via/1, sword_enemy_link/1.
 
 %!  sword_before_enemy(?Episode) is nondet.
 %
@@ -32,9 +59,13 @@
 %       E = 3.
 
 sword_before_enemy(E) :-
-    rgw_episode_(E),
-    rgw_first_event_(E, picked(sword), Ts),
-    rgw_first_enemy_(E, Te),
+    context_module(M),
+    sword_before_enemy_(M, E).
+
+sword_before_enemy_(M, E) :-
+    kb_episode(M, E),
+    kb_first_event(M, E, picked(sword), Ts),
+    first_enemy_(M, E, Te),
     Ts < Te.
 
 %!  teleport_before_enemy(?Episode) is nondet.
@@ -45,9 +76,13 @@ sword_before_enemy(E) :-
 %       true.
 
 teleport_before_enemy(E) :-
-    rgw_episode_(E),
-    rgw_first_event_(E, teleported, Tt),
-    rgw_first_enemy_(E, Te),
+    context_module(M),
+    teleport_before_enemy_(M, E).
+
+teleport_before_enemy_(M, E) :-
+    kb_episode(M, E),
+    kb_first_event(M, E, teleported, Tt),
+    first_enemy_(M, E, Te),
     Tt < Te.
 
 %!  enemy_beaten_with_sword(?Episode) is nondet.
@@ -59,10 +94,14 @@ teleport_before_enemy(E) :-
 %       E = 0.
 
 enemy_beaten_with_sword(E) :-
-    rgw_episode_(E),
-    once(( event(E, T, Event),
+    context_module(M),
+    enemy_beaten_with_sword_(M, E).
+
+enemy_beaten_with_sword_(M, E) :-
+    kb_episode(M, E),
+    once(( M:event(E, T, Event),
            Event == defeated(enemy),
-           holding(E, T1, Item),
+           M:holding(E, T1, Item),
            T1 == T,
            Item == sword )).
 
@@ -76,8 +115,12 @@ enemy_beaten_with_sword(E) :-
 %       Order = [sword, teleport, enemy, terminal].
 
 visit_order(E, Order) :-
-    rgw_episode_(E),
-    findall(T-Object, ( event(E, T, Event), rgw_visit_(Event, Object) ), Pairs0),
+    context_module(M),
+    visit_order_(M, E, Order).
+
+visit_order_(M, E, Order) :-
+    kb_episode(M, E),
+    findall(T-Object, ( M:event(E, T, Event), visit_(Event, Object) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Objects),
     list_to_set(Objects, Order).
@@ -91,7 +134,8 @@ visit_order(E, Order) :-
 %       E = 0.
 
 optimal_order(E) :-
-    visit_order(E, [sword, teleport, enemy, terminal]).
+    context_module(M),
+    visit_order_(M, E, [sword, teleport, enemy, terminal]).
 
 %!  orders_sword_before_enemy(?Relation) is nondet.
 %
@@ -103,8 +147,12 @@ optimal_order(E) :-
 %       R = r(1).
 
 orders_sword_before_enemy(R) :-
-    distinct(R, holds(_, _, R, sword, enemy)),
-    \+ holds(_, _, R, enemy, sword).
+    context_module(M),
+    orders_sword_before_enemy_(M, R).
+
+orders_sword_before_enemy_(M, R) :-
+    distinct(R, M:holds(_, _, R, sword, enemy)),
+    \+ M:holds(_, _, R, enemy, sword).
 
 %!  sword_enemy_direct(?Link) is nondet.
 %
@@ -117,7 +165,11 @@ orders_sword_before_enemy(R) :-
 %       L = r(1).
 
 sword_enemy_direct(Link) :-
-    distinct(Link, rgw_link_(sword, enemy, Link)).
+    context_module(M),
+    sword_enemy_direct_(M, Link).
+
+sword_enemy_direct_(M, Link) :-
+    distinct(Link, kb_link(M, sword, enemy, Link)).
 
 %!  sword_enemy_via(?Object) is nondet.
 %
@@ -131,11 +183,15 @@ sword_enemy_direct(Link) :-
 %       X = teleport.
 
 sword_enemy_via(X) :-
-    rgw_entity_type_(X),
+    context_module(M),
+    sword_enemy_via_(M, X).
+
+sword_enemy_via_(M, X) :-
+    entity_type_(M, X),
     X \== sword,
     X \== enemy,
-    once(rgw_link_(sword, X, _)),
-    once(rgw_link_(X, enemy, _)).
+    once(kb_link(M, sword, X, _)),
+    once(kb_link(M, X, enemy, _)).
 
 %!  sword_enemy_link(-Answer) is det.
 %
@@ -147,10 +203,14 @@ sword_enemy_via(X) :-
 %       A = direct([r(1), r(0)]).
 
 sword_enemy_link(Answer) :-
-    findall(L, sword_enemy_direct(L), Links),
+    context_module(M),
+    sword_enemy_link_(M, Answer).
+
+sword_enemy_link_(M, Answer) :-
+    findall(L, sword_enemy_direct_(M, L), Links),
     (   Links \== []
     ->  Answer = direct(Links)
-    ;   findall(X, sword_enemy_via(X), Xs),
+    ;   findall(X, sword_enemy_via_(M, X), Xs),
         (   Xs \== []
         ->  Answer = indirect(Xs)
         ;   Answer = none
@@ -158,42 +218,24 @@ sword_enemy_link(Answer) :-
     ).
 
 % ------------------------------------------------------------------ helpers
-
-%   rgw_episode_(?E): E is an episode; enumerates in episode order.
-rgw_episode_(E) :-
-    episode(E, _, _, _).
-
-%   rgw_first_event_(+E, +Event, -T): T is the first time Event happened in E;
-%   fails when it never did.
 %
-%   Speed: the rules look events up by episode only (event(E, T, Ev) with E
-%   bound, then compare Ev), so SWI-Prolog builds one just-in-time index, on
-%   the first argument, and no composite index on (E, Event), whose
-%   construction dominated the first call over large KBs.
-rgw_first_event_(E, Event, T) :-
-    aggregate_all(min(T0), ( event(E, T0, Ev), Ev == Event ), T).
+% Episodes, first events and the network's links: lib/kb_common.pl.
 
-%   rgw_first_enemy_(+E, -T): the first time the agent met the enemy in E.
-rgw_first_enemy_(E, T) :-
-    aggregate_all(min(T0), ( event(E, T0, Ev), rgw_meets_enemy_(Ev) ), T).
+%   first_enemy_(+M, +E, -T): the first time the agent met the enemy in E.
+first_enemy_(M, E, T) :-
+    aggregate_all(min(T0), ( M:event(E, T0, Ev), meets_enemy_(Ev) ), T).
 
-rgw_meets_enemy_(defeated(enemy)).
-rgw_meets_enemy_(hurt_by(enemy)).
+meets_enemy_(defeated(enemy)).
+meets_enemy_(hurt_by(enemy)).
 
-%   rgw_visit_(+Event, -Object): the key object an event reaches.
-rgw_visit_(picked(sword), sword).
-rgw_visit_(teleported, teleport).
-rgw_visit_(defeated(enemy), enemy).
-rgw_visit_(hurt_by(enemy), enemy).
-rgw_visit_(reached(terminal), terminal).
-rgw_visit_(fell(pit), pit).
+%   visit_(+Event, -Object): the key object an event reaches.
+visit_(picked(sword), sword).
+visit_(teleported, teleport).
+visit_(defeated(enemy), enemy).
+visit_(hurt_by(enemy), enemy).
+visit_(reached(terminal), terminal).
+visit_(fell(pit), pit).
 
-%   rgw_link_(?A, ?B, -Link): the network relates A and B (either orientation).
-rgw_link_(A, B, R) :- holds(_, _, R, A, B).
-rgw_link_(A, B, R) :- holds(_, _, R, B, A).
-rgw_link_(A, B, attention(H)) :- attention(_, _, H, A, B, _).
-rgw_link_(A, B, attention(H)) :- attention(_, _, H, B, A, _).
-
-%   rgw_entity_type_(-Type): object types of the map, and the agent; each once.
-rgw_entity_type_(Type) :-
-    distinct(Type, ( Type = agent ; object(_, Type) )).
+%   entity_type_(+M, -Type): object types of the map, and the agent; each once.
+entity_type_(M, Type) :-
+    distinct(Type, ( Type = agent ; M:object(_, Type) )).

@@ -20,9 +20,13 @@ stops a running goal with :class:`KeyboardInterrupt` (Prolog checks for it
 every 100,000 inferences; the KB stays usable).
 
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
-one process even when they load the same rule file. Files are plain Prolog
-(no module header); they are loaded under a per-module source id because
-SWI-Prolog will not load one non-module file into two modules.
+one process even when they load the same rule file. A rule file that is a
+module (the shipped ones: ``rules/rgw.pl`` is module ``rgw``) is loaded once
+per process and imported into each KB's module; its exported predicates are
+module transparent and read the facts of the KB they are called from
+(``rules/lib/kb_common.pl``). Any other file is plain Prolog, loaded into the
+KB's module under a per-module source id because SWI-Prolog will not load
+one non-module file into two modules.
 
 Values cross the boundary as data, never as goal text:
 
@@ -400,15 +404,17 @@ class KnowledgeBase:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
 
         A bare name (``"rgw"``) is a shipped rule file (:func:`neurosym.shipped.rule_file`).
-        Syntax and other load errors raise :class:`PrologError` naming the
-        file and line, and the file's clauses are unloaded again; warnings
-        become :class:`PrologWarning`.
+        A module file is loaded once per process (again when it changed on
+        disk) and imported: every KB that loads it shares its code, and each
+        KB's queries read that KB's facts. Syntax and other load errors raise
+        :class:`PrologError` naming the file and line, and the file's clauses
+        are unloaded again; warnings become :class:`PrologWarning`.
         """
         from neurosym.shipped import rule_file
 
         self._check_open()
         path = _existing(rule_file(path))
-        fmt = "qlf" if path.suffix == ".qlf" else "source"
+        fmt = "qlf" if path.suffix == ".qlf" else "rules"
         before = len(self._source_ids)
         self._finish(path, *self._load_file(path, fmt))
         self._rule_ids.extend([*self._source_ids[before:], str(path)])

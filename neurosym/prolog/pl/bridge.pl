@@ -15,7 +15,12 @@ What it does, and why in Prolog:
     so several fact files add up instead of replacing each other. Errors and
     warnings printed during the load are captured with message_hook/3 and
     returned instead of being printed. The dynamic, discontiguous and
-    multifile directives a =|.qlf|= replays land in the KB's module.
+    multifile directives a =|.qlf|= replays land in the KB's module. A rule
+    file (format =rules=) that is a module file, as the shipped rule files
+    are, is instead loaded once per process, as that module, and imported
+    into the KB's module: its exported predicates are module transparent
+    and read the facts of the module they are called from (see
+    =|rules/lib/kb_common.pl|=).
   - solve/8 parses the goal text in the KB module, binds the inputs by
     variable name (values never pass through goal text), runs it under
     limit/2 and returns every answer in one call, each value encoded so
@@ -136,6 +141,11 @@ multifile_loaded_(M) :-
              \+ predicate_property(M:Head, imported_from(_)) ),
            ( functor(Head, Name, Arity), multifile(M:Name/Arity) )).
 
+load_(M, Id, File, rules) :-
+    (   module_file_(File)
+    ->  load_module_(M, File)
+    ;   load_(M, Id, File, source)
+    ).
 load_(M, Id, File, source) :-
     setup_call_cleanup(
         open(File, read, S, [encoding(utf8)]),
@@ -146,6 +156,32 @@ load_(M, Id, File, qlf) :-
         open(File, read, S, [type(binary)]),
         load_files(M:Id, [stream(S), format(qlf), silent(true)]),
         close(S)).
+
+%   module_file_(+File): File's first term is a module header. A file
+%   whose first term cannot be read is no module file: loading it as source
+%   reports the syntax error.
+module_file_(File) :-
+    setup_call_cleanup(
+        open(File, read, S, [encoding(utf8)]),
+        catch(read_term(S, First, [syntax_errors(error)]), error(_, _), fail),
+        close(S)),
+    nonvar(First),
+    (   First = (:- module(_, _))
+    ;   First = (:- module(_, _, _))
+    ),
+    !.
+
+%   load_module_(+M, +File): the module file File loaded (once per process;
+%   again when it changed on disk) and imported into M. A load that printed
+%   an error unloads File again, so that the next KB that loads it reports
+%   the error too instead of importing what part of it loaded.
+load_module_(M, File) :-
+    catch(load_files(M:File, [if(changed), silent(true)]), E, true),
+    (   ( nonvar(E) ; collected_(error, _) )
+    ->  catch(unload_file(File), _, true)
+    ;   true
+    ),
+    (   nonvar(E) -> throw(E) ; true ).
 
 % A .qlf replays a file's directives qualified with the module it was
 % compiled in. neurosym compiles into neurosym_qlf (see neurosym/prolog/qlf.py),
