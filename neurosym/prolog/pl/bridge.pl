@@ -172,13 +172,18 @@ module_file_(File) :-
     !.
 
 %   load_module_(+M, +File): the module file File loaded (once per process;
-%   again when it changed on disk) and imported into M. A load that printed
-%   an error unloads File again, so that the next KB that loads it reports
-%   the error too instead of importing what part of it loaded.
+%   again when it changed on disk) and imported into M. After a load that
+%   printed an error the next one loads File again, so that every KB that
+%   loads it reports the error, instead of importing what part of it
+%   loaded. (unload_file/1 cannot undo the load: SWI-Prolog then takes File
+%   for a non-module file loaded into the first KB's module.)
+:- dynamic broken_module_/1.
+
 load_module_(M, File) :-
-    catch(load_files(M:File, [if(changed), silent(true)]), E, true),
+    (   retract(broken_module_(File)) -> If = true ; If = changed ),
+    catch(load_files(M:File, [if(If), silent(true)]), E, true),
     (   ( nonvar(E) ; collected_(error, _) )
-    ->  catch(unload_file(File), _, true)
+    ->  assertz(broken_module_(File))
     ;   true
     ),
     (   nonvar(E) -> throw(E) ; true ).
