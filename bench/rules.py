@@ -5,23 +5,26 @@ episodes of ``--steps`` states each: episode/4, object/2, the events the rules a
 about (picked(sword), teleported, defeated(enemy) or hurt_by(enemy), reached(terminal),
 at random distinct times), holding(E, T, sword) after the pick-up, and per state one
 holds/5 and one relation/7 fact between random entity types. Each rule goal is counted
-in Prolog (``aggregate_all(count, Goal, N)``):
+in Prolog (``aggregate_all(count, Goal, N)``), CPU time:
 
-* ``plain``: in a plain ``swipl kb.pl rules/rgw.pl rules/relations.pl`` (the KB in
-  module user), timed inside Prolog;
-* ``janus``: through :class:`~neurosym.prolog.KnowledgeBase` (``kb.count(goal)``),
-  the KB in a module of its own.
+* ``plain``: in one plain swipl, the KB consulted into module user, this tree's
+  rule files loaded as at ``swipl kb.pl rules/rgw.pl rules/relations.pl`` and the
+  baseline's consulted into module ``baseline`` (so they must be plain files, as
+  the rules were before they became modules);
+* ``janus``: in one Python process, two :class:`~neurosym.prolog.KnowledgeBase`
+  of the same KB file, one with this tree's rules, one with the baseline's
+  (``kb.count(goal)``), each KB in a module of its own with its own indexes.
 
-``first_ms`` is the goal's first call in a fresh process (SWI-Prolog builds its
-just-in-time indexes then), ``ms`` the median of ``--calls`` later calls. Each side
-runs in a fresh process per try, this tree's rules and the baseline's alternately,
-``--repeat`` times; the figures are the best of the tries. With ``--baseline DIR`` (a
-tree holding the old ``rules/``, e.g. ``git archive main rules | tar -x -C /tmp/base``)
-both are timed; without it only this tree's. The first line describes the machine,
+The two sides are called alternately, ``--calls`` times each after a first call,
+so that a busy machine slows both alike; ``ms`` is the median of those calls and
+``min_ms`` the fastest. ``first_ms`` (janus only: each KB has its own facts) is the
+first call, when SWI-Prolog builds its just-in-time indexes. ``--baseline DIR`` is
+a tree holding the old ``rules/`` (``git archive BASE rules | tar -x -C DIR``);
+without it only this tree's rules are timed. The first line describes the machine,
 its load average included: the figures are times on a machine that may be shared.
 
     python bench/rules.py --baseline /tmp/base                  # 10k episodes
-    python bench/rules.py --episodes 1000 --repeat 1            # quick
+    python bench/rules.py --episodes 1000 --calls 5             # quick
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -44,6 +48,7 @@ sys.path.insert(0, str(ROOT))
 
 from neurosym.export.prolog_writer import write_prolog  # noqa: E402
 from neurosym.prolog.locate import find_swipl  # noqa: E402
+from neurosym.terms import atom_text  # noqa: E402
 
 GOALS = (
     "sword_before_enemy(_)",
@@ -129,23 +134,34 @@ def synthetic_kb(path: Path, episodes: int, steps: int, seed: int = 0) -> int:
     return sum(len(df) for df in tables.values())
 
 
-def plain(kb: Path, rules: Path, calls: int) -> dict[str, list[float]]:
-    """{goal: [first ms, median ms]} in a fresh plain swipl with ``rules``' rule files."""
-    files = [str(kb), *(str(rules / f) for f in RULE_FILES)]
-    goals = "[" + ", ".join(GOALS) + "]"
-    program = (
-        "time_ms_(G, Ms) :- statistics(cputime, C0), aggregate_all(count, G, _),"
-        " statistics(cputime, C1), Ms is (C1 - C0) * 1000.\n"
-        f"bench_ :- forall(nth0(K, {goals}, G), ( time_ms_(G, First),"
-        f" findall(Ms, (between(1, {calls}, _), time_ms_(G, Ms)), L), msort(L, S),"
-        " length(S, N), I is N // 2, nth0(I, S, Med),"
-        " format('~d ~6f ~6f~n', [K, First, Med]) )).\n"
-    )
+_PLAIN = """
+time_ms_(G, Ms) :-
+    statistics(cputime, C0), aggregate_all(count, G, _), statistics(cputime, C1),
+    Ms is (C1 - C0) * 1000.
+side_ms_(Sides, G, Times) :- maplist(side_goal_(G), Sides, Gs), maplist(time_ms_, Gs, Times).
+side_goal_(G, this, G).
+side_goal_(G, baseline, baseline:G).
+bench_(Goals, Sides, Calls) :-
+    forall(nth0(K, Goals, G),
+           ( side_ms_(Sides, G, _),
+             forall(between(1, Calls, _),
+                    ( side_ms_(Sides, G, Ts), format('~d ~q~n', [K, Ts]) )) )).
+"""
+
+
+def plain(kb: Path, sides: dict[str, Path], calls: int) -> dict[str, dict[str, list[float]]]:
+    """{goal: {side: [ms of each later call]}} in one plain swipl holding both sides' rules."""
+    load = [f"consult({atom_text(str(kb))})"]
+    for side, rules in sides.items():
+        for name in RULE_FILES:
+            target = "user" if side == "this" else side
+            load.append(f"{target}:consult({atom_text(str(rules / name))})")
+    goal = ", ".join([*load, f"bench_([{', '.join(GOALS)}], [{', '.join(sides)}], {int(calls)})"])
     with tempfile.NamedTemporaryFile("w", suffix=".pl", delete=False) as f:
-        f.write(program)
+        f.write(_PLAIN)
     try:
         proc = subprocess.run(
-            [str(find_swipl().executable), "-q", "-g", "bench_", "-t", "halt", *files, f.name],
+            [str(find_swipl().executable), "-q", "-g", goal, "-t", "halt", f.name],
             capture_output=True,
             text=True,
             check=True,
@@ -154,35 +170,39 @@ def plain(kb: Path, rules: Path, calls: int) -> dict[str, list[float]]:
         os.unlink(f.name)
     if proc.stderr:
         raise SystemExit(f"plain swipl printed: {proc.stderr.strip()}")
-    out = {}
+    out: dict[str, dict[str, list[float]]] = {g: {side: [] for side in sides} for g in GOALS}
     for line in proc.stdout.splitlines():
-        k, first, median = line.split()
-        out[GOALS[int(k)]] = [float(first), float(median)]
+        k, times = line.split(" ", 1)
+        for side, ms in zip(sides, json.loads(times), strict=True):
+            out[GOALS[int(k)]][side].append(ms)
     return out
 
 
 _CHILD = """
-import json, statistics, sys, time
+import json, sys, time
 from neurosym.prolog.knowledge_base import KnowledgeBase
-kb_path, rules, calls, goals = sys.argv[1], sys.argv[2:4], int(sys.argv[4]), sys.argv[5:]
-kb = KnowledgeBase(kb_path, rules=rules)
+kb_path, calls, sides = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
+goals = json.loads(sys.argv[4])
+kbs = {side: KnowledgeBase(kb_path, rules=rules) for side, rules in sides.items()}
+def ms(kb, goal):
+    start = time.process_time()
+    kb.count(goal)
+    return (time.process_time() - start) * 1e3
 out = {}
 for goal in goals:
-    times = []
-    for _ in range(calls + 1):
-        start = time.process_time()
-        kb.count(goal)
-        times.append((time.process_time() - start) * 1e3)
-    out[goal] = [times[0], statistics.median(times[1:])]
+    out[goal] = {side: [ms(kb, goal)] for side, kb in kbs.items()}  # the first call
+    for _ in range(calls):
+        for side, kb in kbs.items():
+            out[goal][side].append(ms(kb, goal))
 print(json.dumps(out))
 """
 
 
-def janus(kb: Path, rules: Path, calls: int) -> dict[str, list[float]]:
-    """{goal: [first ms, median ms]} through KnowledgeBase in a fresh Python process."""
-    args = [str(kb), *(str(rules / f) for f in RULE_FILES), str(calls)]
+def janus(kb: Path, sides: dict[str, Path], calls: int) -> dict[str, dict[str, list[float]]]:
+    """{goal: {side: [first ms, ms of each later call]}}: one KnowledgeBase per side."""
+    rules = {side: [str(folder / f) for f in RULE_FILES] for side, folder in sides.items()}
     proc = subprocess.run(
-        [sys.executable, "-c", _CHILD, *args, *GOALS],
+        [sys.executable, "-c", _CHILD, str(kb), str(calls), json.dumps(rules), json.dumps(GOALS)],
         capture_output=True,
         text=True,
         check=True,
@@ -191,24 +211,24 @@ def janus(kb: Path, rules: Path, calls: int) -> dict[str, list[float]]:
     return json.loads(proc.stdout)
 
 
-def best(tries: list[dict[str, list[float]]]) -> dict[str, list[float]]:
-    """Per goal, the smallest first-call and median figures over the tries."""
-    return {
-        g: [round(min(t[g][0] for t in tries), 2), round(min(t[g][1] for t in tries), 2)]
-        for g in tries[0]
-    }
+def figures(times: list[float], first: bool) -> dict[str, float]:
+    """first_ms (when ``times`` starts with the first call), ms (median) and min_ms."""
+    later = times[1:] if first else times
+    out = {"first_ms": round(times[0], 2)} if first else {}
+    return {**out, "ms": round(statistics.median(later), 2), "min_ms": round(min(later), 2)}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=10_000)
     ap.add_argument("--steps", type=int, default=20)
-    ap.add_argument("--calls", type=int, default=5, help="later calls per goal (default 5)")
-    ap.add_argument("--repeat", type=int, default=3, help="fresh processes per side (default 3)")
+    ap.add_argument("--calls", type=int, default=11, help="timed calls per goal and side (11)")
     ap.add_argument("--baseline", type=Path, help="a tree whose rules/ are the baseline")
     args = ap.parse_args()
     if not 1 <= args.episodes <= 1_000_000 or not 4 <= args.steps <= 1000:
         raise SystemExit("--episodes must be 1..1,000,000 and --steps 4..1000")
+    if not 1 <= args.calls <= 1000:
+        raise SystemExit("--calls must be 1..1000")
     emit(
         bench="machine",
         cpus=os.cpu_count(),
@@ -224,15 +244,10 @@ def main() -> None:
         n = synthetic_kb(kb, args.episodes, args.steps)
         emit(bench="kb", episodes=args.episodes, steps=args.steps, facts=n)
         for how, run in (("plain", plain), ("janus", janus)):
-            tries: dict[str, list] = {side: [] for side in sides}
-            for _ in range(args.repeat):
-                for side, rules in sides.items():
-                    tries[side].append(run(kb, rules, args.calls))
-            figures = {side: best(t) for side, t in tries.items()}
-            for goal in figures["this"]:
+            for goal, by_side in run(kb, sides, args.calls).items():
                 line = {"bench": how, "goal": goal}
-                for side, f in figures.items():
-                    line[side] = {"first_ms": f[goal][0], "ms": f[goal][1]}
+                for side, times in by_side.items():
+                    line[side] = figures(times, first=how == "janus")
                 emit(**line)
 
 
