@@ -4,11 +4,14 @@ The KB (written with neurosym's writer) holds ``--episodes`` Relational-Grid-Wor
 episodes of ``--steps`` states each: episode/4, object/2, the events the rules ask
 about (picked(sword), teleported, defeated(enemy) or hurt_by(enemy), reached(terminal),
 at random distinct times), holding(E, T, sword) after the pick-up, and per state one
-holds/5 and one relation/7 fact between random entity types. Each rule goal is counted
+holds/5 and one relation/7 fact between random entity types; also, for the Box-World
+rules, the same map of keys, locks and gem at state 0 of every episode (at/5, object/2)
+and the got(...) events of its solution. Each rule goal is counted
 in Prolog (``aggregate_all(count, Goal, N)``), CPU time:
 
 * ``plain``: in one plain swipl, the KB consulted into module user, this tree's
-  rule files loaded as at ``swipl kb.pl rules/rgw.pl rules/relations.pl`` and the
+  rule files loaded as at ``swipl kb.pl rules/rgw.pl rules/relations.pl
+  rules/boxworld.pl`` and the
   baseline's consulted into module ``baseline`` (so they must be plain files, as
   the rules were before they became modules);
 * ``janus``: in one Python process, two :class:`~neurosym.prolog.KnowledgeBase`
@@ -59,9 +62,27 @@ GOALS = (
     "sword_enemy_link(_)",
     "consistently_orders(_, _, _)",
     "head_pairs(_, _)",
+    "box(_, _, _)",
+    "solution_chain(_, _)",
+    "distractor_box(_, _, _)",
+    "followed_solution(_)",
 )
-RULE_FILES = ("rgw.pl", "relations.pl")
+RULE_FILES = ("rgw.pl", "relations.pl", "boxworld.pl")
 TYPES = ["agent", "sword", "enemy", "teleport", "terminal", "wall"]
+# The Box-World map of every episode at state 0 (rules/tests/boxworld_facts.pl's
+# episode 0): id, type, row, column; key(red) opens a box holding key(blue), which
+# opens the gem's box; the other red lock guards a distractor, key(green).
+BOX_MAP = [
+    ("agent", "agent", 1, 1),
+    ("key_red", "key(red)", 2, 3),
+    ("key_blue", "key(blue)", 5, 5),
+    ("lock_red", "lock(red)", 5, 6),
+    ("gem", "gem", 8, 7),
+    ("lock_blue", "lock(blue)", 8, 8),
+    ("key_green", "key(green)", 10, 2),
+    ("lock_red_2", "lock(red)", 10, 3),
+]
+BOX_EVENTS = ["got(key(red))", "got(key(blue))", "got(gem)"]
 
 
 def emit(**fields: Any) -> None:
@@ -89,7 +110,16 @@ def synthetic_kb(path: Path, episodes: int, steps: int, seed: int = 0) -> int:
                 ]
             ),
         }
-    ).sort_values(["episode", "t"], kind="stable")
+    )
+    box_events = pd.DataFrame(
+        {
+            "episode": np.repeat(ep, len(BOX_EVENTS)),
+            "t": np.tile(np.arange(len(BOX_EVENTS)), episodes),
+            "event": np.tile(BOX_EVENTS, episodes),
+        }
+    )
+    events = pd.concat([events, box_events]).sort_values(["episode", "t"], kind="stable")
+    ids, types, rows, cols = zip(*BOX_MAP, strict=True)
     held = [(e, t) for e in ep for t in range(t_sword[e] + 1, steps)]
     states = episodes * steps
     pairs = rng.integers(0, len(TYPES), (states, 2))
@@ -99,7 +129,19 @@ def synthetic_kb(path: Path, episodes: int, steps: int, seed: int = 0) -> int:
     }
     tables = {
         "object": pd.DataFrame(
-            {"id": ["sword", "enemy", "tele_1"], "type": ["sword", "enemy", "teleport"]}
+            {
+                "id": ["sword", "enemy", "tele_1", *ids[1:]],
+                "type": ["sword", "enemy", "teleport", *types[1:]],
+            }
+        ),
+        "at": pd.DataFrame(
+            {
+                "episode": np.repeat(ep, len(BOX_MAP)),
+                "t": 0,
+                "id": np.tile(ids, episodes),
+                "row": np.tile(rows, episodes),
+                "col": np.tile(cols, episodes),
+            }
         ),
         "episode": pd.DataFrame(
             {"episode": ep, "steps": steps, "return": 1.0, "outcome": "terminal"}
@@ -129,7 +171,7 @@ def synthetic_kb(path: Path, episodes: int, steps: int, seed: int = 0) -> int:
         path,
         tables,
         dynamic=["attention/6"],
-        term_columns={"event": ["event"], "holds": ["r"]},
+        term_columns={"event": ["event"], "holds": ["r"], "object": ["type"]},
     )
     return sum(len(df) for df in tables.values())
 
