@@ -13,12 +13,11 @@
         key is the entity held(C) (drawn in the top-left border cell).
     The map of an episode is read at its state 0.
 
-    A module (boxworld), loaded once per process: its predicates read the
-    facts of the module they are called from (module transparent, see
-    lib/kb_common.pl), user in plain swipl, the KB's own module in
-    neurosym.prolog.KnowledgeBase. Its helpers stay inside it, so it loads
-    beside the other rule files without clashes. A copy to edit needs lib/
-    beside it, and another module name.
+    A module (boxworld) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
 
 :- module(boxworld,
@@ -42,15 +41,8 @@
 :- use_module(library(pairs)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
-:- use_module(lib/kb_common).
 
-% Each exported predicate finds the facts' module (M) and passes it to its
-% worker (name_/N+1), which reads the facts as M:Fact (see rgw.pl).
-:- module_transparent
-    box/3, loose_key/2, solution_chain/2, distractor_box/3, key_opens/2,
-    got_order/2, gem_chain/2, followed_solution/1, distractor_taken/1,
-    distractor_avoided/1, key_lock_link/2, wrong_key_lock_link/3,
-    attends_matching_lock/3, matching_lock_rate/2.
+:- include(lib/kb_common).
 
 %!  box(?Episode, ?Lock, ?Content) is nondet.
 %
@@ -61,11 +53,7 @@
 %       X = key(blue).
 
 box(E, Lock, Content) :-
-    context_module(M),
-    box_(M, E, Lock, Content).
-
-box_(M, E, Lock, Content) :-
-    box_at_(M, E, Lock, Content, _, _).
+    box_at_(E, Lock, Content, _, _).
 
 %!  loose_key(?Episode, ?Key) is nondet.
 %
@@ -74,15 +62,11 @@ box_(M, E, Lock, Content) :-
 %       ?- loose_key(0, K).
 %       K = key(red).
 
-loose_key(E, Key) :-
-    context_module(M),
-    loose_key_(M, E, Key).
-
-loose_key_(M, E, key(C)) :-
-    M:at(E, 0, Id, R, Col),
-    M:object(Id, key(C)),
+loose_key(E, key(C)) :-
+    at(E, 0, Id, R, Col),
+    object(Id, key(C)),
     Right is Col + 1,
-    \+ ( M:at(E, 0, Id2, R, Right), M:object(Id2, lock(_)) ).
+    \+ ( at(E, 0, Id2, R, Right), object(Id2, lock(_)) ).
 
 %!  solution_chain(?Episode, -Chain:list) is nondet.
 %
@@ -94,13 +78,9 @@ loose_key_(M, E, key(C)) :-
 %       ?- solution_chain(0, Chain).
 %       Chain = [key(red), key(blue), gem].
 
-solution_chain(E, Chain) :-
-    context_module(M),
-    solution_chain_(M, E, Chain).
-
-solution_chain_(M, E, [Key|Rest]) :-
-    loose_key_(M, E, Key),
-    chain_from_(M, E, Key, [Key], Rest).
+solution_chain(E, [Key|Rest]) :-
+    loose_key(E, Key),
+    chain_from_(E, Key, [Key], Rest).
 
 %!  distractor_box(?Episode, ?Lock, ?Content) is nondet.
 %
@@ -111,12 +91,8 @@ solution_chain_(M, E, [Key|Rest]) :-
 %       L = lock(red), X = key(green).
 
 distractor_box(E, Lock, Content) :-
-    context_module(M),
-    distractor_box_(M, E, Lock, Content).
-
-distractor_box_(M, E, Lock, Content) :-
-    box_(M, E, Lock, Content),
-    \+ on_chain_(M, E, Lock, Content).
+    box(E, Lock, Content),
+    \+ on_chain_(E, Lock, Content).
 
 %!  key_opens(?Key, ?Lock) is nondet.
 %
@@ -127,11 +103,7 @@ distractor_box_(M, E, Lock, Content) :-
 %       L = lock(red).
 
 key_opens(Key, Lock) :-
-    context_module(M),
-    key_opens_(M, Key, Lock).
-
-key_opens_(M, Key, Lock) :-
-    distinct(Key-Lock, ( M:event(E, T, opened(Lock)), M:holding(E, T, Key) )).
+    distinct(Key-Lock, ( event(E, T, opened(Lock)), holding(E, T, Key) )).
 
 %!  got_order(?Episode, -Items:list) is nondet.
 %
@@ -142,12 +114,8 @@ key_opens_(M, Key, Lock) :-
 %       Items = [key(red), key(blue), gem].
 
 got_order(E, Items) :-
-    context_module(M),
-    got_order_(M, E, Items).
-
-got_order_(M, E, Items) :-
-    kb_episode(M, E),
-    findall(T-I, ( M:event(E, T, Ev), Ev = got(I) ), Pairs0),
+    kb_episode_(E),
+    findall(T-I, ( event(E, T, Ev), Ev = got(I) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Items).
 
@@ -159,11 +127,7 @@ got_order_(M, E, Items) :-
 %       E = 0, C = [key(red), key(blue), gem].
 
 gem_chain(E, Chain) :-
-    context_module(M),
-    gem_chain_(M, E, Chain).
-
-gem_chain_(M, E, Chain) :-
-    got_order_(M, E, Chain),
+    got_order(E, Chain),
     last(Chain, gem).
 
 %!  followed_solution(?Episode) is nondet.
@@ -175,12 +139,8 @@ gem_chain_(M, E, Chain) :-
 %       E = 0.
 
 followed_solution(E) :-
-    context_module(M),
-    followed_solution_(M, E).
-
-followed_solution_(M, E) :-
-    gem_chain_(M, E, Chain),
-    once(solution_chain_(M, E, Chain)).
+    gem_chain(E, Chain),
+    once(solution_chain(E, Chain)).
 
 %!  distractor_taken(?Episode) is nondet.
 %
@@ -190,12 +150,8 @@ followed_solution_(M, E) :-
 %       E = 1.
 
 distractor_taken(E) :-
-    context_module(M),
-    distractor_taken_(M, E).
-
-distractor_taken_(M, E) :-
-    kb_episode(M, E),
-    kb_event(M, E, hit(distractor)).
+    kb_episode_(E),
+    kb_event_(E, hit(distractor)).
 
 %!  distractor_avoided(?Episode) is nondet.
 %
@@ -206,14 +162,10 @@ distractor_taken_(M, E) :-
 %       E = 0.
 
 distractor_avoided(E) :-
-    context_module(M),
-    distractor_avoided_(M, E).
-
-distractor_avoided_(M, E) :-
-    kb_episode(M, E),
-    once(distractor_box_(M, E, _, _)),
-    kb_event(M, E, got(gem)),
-    \+ kb_event(M, E, hit(distractor)).
+    kb_episode_(E),
+    once(distractor_box(E, _, _)),
+    kb_event_(E, got(gem)),
+    \+ kb_event_(E, hit(distractor)).
 
 %!  key_lock_link(?Colour, ?Link) is nondet.
 %
@@ -225,11 +177,7 @@ distractor_avoided_(M, E) :-
 %       C = red, L = r(1).
 
 key_lock_link(C, Link) :-
-    context_module(M),
-    key_lock_link_(M, C, Link).
-
-key_lock_link_(M, C, Link) :-
-    distinct(C-Link, ( kb_link(M, K, lock(C), Link), key_colour_(K, C) )).
+    distinct(C-Link, ( kb_link_(K, lock(C), Link), key_colour_(K, C) )).
 
 %!  wrong_key_lock_link(?Key, ?Lock, ?Link) is nondet.
 %
@@ -239,12 +187,8 @@ key_lock_link_(M, C, Link) :-
 %       ?- wrong_key_lock_link(K, L, R).
 %       K = held(red), L = lock(green), R = r(0).
 
-wrong_key_lock_link(Key, Lock, Link) :-
-    context_module(M),
-    wrong_key_lock_link_(M, Key, Lock, Link).
-
-wrong_key_lock_link_(M, Key, lock(C2), Link) :-
-    distinct(Key-C2-Link, ( kb_link(M, Key, lock(C2), Link),
+wrong_key_lock_link(Key, lock(C2), Link) :-
+    distinct(Key-C2-Link, ( kb_link_(Key, lock(C2), Link),
                             key_colour_(Key, C1),
                             C1 \== C2 )).
 
@@ -258,12 +202,8 @@ wrong_key_lock_link_(M, Key, lock(C2), Link) :-
 %       E = 0, T = 4, H = 1.
 
 attends_matching_lock(E, T, H) :-
-    context_module(M),
-    attends_matching_lock_(M, E, T, H).
-
-attends_matching_lock_(M, E, T, H) :-
-    M:holding(E, T, key(C)),
-    distinct(H, M:attends(E, T, H, _, lock(C), _, _, _)).
+    holding(E, T, key(C)),
+    distinct(H, attends(E, T, H, _, lock(C), _, _, _)).
 
 %!  matching_lock_rate(-Attended, -Holding) is det.
 %
@@ -274,43 +214,39 @@ attends_matching_lock_(M, E, T, H) :-
 %       A = 1, N = 5.
 
 matching_lock_rate(Attended, Holding) :-
-    context_module(M),
-    matching_lock_rate_(M, Attended, Holding).
-
-matching_lock_rate_(M, Attended, Holding) :-
-    aggregate_all(count, M:holding(_, _, key(_)), Holding),
+    aggregate_all(count, holding(_, _, key(_)), Holding),
     aggregate_all(count,
-                  ( M:holding(E, T, key(C)),
-                    once(M:attends(E, T, _, _, lock(C), _, _, _)) ),
+                  ( holding(E, T, key(C)),
+                    once(attends(E, T, _, _, lock(C), _, _, _)) ),
                   Attended).
 
 % ------------------------------------------------------------------ helpers
 %
 % Episodes, events and the network's links: lib/kb_common.pl.
 
-%   box_at_(+M, ?E, ?Lock, ?Content, ?Row, ?Col): a box at the start of E,
-%   its lock at (Row, Col) and its content at (Row, Col - 1).
-box_at_(M, E, lock(C), Content, R, Col) :-
-    M:at(E, 0, LockId, R, Col),
-    M:object(LockId, lock(C)),
+%   box_at_(?E, ?Lock, ?Content, ?Row, ?Col): a box at the start of E, its
+%   lock at (Row, Col) and its content at (Row, Col - 1).
+box_at_(E, lock(C), Content, R, Col) :-
+    at(E, 0, LockId, R, Col),
+    object(LockId, lock(C)),
     Left is Col - 1,
-    M:at(E, 0, ContentId, R, Left),
-    M:object(ContentId, Content).
+    at(E, 0, ContentId, R, Left),
+    object(ContentId, Content).
 
-%   chain_from_(+M, +E, +Key, +Seen, -Rest): Rest leads from Key to the gem.
-chain_from_(M, E, key(C), Seen, Chain) :-
-    box_(M, E, lock(C), Content),
+%   chain_from_(+E, +Key, +Seen, -Rest): Rest leads from Key to the gem.
+chain_from_(E, key(C), Seen, Chain) :-
+    box(E, lock(C), Content),
     \+ memberchk(Content, Seen),
     (   Content == gem
     ->  Chain = [gem]
     ;   Chain = [Content|Rest],
-        chain_from_(M, E, Content, [Content|Seen], Rest)
+        chain_from_(E, Content, [Content|Seen], Rest)
     ).
 
-%   on_chain_(+M, +E, +Lock, +Content): the box Lock/Content is a step of a
+%   on_chain_(+E, +Lock, +Content): the box Lock/Content is a step of a
 %   solution chain of E (key(C) followed by Content, Lock = lock(C)).
-on_chain_(M, E, lock(C), Content) :-
-    solution_chain_(M, E, Chain),
+on_chain_(E, lock(C), Content) :-
+    solution_chain(E, Chain),
     nextto(key(C), Content, Chain),
     !.
 

@@ -25,12 +25,12 @@
 
     A change counts when it is at least causal_margin/1 (a share of episodes).
 
-    A module (causal), loaded once per process: its predicates read the
-    facts of the module they are called from (module transparent, see
-    lib/kb_common.pl), user in plain swipl, the KB's own module in
-    neurosym.prolog.KnowledgeBase. A KB without facts of one of the four
-    predicates above is read as having none of them (kb_fact/2), as when
-    they are declared dynamic.
+    A module (causal) whose helpers stay inside it. It reads the facts as
+    unqualified goals, which resolve through its default import module:
+    user in plain swipl, the KB's own module in neurosym.prolog.KnowledgeBase
+    (which loads the rule modules once per KB, see lib/kb_common.pl). A KB
+    without facts of one of the four predicates above is read as having none
+    of them (kb_fact_/1), as when they are declared dynamic.
 */
 
 :- module(causal,
@@ -42,14 +42,8 @@
           ]).
 
 :- use_module(library(lists)).
-:- use_module(lib/kb_common).
 
-% Each exported predicate that reads facts finds the facts' module (K) and
-% passes it to its worker (name_/N+1), which reads them with kb_fact(K, Fact)
-% (see rgw.pl).
-:- module_transparent
-    sword_enemy_cause/1, direct_evidence/1, correlational_evidence/1,
-    level_experiment/2.
+:- include(lib/kb_common).
 
 %!  causal_margin(-Share:float) is det.
 %
@@ -73,14 +67,10 @@ causal_margin(0.5).
 %                                               measure(swap_sword_enemy,enemy_unarmed,1.0)])]).
 
 sword_enemy_cause(Answer) :-
-    context_module(K),
-    sword_enemy_cause_(K, Answer).
-
-sword_enemy_cause_(K, Answer) :-
-    findall(E, direct_evidence_(K, E), Direct),
+    findall(E, direct_evidence(E), Direct),
     (   Direct \== []
     ->  Answer = direct(Direct)
-    ;   findall(E, correlational_evidence_(K, E), Corr),
+    ;   findall(E, correlational_evidence(E), Corr),
         (   Corr \== []
         ->  Answer = correlational(Corr)
         ;   Answer = none
@@ -99,30 +89,26 @@ sword_enemy_cause_(K, Answer) :-
 %       E = ablation_breaks_order([experiment(ablate_head_1,ablate(head(1))),
 %                                  relates(1,enemy,sword,0.2), ...]).
 
-direct_evidence(Evidence) :-
-    context_module(K),
-    direct_evidence_(K, Evidence).
-
-direct_evidence_(K, avoids_enemy_without_sword([measure(baseline, sword_before_enemy, B),
-                                                 effect(X, enemy_met, D)])) :-
+direct_evidence(avoids_enemy_without_sword([measure(baseline, sword_before_enemy, B),
+                                            effect(X, enemy_met, D)])) :-
     causal_margin(M),
-    kb_fact(K, measure(baseline, sword_before_enemy, B)),
+    kb_fact_(measure(baseline, sword_before_enemy, B)),
     B >= M,
-    kb_fact(K, experiment(X, remove(sword), _)),
-    kb_fact(K, effect(X, enemy_met, D)),
+    kb_fact_(experiment(X, remove(sword), _)),
+    kb_fact_(effect(X, enemy_met, D)),
     D =< -M,
-    \+ unarmed_meeting_(K, _, _).
-direct_evidence_(K, ablation_breaks_order([experiment(X, ablate(head(H))),
-                                            relates(H, A, B, S),
-                                            measure(baseline, sword_before_enemy, B0),
-                                            effect(X, sword_before_enemy, D)])) :-
+    \+ unarmed_meeting_(_, _).
+direct_evidence(ablation_breaks_order([experiment(X, ablate(head(H))),
+                                       relates(H, A, B, S),
+                                       measure(baseline, sword_before_enemy, B0),
+                                       effect(X, sword_before_enemy, D)])) :-
     causal_margin(M),
-    kb_fact(K, measure(baseline, sword_before_enemy, B0)),
+    kb_fact_(measure(baseline, sword_before_enemy, B0)),
     B0 >= M,
-    kb_fact(K, experiment(X, ablate(head(H)), _)),
-    relates_(K, H, A, B, S),
+    kb_fact_(experiment(X, ablate(head(H)), _)),
+    relates_(H, A, B, S),
     S > 0,
-    kb_fact(K, effect(X, sword_before_enemy, D)),
+    kb_fact_(effect(X, sword_before_enemy, D)),
     D =< -M.
 
 %!  correlational_evidence(-Evidence) is nondet.
@@ -134,16 +120,12 @@ direct_evidence_(K, ablation_breaks_order([experiment(X, ablate(head(H))),
 %       E = meets_enemy_unarmed([measure(baseline,enemy_defeated,1.0),
 %                                measure(swap_sword_enemy,enemy_unarmed,1.0)]).
 
-correlational_evidence(Evidence) :-
-    context_module(K),
-    correlational_evidence_(K, Evidence).
-
-correlational_evidence_(K, meets_enemy_unarmed([measure(baseline, enemy_defeated, B),
-                                                 measure(X, enemy_unarmed, V)])) :-
+correlational_evidence(meets_enemy_unarmed([measure(baseline, enemy_defeated, B),
+                                            measure(X, enemy_unarmed, V)])) :-
     causal_margin(M),
-    kb_fact(K, measure(baseline, enemy_defeated, B)),
+    kb_fact_(measure(baseline, enemy_defeated, B)),
     B >= M,
-    unarmed_meeting_(K, X, V).
+    unarmed_meeting_(X, V).
 
 %!  level_experiment(?X, ?Kind) is nondet.
 %
@@ -153,23 +135,17 @@ correlational_evidence_(K, meets_enemy_unarmed([measure(baseline, enemy_defeated
 %       X = remove_sword.
 
 level_experiment(X, Kind) :-
-    context_module(K),
-    level_experiment_(K, X, Kind).
-
-level_experiment_(K, X, Kind) :-
-    kb_fact(K, experiment(X, Kind, _)),
+    kb_fact_(experiment(X, Kind, _)),
     level_kind_(Kind).
 
 % ------------------------------------------------------------------ helpers
-%
-% K is the facts' module; M is the margin, as in causal_margin/1.
 
-%   unarmed_meeting_(+K, ?X, ?Share): on level X the agent met the enemy
+%   unarmed_meeting_(?X, ?Share): on level X the agent met the enemy
 %   without the sword in at least causal_margin/1 of the episodes.
-unarmed_meeting_(K, X, V) :-
+unarmed_meeting_(X, V) :-
     causal_margin(M),
-    level_experiment_(K, X, _),
-    kb_fact(K, measure(X, enemy_unarmed, V)),
+    level_experiment(X, _),
+    kb_fact_(measure(X, enemy_unarmed, V)),
     V >= M.
 
 level_kind_(baseline).
@@ -177,6 +153,6 @@ level_kind_(remove(_)).
 level_kind_(move(_, _, _)).
 level_kind_(swap(_, _)).
 
-%   relates_(+K, ?H, -A, -B, -Share): head H relates sword and enemy (either order).
-relates_(K, H, sword, enemy, S) :- kb_fact(K, relates(H, sword, enemy, S)).
-relates_(K, H, enemy, sword, S) :- kb_fact(K, relates(H, enemy, sword, S)).
+%   relates_(?H, -A, -B, -Share): head H relates sword and enemy (either order).
+relates_(H, sword, enemy, S) :- kb_fact_(relates(H, sword, enemy, S)).
+relates_(H, enemy, sword, S) :- kb_fact_(relates(H, enemy, sword, S)).

@@ -12,12 +12,12 @@
     name when some head's probe of it is at least min_selectivity/1 selective:
     W_S is shared by all heads, so relation j means the same thing in every head.
 
-    A module (meaning), loaded once per process: its predicates read the
-    facts of the module they are called from (module transparent, see
-    lib/kb_common.pl), user in plain swipl, the KB's own module in
-    neurosym.prolog.KnowledgeBase. A KB without facts of one of the three
-    predicates above is read as having none of them (kb_fact/2), as when
-    they are declared dynamic.
+    A module (meaning) whose helpers stay inside it. It reads the facts as
+    unqualified goals, which resolve through its default import module:
+    user in plain swipl, the KB's own module in neurosym.prolog.KnowledgeBase
+    (which loads the rule modules once per KB, see lib/kb_common.pl). A KB
+    without facts of one of the three predicates above is read as having none
+    of them (kb_fact_/1), as when they are declared dynamic.
 */
 
 :- module(meaning,
@@ -33,14 +33,8 @@
 :- use_module(library(lists)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
-:- use_module(lib/kb_common).
 
-% Each exported predicate that reads facts finds the facts' module (K) and
-% passes it to its worker (name_/N+1), which reads them with kb_fact(K, Fact)
-% (see rgw.pl).
-:- module_transparent
-    selectivity/4, relation_means/2, relation_name/3, head_encodes/3,
-    training_added/4, named_holds/5.
+:- include(lib/kb_common).
 
 %!  min_selectivity(-S:float) is det.
 %
@@ -59,11 +53,7 @@ min_selectivity(0.2).
 %       S = 0.42.
 
 selectivity(H, J, P, S) :-
-    context_module(K),
-    selectivity_(K, H, J, P, S).
-
-selectivity_(K, H, J, P, S) :-
-    kb_fact(K, probe(H, J, P, Acc, Ctl)),
+    kb_fact_(probe(H, J, P, Acc, Ctl)),
     S is Acc - Ctl.
 
 %!  relation_means(?Relation, ?Predicate) is nondet.
@@ -74,13 +64,9 @@ selectivity_(K, H, J, P, S) :-
 %       ?- relation_means(r(3), P).
 %       P = holding(sword).
 
-relation_means(R, P) :-
-    context_module(K),
-    relation_means_(K, R, P).
-
-relation_means_(K, r(J), P) :-
+relation_means(r(J), P) :-
     min_selectivity(Min),
-    distinct(J-P, ( selectivity_(K, _, J, P, S), integer(J), S >= Min )).
+    distinct(J-P, ( selectivity(_, J, P, S), integer(J), S >= Min )).
 
 %!  relation_name(?Relation, -Predicate, -Selectivity) is nondet.
 %
@@ -90,14 +76,10 @@ relation_means_(K, r(J), P) :-
 %       ?- relation_name(r(3), P, S).
 %       P = holding(sword), S = 0.42.
 
-relation_name(R, P, S) :-
-    context_module(K),
-    relation_name_(K, R, P, S).
-
-relation_name_(K, r(J), P, S) :-
+relation_name(r(J), P, S) :-
     min_selectivity(Min),
-    distinct(J, ( kb_fact(K, probe(_, J, _, _, _)), integer(J) )),
-    aggregate_all(max(S0, P0), ( selectivity_(K, _, J, P0, S0) ), max(S, P)),
+    distinct(J, ( kb_fact_(probe(_, J, _, _, _)), integer(J) )),
+    aggregate_all(max(S0, P0), ( selectivity(_, J, P0, S0) ), max(S, P)),
     S >= Min.
 
 %!  head_encodes(?Head, ?Predicate, -Selectivity) is nondet.
@@ -108,12 +90,8 @@ relation_name_(K, r(J), P, S) :-
 %       P = visited(sword), S = 0.35.
 
 head_encodes(H, P, S) :-
-    context_module(K),
-    head_encodes_(K, H, P, S).
-
-head_encodes_(K, H, P, S) :-
     min_selectivity(Min),
-    selectivity_(K, H, all, P, S),
+    selectivity(H, all, P, S),
     S >= Min.
 
 %!  training_added(?Head, ?J, ?Predicate, -Gain) is nondet.
@@ -125,14 +103,10 @@ head_encodes_(K, H, P, S) :-
 %       G = 0.3.
 
 training_added(H, J, P, Gain) :-
-    context_module(K),
-    training_added_(K, H, J, P, Gain).
-
-training_added_(K, H, J, P, Gain) :-
     min_selectivity(Min),
-    selectivity_(K, H, J, P, S),
+    selectivity(H, J, P, S),
     S >= Min,
-    kb_fact(K, probe_untrained(H, J, P, Acc0, Ctl0)),
+    kb_fact_(probe_untrained(H, J, P, Acc0, Ctl0)),
     Gain is S - (Acc0 - Ctl0).
 
 %!  named_holds(?E, ?T, ?Name, ?A, ?B) is nondet.
@@ -144,9 +118,5 @@ training_added_(K, H, J, P, Gain) :-
 %       T = 4, A = agent, B = sword.
 
 named_holds(E, T, Name, A, B) :-
-    context_module(K),
-    named_holds_(K, E, T, Name, A, B).
-
-named_holds_(K, E, T, Name, A, B) :-
-    relation_name_(K, R, Name, _),
-    kb_fact(K, holds(E, T, R, A, B)).
+    relation_name(R, Name, _),
+    kb_fact_(holds(E, T, R, A, B)).

@@ -11,11 +11,11 @@
     Heads and relations count from 0. Entities are named by type (sword,
     key(red), ...), so these rules speak about types, not single objects.
 
-    A module (relations), loaded once per process: its predicates read the
-    facts of the module they are called from (module transparent, see
-    lib/kb_common.pl), user in plain swipl, the KB's own module in
-    neurosym.prolog.KnowledgeBase. Its helpers stay inside it, so it loads
-    beside the other rule files without clashes.
+    A module (relations) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
 
 :- module(relations,
@@ -36,12 +36,6 @@
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
 
-% Each exported predicate finds the facts' module (M) and passes it to its
-% worker (name_/N+1), which reads the facts as M:Fact (see rgw.pl).
-:- module_transparent
-    head/1, head_pairs/2, head_top_pair/4, relation_stats/5, pair_strength/5,
-    held_count/4, consistently_orders/3, order_support/5, strongest_pairs/2.
-
 %!  head(?Head) is nondet.
 %
 %   Head is a head that has facts in the KB (relation/7 or attention/6),
@@ -52,15 +46,11 @@
 %       H = 1.
 
 head(H) :-
-    context_module(M),
-    head_(M, H).
-
-head_(M, H) :-
     integer(H),
     !,
-    once(has_head_(M, H)).
-head_(M, H) :-
-    setof(H0, has_head_(M, H0), Hs),
+    once(has_head_(H)).
+head(H) :-
+    setof(H0, has_head_(H0), Hs),
     member(H, Hs).
 
 %!  head_pairs(?Head, -Pairs:list) is nondet.
@@ -74,12 +64,8 @@ head_(M, H) :-
 %       Ps = [3-(sword-enemy), 1-(agent-sword)].
 
 head_pairs(H, Pairs) :-
-    context_module(M),
-    head_pairs_(M, H, Pairs).
-
-head_pairs_(M, H, Pairs) :-
-    head_(M, H),
-    findall(A-B, compares_(M, H, A, B), AB),
+    head(H),
+    findall(A-B, compares_(H, A, B), AB),
     msort(AB, Sorted),
     clumped(Sorted, Clumps),
     findall(N-P, member(P-N, Clumps), Counted),
@@ -94,11 +80,7 @@ head_pairs_(M, H, Pairs) :-
 %       A = sword, B = enemy, N = 3.
 
 head_top_pair(H, A, B, N) :-
-    context_module(M),
-    head_top_pair_(M, H, A, B, N).
-
-head_top_pair_(M, H, A, B, N) :-
-    head_pairs_(M, H, [N-(A-B)|_]).
+    head_pairs(H, [N-(A-B)|_]).
 
 %!  relation_stats(?J, -Count, -Mean, -Min, -Max) is nondet.
 %
@@ -108,13 +90,8 @@ head_top_pair_(M, H, A, B, N) :-
 %       N = 5, Mean = 0.1, Min = -0.75, Max = 1.0.
 
 relation_stats(J, N, Mean, Min, Max) :-
-    context_module(M),
-    relation_stats_(M, J, N, Mean, Min, Max).
-
-relation_stats_(M, J, N, Mean, Min, Max) :-
-    relation_index_(M, J),
-    aggregate_all(r(count, sum(V), min(V), max(V)), M:relation(_, _, _, J, _, _, V),
-                  r(N, Sum, Min, Max)),
+    relation_index_(J),
+    aggregate_all(r(count, sum(V), min(V), max(V)), relation(_, _, _, J, _, _, V), r(N, Sum, Min, Max)),
     Mean is Sum / N.
 
 %!  pair_strength(?J, ?A, ?B, -Count, -Mean) is nondet.
@@ -127,12 +104,8 @@ relation_stats_(M, J, N, Mean, Min, Max) :-
 %       N = 4, M = 0.625.
 
 pair_strength(J, A, B, N, Mean) :-
-    context_module(M),
-    pair_strength_(M, J, A, B, N, Mean).
-
-pair_strength_(M, J, A, B, N, Mean) :-
-    distinct(J-A-B, pair_(M, J, A, B)),
-    aggregate_all(r(count, sum(V)), oriented_value_(M, J, A, B, V), r(N, Sum)),
+    distinct(J-A-B, pair_(J, A, B)),
+    aggregate_all(r(count, sum(V)), oriented_value_(J, A, B, V), r(N, Sum)),
     Mean is Sum / N.
 
 %!  held_count(?J, ?A, ?B, -Count) is nondet.
@@ -143,12 +116,8 @@ pair_strength_(M, J, A, B, N, Mean) :-
 %       N = 2.
 
 held_count(J, A, B, N) :-
-    context_module(M),
-    held_count_(M, J, A, B, N).
-
-held_count_(M, J, A, B, N) :-
-    distinct(J-A-B, M:holds(_, _, r(J), A, B)),
-    aggregate_all(count, M:holds(_, _, r(J), A, B), N).
+    distinct(J-A-B, holds(_, _, r(J), A, B)),
+    aggregate_all(count, holds(_, _, r(J), A, B), N).
 
 %!  consistently_orders(?J, ?A, ?B) is nondet.
 %
@@ -159,13 +128,9 @@ held_count_(M, J, A, B, N) :-
 %       J = 0.
 
 consistently_orders(J, A, B) :-
-    context_module(M),
-    consistently_orders_(M, J, A, B).
-
-consistently_orders_(M, J, A, B) :-
-    distinct(J-A-B, M:holds(_, _, r(J), A, B)),
+    distinct(J-A-B, holds(_, _, r(J), A, B)),
     A \== B,
-    \+ M:holds(_, _, r(J), B, A).
+    \+ holds(_, _, r(J), B, A).
 
 %!  order_support(?J, ?A, ?B, -For, -Against) is nondet.
 %
@@ -176,13 +141,9 @@ consistently_orders_(M, J, A, B) :-
 %       F = 2, A = 1.
 
 order_support(J, A, B, For, Against) :-
-    context_module(M),
-    order_support_(M, J, A, B, For, Against).
-
-order_support_(M, J, A, B, For, Against) :-
-    held_count_(M, J, A, B, For),
+    held_count(J, A, B, For),
     A \== B,
-    aggregate_all(count, M:holds(_, _, r(J), B, A), Against).
+    aggregate_all(count, holds(_, _, r(J), B, A), Against).
 
 %!  strongest_pairs(+N, -Top:list) is det.
 %
@@ -193,11 +154,7 @@ order_support_(M, J, A, B, For, Against) :-
 %       Top = [held(0, sword, enemy, 2)].
 
 strongest_pairs(N, Top) :-
-    context_module(M),
-    strongest_pairs_(M, N, Top).
-
-strongest_pairs_(M, N, Top) :-
-    findall(k(NC, J, A, B), ( held_count_(M, J, A, B, C), A \== B, NC is -C ), Keys),
+    findall(k(NC, J, A, B), ( held_count(J, A, B, C), A \== B, NC is -C ), Keys),
     msort(Keys, Sorted),
     length(Sorted, Len),
     K is min(N, Len),
@@ -207,25 +164,23 @@ strongest_pairs_(M, N, Top) :-
 
 % ------------------------------------------------------------------ helpers
 
-has_head_(M, H) :- M:relation(_, _, H, _, _, _, _).
-has_head_(M, H) :- M:attention(_, _, H, _, _, _).
+has_head_(H) :- relation(_, _, H, _, _, _, _).
+has_head_(H) :- attention(_, _, H, _, _, _).
 
-%   compares_(+M, ?H, ?A, ?B): one answer per state at which head H compared
+%   compares_(?H, ?A, ?B): one answer per state at which head H compared
 %   A (first argument / query) with B. PrediNet rows exist for every relation
 %   J at each state; counting the J = 0 rows counts the states once.
-compares_(M, H, A, B) :- M:relation(_, _, H, 0, A, B, _).
-compares_(M, H, A, B) :- M:attention(_, _, H, A, B, _).
+compares_(H, A, B) :- relation(_, _, H, 0, A, B, _).
+compares_(H, A, B) :- attention(_, _, H, A, B, _).
 
-relation_index_(M, J) :-
-    setof(J0, relation_j_(M, J0), Js),
+relation_index_(J) :-
+    setof(J0, E^T^H^A^B^V^relation(E, T, H, J0, A, B, V), Js),
     member(J, Js).
 
-relation_j_(M, J) :- M:relation(_, _, _, J, _, _, _).
+pair_(J, A, B) :- relation(_, _, _, J, A, B, _), A \== B.
+pair_(J, A, B) :- relation(_, _, _, J, B, A, _), A \== B.
 
-pair_(M, J, A, B) :- M:relation(_, _, _, J, A, B, _), A \== B.
-pair_(M, J, A, B) :- M:relation(_, _, _, J, B, A, _), A \== B.
-
-oriented_value_(M, J, A, B, V) :- M:relation(_, _, _, J, A, B, V).
-oriented_value_(M, J, A, B, V) :- M:relation(_, _, _, J, B, A, V0), V is -V0.
+oriented_value_(J, A, B, V) :- relation(_, _, _, J, A, B, V).
+oriented_value_(J, A, B, V) :- relation(_, _, _, J, B, A, V0), V is -V0.
 
 held_(k(NC, J, A, B), held(J, A, B, C)) :- C is -NC.

@@ -14,12 +14,11 @@
     Time: event(E, T, Ev) is the transition from state T to T+1, so "before"
     compares those T. Meeting the enemy is defeated(enemy) or hurt_by(enemy).
 
-    A module (rgw), loaded once per process: its predicates read the facts
-    of the module they are called from (module transparent, see
-    lib/kb_common.pl), user in plain swipl, the KB's own module in
-    neurosym.prolog.KnowledgeBase. Its helpers stay inside it, so it loads
-    beside the other rule files without clashes. A copy to edit needs lib/
-    beside it, and another module name.
+    A module (rgw) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
 
 :- module(rgw,
@@ -38,16 +37,8 @@
 :- use_module(library(pairs)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
-:- use_module(lib/kb_common).
 
-% Each exported predicate finds the facts' module (M) and passes it to its
-% worker (name_/N+1), which reads the facts as M:Fact. The transparent
-% clause itself makes no meta-call: a goal it passed to findall/3 and the
-% like would be looked up in M, where this module's helpers are not.
-:- module_transparent
-    sword_before_enemy/1, teleport_before_enemy/1, enemy_beaten_with_sword/1,
-    visit_order/2, optimal_order/1, orders_sword_before_enemy/1,
-    sword_enemy_direct/1, sword_enemy_via/1, sword_enemy_link/1.
+:- include(lib/kb_common).
 
 %!  sword_before_enemy(?Episode) is nondet.
 %
@@ -59,13 +50,9 @@
 %       E = 3.
 
 sword_before_enemy(E) :-
-    context_module(M),
-    sword_before_enemy_(M, E).
-
-sword_before_enemy_(M, E) :-
-    kb_episode(M, E),
-    kb_first_event(M, E, picked(sword), Ts),
-    first_enemy_(M, E, Te),
+    kb_episode_(E),
+    kb_first_event_(E, picked(sword), Ts),
+    first_enemy_(E, Te),
     Ts < Te.
 
 %!  teleport_before_enemy(?Episode) is nondet.
@@ -76,13 +63,9 @@ sword_before_enemy_(M, E) :-
 %       true.
 
 teleport_before_enemy(E) :-
-    context_module(M),
-    teleport_before_enemy_(M, E).
-
-teleport_before_enemy_(M, E) :-
-    kb_episode(M, E),
-    kb_first_event(M, E, teleported, Tt),
-    first_enemy_(M, E, Te),
+    kb_episode_(E),
+    kb_first_event_(E, teleported, Tt),
+    first_enemy_(E, Te),
     Tt < Te.
 
 %!  enemy_beaten_with_sword(?Episode) is nondet.
@@ -94,14 +77,10 @@ teleport_before_enemy_(M, E) :-
 %       E = 0.
 
 enemy_beaten_with_sword(E) :-
-    context_module(M),
-    enemy_beaten_with_sword_(M, E).
-
-enemy_beaten_with_sword_(M, E) :-
-    kb_episode(M, E),
-    once(( M:event(E, T, Event),
+    kb_episode_(E),
+    once(( event(E, T, Event),
            Event == defeated(enemy),
-           M:holding(E, T1, Item),
+           holding(E, T1, Item),
            T1 == T,
            Item == sword )).
 
@@ -115,12 +94,8 @@ enemy_beaten_with_sword_(M, E) :-
 %       Order = [sword, teleport, enemy, terminal].
 
 visit_order(E, Order) :-
-    context_module(M),
-    visit_order_(M, E, Order).
-
-visit_order_(M, E, Order) :-
-    kb_episode(M, E),
-    findall(T-Object, ( M:event(E, T, Event), visit_(Event, Object) ), Pairs0),
+    kb_episode_(E),
+    findall(T-Object, ( event(E, T, Event), visit_(Event, Object) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Objects),
     list_to_set(Objects, Order).
@@ -134,8 +109,7 @@ visit_order_(M, E, Order) :-
 %       E = 0.
 
 optimal_order(E) :-
-    context_module(M),
-    visit_order_(M, E, [sword, teleport, enemy, terminal]).
+    visit_order(E, [sword, teleport, enemy, terminal]).
 
 %!  orders_sword_before_enemy(?Relation) is nondet.
 %
@@ -147,12 +121,8 @@ optimal_order(E) :-
 %       R = r(1).
 
 orders_sword_before_enemy(R) :-
-    context_module(M),
-    orders_sword_before_enemy_(M, R).
-
-orders_sword_before_enemy_(M, R) :-
-    distinct(R, M:holds(_, _, R, sword, enemy)),
-    \+ M:holds(_, _, R, enemy, sword).
+    distinct(R, holds(_, _, R, sword, enemy)),
+    \+ holds(_, _, R, enemy, sword).
 
 %!  sword_enemy_direct(?Link) is nondet.
 %
@@ -165,11 +135,7 @@ orders_sword_before_enemy_(M, R) :-
 %       L = r(1).
 
 sword_enemy_direct(Link) :-
-    context_module(M),
-    sword_enemy_direct_(M, Link).
-
-sword_enemy_direct_(M, Link) :-
-    distinct(Link, kb_link(M, sword, enemy, Link)).
+    distinct(Link, kb_link_(sword, enemy, Link)).
 
 %!  sword_enemy_via(?Object) is nondet.
 %
@@ -183,15 +149,11 @@ sword_enemy_direct_(M, Link) :-
 %       X = teleport.
 
 sword_enemy_via(X) :-
-    context_module(M),
-    sword_enemy_via_(M, X).
-
-sword_enemy_via_(M, X) :-
-    entity_type_(M, X),
+    entity_type_(X),
     X \== sword,
     X \== enemy,
-    once(kb_link(M, sword, X, _)),
-    once(kb_link(M, X, enemy, _)).
+    once(kb_link_(sword, X, _)),
+    once(kb_link_(X, enemy, _)).
 
 %!  sword_enemy_link(-Answer) is det.
 %
@@ -203,14 +165,10 @@ sword_enemy_via_(M, X) :-
 %       A = direct([r(1), r(0)]).
 
 sword_enemy_link(Answer) :-
-    context_module(M),
-    sword_enemy_link_(M, Answer).
-
-sword_enemy_link_(M, Answer) :-
-    findall(L, sword_enemy_direct_(M, L), Links),
+    findall(L, sword_enemy_direct(L), Links),
     (   Links \== []
     ->  Answer = direct(Links)
-    ;   findall(X, sword_enemy_via_(M, X), Xs),
+    ;   findall(X, sword_enemy_via(X), Xs),
         (   Xs \== []
         ->  Answer = indirect(Xs)
         ;   Answer = none
@@ -221,9 +179,9 @@ sword_enemy_link_(M, Answer) :-
 %
 % Episodes, first events and the network's links: lib/kb_common.pl.
 
-%   first_enemy_(+M, +E, -T): the first time the agent met the enemy in E.
-first_enemy_(M, E, T) :-
-    aggregate_all(min(T0), ( M:event(E, T0, Ev), meets_enemy_(Ev) ), T).
+%   first_enemy_(+E, -T): the first time the agent met the enemy in E.
+first_enemy_(E, T) :-
+    aggregate_all(min(T0), ( event(E, T0, Ev), meets_enemy_(Ev) ), T).
 
 meets_enemy_(defeated(enemy)).
 meets_enemy_(hurt_by(enemy)).
@@ -236,6 +194,6 @@ visit_(hurt_by(enemy), enemy).
 visit_(reached(terminal), terminal).
 visit_(fell(pit), pit).
 
-%   entity_type_(+M, -Type): object types of the map, and the agent; each once.
-entity_type_(M, Type) :-
-    distinct(Type, ( Type = agent ; M:object(_, Type) )).
+%   entity_type_(-Type): object types of the map, and the agent; each once.
+entity_type_(Type) :-
+    distinct(Type, ( Type = agent ; object(_, Type) )).
