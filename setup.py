@@ -1,9 +1,10 @@
 """Packages and package data of the wheel (the rest of the metadata is in pyproject.toml).
 
-The repository's rules/ (the source of truth, beside its plunit files) and
-checkpoints/ (the curated agents) are mapped into the package as
-``neurosym.rules`` and ``neurosym.checkpoints``: an installed neurosym finds its
-rule files and agents without a clone, and nothing is copied in the repository.
+The repository's rules/ (the source of truth, beside its plunit files; rules/lib/
+holds the module the rule files share) and checkpoints/ (the curated agents) are
+mapped into the package as ``neurosym.rules`` and ``neurosym.checkpoints``: an
+installed neurosym finds its rule files and agents without a clone, and nothing
+is copied in the repository.
 The Prolog modules of the janus bridge (neurosym/prolog/pl/*.pl) ship as
 package data; their plunit files (*.plt) stay behind.
 """
@@ -24,7 +25,7 @@ setup(
         "neurosym.induce": ["pl/*.pl"],  # the Prolog text learned files carry
         "neurosym.play": ["pl/*.pl"],  # the Prolog half of neurosym play
         "neurosym.webreport": ["templates/*"],
-        "neurosym.rules": ["*.pl"],
+        "neurosym.rules": ["*.pl", "lib/*.pl"],
         "neurosym.checkpoints": ["*.pt"],
     },
     exclude_package_data={"neurosym.rules": ["tests/*"]},

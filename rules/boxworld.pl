@@ -11,14 +11,38 @@
         opened(lock(C)) | hit(distractor)), episode(E, Steps, Return, Outcome)
         holds/5, attention/6, attends/8 for the network-level rules; the held
         key is the entity held(C) (drawn in the top-left border cell).
-    The map of an episode is read at its state 0. Helpers end in _ and start
-    with bw_, so this file loads beside the other rule files without clashes.
+    The map of an episode is read at its state 0.
+
+    A module (boxworld) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
+
+:- module(boxworld,
+          [ box/3,
+            loose_key/2,
+            solution_chain/2,
+            distractor_box/3,
+            key_opens/2,
+            got_order/2,
+            gem_chain/2,
+            followed_solution/1,
+            distractor_taken/1,
+            distractor_avoided/1,
+            key_lock_link/2,
+            wrong_key_lock_link/3,
+            attends_matching_lock/3,
+            matching_lock_rate/2
+          ]).
 
 :- use_module(library(lists)).
 :- use_module(library(pairs)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
+
+:- include(lib/kb_common).
 
 %!  box(?Episode, ?Lock, ?Content) is nondet.
 %
@@ -29,7 +53,7 @@
 %       X = key(blue).
 
 box(E, Lock, Content) :-
-    bw_box_(E, Lock, Content, _, _).
+    box_at_(E, Lock, Content, _, _).
 
 %!  loose_key(?Episode, ?Key) is nondet.
 %
@@ -56,7 +80,7 @@ loose_key(E, key(C)) :-
 
 solution_chain(E, [Key|Rest]) :-
     loose_key(E, Key),
-    bw_chain_from_(E, Key, [Key], Rest).
+    chain_from_(E, Key, [Key], Rest).
 
 %!  distractor_box(?Episode, ?Lock, ?Content) is nondet.
 %
@@ -68,7 +92,7 @@ solution_chain(E, [Key|Rest]) :-
 
 distractor_box(E, Lock, Content) :-
     box(E, Lock, Content),
-    \+ bw_on_chain_(E, Lock, Content).
+    \+ on_chain_(E, Lock, Content).
 
 %!  key_opens(?Key, ?Lock) is nondet.
 %
@@ -90,7 +114,7 @@ key_opens(Key, Lock) :-
 %       Items = [key(red), key(blue), gem].
 
 got_order(E, Items) :-
-    bw_episode_(E),
+    kb_episode_(E),
     findall(T-I, ( event(E, T, Ev), Ev = got(I) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Items).
@@ -126,8 +150,8 @@ followed_solution(E) :-
 %       E = 1.
 
 distractor_taken(E) :-
-    bw_episode_(E),
-    bw_event_(E, hit(distractor)).
+    kb_episode_(E),
+    kb_event_(E, hit(distractor)).
 
 %!  distractor_avoided(?Episode) is nondet.
 %
@@ -138,10 +162,10 @@ distractor_taken(E) :-
 %       E = 0.
 
 distractor_avoided(E) :-
-    bw_episode_(E),
+    kb_episode_(E),
     once(distractor_box(E, _, _)),
-    bw_event_(E, got(gem)),
-    \+ bw_event_(E, hit(distractor)).
+    kb_event_(E, got(gem)),
+    \+ kb_event_(E, hit(distractor)).
 
 %!  key_lock_link(?Colour, ?Link) is nondet.
 %
@@ -153,7 +177,7 @@ distractor_avoided(E) :-
 %       C = red, L = r(1).
 
 key_lock_link(C, Link) :-
-    distinct(C-Link, ( bw_link_(K, lock(C), Link), bw_key_colour_(K, C) )).
+    distinct(C-Link, ( kb_link_(K, lock(C), Link), key_colour_(K, C) )).
 
 %!  wrong_key_lock_link(?Key, ?Lock, ?Link) is nondet.
 %
@@ -164,8 +188,8 @@ key_lock_link(C, Link) :-
 %       K = held(red), L = lock(green), R = r(0).
 
 wrong_key_lock_link(Key, lock(C2), Link) :-
-    distinct(Key-C2-Link, ( bw_link_(Key, lock(C2), Link),
-                            bw_key_colour_(Key, C1),
+    distinct(Key-C2-Link, ( kb_link_(Key, lock(C2), Link),
+                            key_colour_(Key, C1),
                             C1 \== C2 )).
 
 %!  attends_matching_lock(?Episode, ?T, ?Head) is nondet.
@@ -197,46 +221,34 @@ matching_lock_rate(Attended, Holding) :-
                   Attended).
 
 % ------------------------------------------------------------------ helpers
+%
+% Episodes, events and the network's links: lib/kb_common.pl.
 
-bw_episode_(E) :-
-    episode(E, _, _, _).
-
-%   bw_event_(+E, +Event): Event happened in E. Looked up by episode only, so
-%   SWI-Prolog needs no composite (episode, event) index (see rgw.pl).
-bw_event_(E, Event) :-
-    once(( event(E, _, Ev), Ev == Event )).
-
-%   bw_box_(?E, ?Lock, ?Content, ?Row, ?Col): a box at the start of E, its
+%   box_at_(?E, ?Lock, ?Content, ?Row, ?Col): a box at the start of E, its
 %   lock at (Row, Col) and its content at (Row, Col - 1).
-bw_box_(E, lock(C), Content, R, Col) :-
+box_at_(E, lock(C), Content, R, Col) :-
     at(E, 0, LockId, R, Col),
     object(LockId, lock(C)),
     Left is Col - 1,
     at(E, 0, ContentId, R, Left),
     object(ContentId, Content).
 
-%   bw_chain_from_(+E, +Key, +Seen, -Rest): Rest leads from Key to the gem.
-bw_chain_from_(E, key(C), Seen, Chain) :-
+%   chain_from_(+E, +Key, +Seen, -Rest): Rest leads from Key to the gem.
+chain_from_(E, key(C), Seen, Chain) :-
     box(E, lock(C), Content),
     \+ memberchk(Content, Seen),
     (   Content == gem
     ->  Chain = [gem]
     ;   Chain = [Content|Rest],
-        bw_chain_from_(E, Content, [Content|Seen], Rest)
+        chain_from_(E, Content, [Content|Seen], Rest)
     ).
 
-%   bw_on_chain_(+E, +Lock, +Content): the box Lock/Content is a step of a
+%   on_chain_(+E, +Lock, +Content): the box Lock/Content is a step of a
 %   solution chain of E (key(C) followed by Content, Lock = lock(C)).
-bw_on_chain_(E, lock(C), Content) :-
+on_chain_(E, lock(C), Content) :-
     solution_chain(E, Chain),
     nextto(key(C), Content, Chain),
     !.
 
-bw_key_colour_(key(C), C).
-bw_key_colour_(held(C), C).
-
-%   bw_link_(?A, ?B, -Link): the network relates A and B (either orientation).
-bw_link_(A, B, R) :- holds(_, _, R, A, B).
-bw_link_(A, B, R) :- holds(_, _, R, B, A).
-bw_link_(A, B, attention(H)) :- attention(_, _, H, A, B, _).
-bw_link_(A, B, attention(H)) :- attention(_, _, H, B, A, _).
+key_colour_(key(C), C).
+key_colour_(held(C), C).

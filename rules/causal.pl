@@ -24,12 +24,26 @@
     * none: no experiment says either.
 
     A change counts when it is at least causal_margin/1 (a share of episodes).
-    Helpers end in _ and start with causal_.
+
+    A module (causal) whose helpers stay inside it. It reads the facts as
+    unqualified goals, which resolve through its default import module:
+    user in plain swipl, the KB's own module in neurosym.prolog.KnowledgeBase
+    (which loads the rule modules once per KB, see lib/kb_common.pl). A KB
+    without facts of one of the four predicates above is read as having none
+    of them (kb_fact_/1), as when they are declared dynamic.
 */
+
+:- module(causal,
+          [ causal_margin/1,
+            sword_enemy_cause/1,
+            direct_evidence/1,
+            correlational_evidence/1,
+            level_experiment/2
+          ]).
 
 :- use_module(library(lists)).
 
-:- dynamic experiment/3, measure/3, effect/3, relates/4.
+:- include(lib/kb_common).
 
 %!  causal_margin(-Share:float) is det.
 %
@@ -78,23 +92,23 @@ sword_enemy_cause(Answer) :-
 direct_evidence(avoids_enemy_without_sword([measure(baseline, sword_before_enemy, B),
                                             effect(X, enemy_met, D)])) :-
     causal_margin(M),
-    measure(baseline, sword_before_enemy, B),
+    kb_fact_(measure(baseline, sword_before_enemy, B)),
     B >= M,
-    experiment(X, remove(sword), _),
-    effect(X, enemy_met, D),
+    kb_fact_(experiment(X, remove(sword), _)),
+    kb_fact_(effect(X, enemy_met, D)),
     D =< -M,
-    \+ causal_unarmed_meeting_(_, _).
+    \+ unarmed_meeting_(_, _).
 direct_evidence(ablation_breaks_order([experiment(X, ablate(head(H))),
                                        relates(H, A, B, S),
                                        measure(baseline, sword_before_enemy, B0),
                                        effect(X, sword_before_enemy, D)])) :-
     causal_margin(M),
-    measure(baseline, sword_before_enemy, B0),
+    kb_fact_(measure(baseline, sword_before_enemy, B0)),
     B0 >= M,
-    experiment(X, ablate(head(H)), _),
-    causal_relates_(H, A, B, S),
+    kb_fact_(experiment(X, ablate(head(H)), _)),
+    relates_(H, A, B, S),
     S > 0,
-    effect(X, sword_before_enemy, D),
+    kb_fact_(effect(X, sword_before_enemy, D)),
     D =< -M.
 
 %!  correlational_evidence(-Evidence) is nondet.
@@ -109,9 +123,9 @@ direct_evidence(ablation_breaks_order([experiment(X, ablate(head(H))),
 correlational_evidence(meets_enemy_unarmed([measure(baseline, enemy_defeated, B),
                                             measure(X, enemy_unarmed, V)])) :-
     causal_margin(M),
-    measure(baseline, enemy_defeated, B),
+    kb_fact_(measure(baseline, enemy_defeated, B)),
     B >= M,
-    causal_unarmed_meeting_(X, V).
+    unarmed_meeting_(X, V).
 
 %!  level_experiment(?X, ?Kind) is nondet.
 %
@@ -121,24 +135,24 @@ correlational_evidence(meets_enemy_unarmed([measure(baseline, enemy_defeated, B)
 %       X = remove_sword.
 
 level_experiment(X, Kind) :-
-    experiment(X, Kind, _),
-    causal_level_kind_(Kind).
+    kb_fact_(experiment(X, Kind, _)),
+    level_kind_(Kind).
 
 % ------------------------------------------------------------------ helpers
 
-%   causal_unarmed_meeting_(?X, ?Share): on level X the agent met the enemy
+%   unarmed_meeting_(?X, ?Share): on level X the agent met the enemy
 %   without the sword in at least causal_margin/1 of the episodes.
-causal_unarmed_meeting_(X, V) :-
+unarmed_meeting_(X, V) :-
     causal_margin(M),
     level_experiment(X, _),
-    measure(X, enemy_unarmed, V),
+    kb_fact_(measure(X, enemy_unarmed, V)),
     V >= M.
 
-causal_level_kind_(baseline).
-causal_level_kind_(remove(_)).
-causal_level_kind_(move(_, _, _)).
-causal_level_kind_(swap(_, _)).
+level_kind_(baseline).
+level_kind_(remove(_)).
+level_kind_(move(_, _, _)).
+level_kind_(swap(_, _)).
 
-%   causal_relates_(?H, -A, -B, -Share): head H relates sword and enemy (either order).
-causal_relates_(H, sword, enemy, S) :- relates(H, sword, enemy, S).
-causal_relates_(H, enemy, sword, S) :- relates(H, enemy, sword, S).
+%   relates_(?H, -A, -B, -Share): head H relates sword and enemy (either order).
+relates_(H, sword, enemy, S) :- kb_fact_(relates(H, sword, enemy, S)).
+relates_(H, enemy, sword, S) :- kb_fact_(relates(H, enemy, sword, S)).

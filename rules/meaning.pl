@@ -11,14 +11,30 @@
     Selectivity = Accuracy - Control (Hewitt and Liang 2019). A relation earns a
     name when some head's probe of it is at least min_selectivity/1 selective:
     W_S is shared by all heads, so relation j means the same thing in every head.
-    Helpers end in _ and start with meaning_.
+
+    A module (meaning) whose helpers stay inside it. It reads the facts as
+    unqualified goals, which resolve through its default import module:
+    user in plain swipl, the KB's own module in neurosym.prolog.KnowledgeBase
+    (which loads the rule modules once per KB, see lib/kb_common.pl). A KB
+    without facts of one of the three predicates above is read as having none
+    of them (kb_fact_/1), as when they are declared dynamic.
 */
+
+:- module(meaning,
+          [ min_selectivity/1,
+            selectivity/4,
+            relation_means/2,
+            relation_name/3,
+            head_encodes/3,
+            training_added/4,
+            named_holds/5
+          ]).
 
 :- use_module(library(lists)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
 
-:- dynamic probe/5, probe_untrained/5, holds/5.
+:- include(lib/kb_common).
 
 %!  min_selectivity(-S:float) is det.
 %
@@ -37,7 +53,7 @@ min_selectivity(0.2).
 %       S = 0.42.
 
 selectivity(H, J, P, S) :-
-    probe(H, J, P, Acc, Ctl),
+    kb_fact_(probe(H, J, P, Acc, Ctl)),
     S is Acc - Ctl.
 
 %!  relation_means(?Relation, ?Predicate) is nondet.
@@ -62,7 +78,7 @@ relation_means(r(J), P) :-
 
 relation_name(r(J), P, S) :-
     min_selectivity(Min),
-    distinct(J, ( probe(_, J, _, _, _), integer(J) )),
+    distinct(J, ( kb_fact_(probe(_, J, _, _, _)), integer(J) )),
     aggregate_all(max(S0, P0), ( selectivity(_, J, P0, S0) ), max(S, P)),
     S >= Min.
 
@@ -90,7 +106,7 @@ training_added(H, J, P, Gain) :-
     min_selectivity(Min),
     selectivity(H, J, P, S),
     S >= Min,
-    probe_untrained(H, J, P, Acc0, Ctl0),
+    kb_fact_(probe_untrained(H, J, P, Acc0, Ctl0)),
     Gain is S - (Acc0 - Ctl0).
 
 %!  named_holds(?E, ?T, ?Name, ?A, ?B) is nondet.
@@ -103,4 +119,4 @@ training_added(H, J, P, Gain) :-
 
 named_holds(E, T, Name, A, B) :-
     relation_name(R, Name, _),
-    holds(E, T, R, A, B).
+    kb_fact_(holds(E, T, R, A, B)).

@@ -10,9 +10,25 @@
         attention(E, T, Head, Query, Key, W)   MHDPA: strongest keys per query
     Heads and relations count from 0. Entities are named by type (sword,
     key(red), ...), so these rules speak about types, not single objects.
-    Helpers end in _ and start with rel_, so this file loads beside the other
-    rule files without clashes.
+
+    A module (relations) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
+
+:- module(relations,
+          [ head/1,
+            head_pairs/2,
+            head_top_pair/4,
+            relation_stats/5,
+            pair_strength/5,
+            held_count/4,
+            consistently_orders/3,
+            order_support/5,
+            strongest_pairs/2
+          ]).
 
 :- use_module(library(lists)).
 :- use_module(library(pairs)).
@@ -32,9 +48,9 @@
 head(H) :-
     integer(H),
     !,
-    once(rel_head_(H)).
+    once(has_head_(H)).
 head(H) :-
-    setof(H0, rel_head_(H0), Hs),
+    setof(H0, has_head_(H0), Hs),
     member(H, Hs).
 
 %!  head_pairs(?Head, -Pairs:list) is nondet.
@@ -49,7 +65,7 @@ head(H) :-
 
 head_pairs(H, Pairs) :-
     head(H),
-    findall(A-B, rel_compares_(H, A, B), AB),
+    findall(A-B, compares_(H, A, B), AB),
     msort(AB, Sorted),
     clumped(Sorted, Clumps),
     findall(N-P, member(P-N, Clumps), Counted),
@@ -74,7 +90,7 @@ head_top_pair(H, A, B, N) :-
 %       N = 5, Mean = 0.1, Min = -0.75, Max = 1.0.
 
 relation_stats(J, N, Mean, Min, Max) :-
-    rel_relation_index_(J),
+    relation_index_(J),
     aggregate_all(r(count, sum(V), min(V), max(V)), relation(_, _, _, J, _, _, V), r(N, Sum, Min, Max)),
     Mean is Sum / N.
 
@@ -88,8 +104,8 @@ relation_stats(J, N, Mean, Min, Max) :-
 %       N = 4, M = 0.625.
 
 pair_strength(J, A, B, N, Mean) :-
-    distinct(J-A-B, rel_pair_(J, A, B)),
-    aggregate_all(r(count, sum(V)), rel_oriented_value_(J, A, B, V), r(N, Sum)),
+    distinct(J-A-B, pair_(J, A, B)),
+    aggregate_all(r(count, sum(V)), oriented_value_(J, A, B, V), r(N, Sum)),
     Mean is Sum / N.
 
 %!  held_count(?J, ?A, ?B, -Count) is nondet.
@@ -144,27 +160,27 @@ strongest_pairs(N, Top) :-
     K is min(N, Len),
     length(First, K),
     append(First, _, Sorted),
-    maplist(rel_held_, First, Top).
+    maplist(held_, First, Top).
 
 % ------------------------------------------------------------------ helpers
 
-rel_head_(H) :- relation(_, _, H, _, _, _, _).
-rel_head_(H) :- attention(_, _, H, _, _, _).
+has_head_(H) :- relation(_, _, H, _, _, _, _).
+has_head_(H) :- attention(_, _, H, _, _, _).
 
-%   rel_compares_(?H, ?A, ?B): one answer per state at which head H compared
+%   compares_(?H, ?A, ?B): one answer per state at which head H compared
 %   A (first argument / query) with B. PrediNet rows exist for every relation
 %   J at each state; counting the J = 0 rows counts the states once.
-rel_compares_(H, A, B) :- relation(_, _, H, 0, A, B, _).
-rel_compares_(H, A, B) :- attention(_, _, H, A, B, _).
+compares_(H, A, B) :- relation(_, _, H, 0, A, B, _).
+compares_(H, A, B) :- attention(_, _, H, A, B, _).
 
-rel_relation_index_(J) :-
+relation_index_(J) :-
     setof(J0, E^T^H^A^B^V^relation(E, T, H, J0, A, B, V), Js),
     member(J, Js).
 
-rel_pair_(J, A, B) :- relation(_, _, _, J, A, B, _), A \== B.
-rel_pair_(J, A, B) :- relation(_, _, _, J, B, A, _), A \== B.
+pair_(J, A, B) :- relation(_, _, _, J, A, B, _), A \== B.
+pair_(J, A, B) :- relation(_, _, _, J, B, A, _), A \== B.
 
-rel_oriented_value_(J, A, B, V) :- relation(_, _, _, J, A, B, V).
-rel_oriented_value_(J, A, B, V) :- relation(_, _, _, J, B, A, V0), V is -V0.
+oriented_value_(J, A, B, V) :- relation(_, _, _, J, A, B, V).
+oriented_value_(J, A, B, V) :- relation(_, _, _, J, B, A, V0), V is -V0.
 
-rel_held_(k(NC, J, A, B), held(J, A, B, C)) :- C is -NC.
+held_(k(NC, J, A, B), held(J, A, B, C)) :- C is -NC.

@@ -13,14 +13,32 @@
 
     Time: event(E, T, Ev) is the transition from state T to T+1, so "before"
     compares those T. Meeting the enemy is defeated(enemy) or hurt_by(enemy).
-    Helpers end in _ and start with rgw_, so this file loads beside the other
-    rule files without clashes.
+
+    A module (rgw) whose helpers stay inside it, so it loads beside the
+    other rule files without clashes. It reads the facts as unqualified
+    goals, which resolve through its default import module: user in plain
+    swipl, the KB's own module in neurosym.prolog.KnowledgeBase (which loads
+    the rule modules once per KB, see lib/kb_common.pl).
 */
+
+:- module(rgw,
+          [ sword_before_enemy/1,
+            teleport_before_enemy/1,
+            enemy_beaten_with_sword/1,
+            visit_order/2,
+            optimal_order/1,
+            orders_sword_before_enemy/1,
+            sword_enemy_direct/1,
+            sword_enemy_via/1,
+            sword_enemy_link/1
+          ]).
 
 :- use_module(library(lists)).
 :- use_module(library(pairs)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
+
+:- include(lib/kb_common).
 
 %!  sword_before_enemy(?Episode) is nondet.
 %
@@ -32,9 +50,9 @@
 %       E = 3.
 
 sword_before_enemy(E) :-
-    rgw_episode_(E),
-    rgw_first_event_(E, picked(sword), Ts),
-    rgw_first_enemy_(E, Te),
+    kb_episode_(E),
+    kb_first_event_(E, picked(sword), Ts),
+    first_enemy_(E, Te),
     Ts < Te.
 
 %!  teleport_before_enemy(?Episode) is nondet.
@@ -45,9 +63,9 @@ sword_before_enemy(E) :-
 %       true.
 
 teleport_before_enemy(E) :-
-    rgw_episode_(E),
-    rgw_first_event_(E, teleported, Tt),
-    rgw_first_enemy_(E, Te),
+    kb_episode_(E),
+    kb_first_event_(E, teleported, Tt),
+    first_enemy_(E, Te),
     Tt < Te.
 
 %!  enemy_beaten_with_sword(?Episode) is nondet.
@@ -59,7 +77,7 @@ teleport_before_enemy(E) :-
 %       E = 0.
 
 enemy_beaten_with_sword(E) :-
-    rgw_episode_(E),
+    kb_episode_(E),
     once(( event(E, T, Event),
            Event == defeated(enemy),
            holding(E, T1, Item),
@@ -76,8 +94,8 @@ enemy_beaten_with_sword(E) :-
 %       Order = [sword, teleport, enemy, terminal].
 
 visit_order(E, Order) :-
-    rgw_episode_(E),
-    findall(T-Object, ( event(E, T, Event), rgw_visit_(Event, Object) ), Pairs0),
+    kb_episode_(E),
+    findall(T-Object, ( event(E, T, Event), visit_(Event, Object) ), Pairs0),
     keysort(Pairs0, Pairs),
     pairs_values(Pairs, Objects),
     list_to_set(Objects, Order).
@@ -117,7 +135,7 @@ orders_sword_before_enemy(R) :-
 %       L = r(1).
 
 sword_enemy_direct(Link) :-
-    distinct(Link, rgw_link_(sword, enemy, Link)).
+    distinct(Link, kb_link_(sword, enemy, Link)).
 
 %!  sword_enemy_via(?Object) is nondet.
 %
@@ -131,11 +149,11 @@ sword_enemy_direct(Link) :-
 %       X = teleport.
 
 sword_enemy_via(X) :-
-    rgw_entity_type_(X),
+    entity_type_(X),
     X \== sword,
     X \== enemy,
-    once(rgw_link_(sword, X, _)),
-    once(rgw_link_(X, enemy, _)).
+    once(kb_link_(sword, X, _)),
+    once(kb_link_(X, enemy, _)).
 
 %!  sword_enemy_link(-Answer) is det.
 %
@@ -158,42 +176,24 @@ sword_enemy_link(Answer) :-
     ).
 
 % ------------------------------------------------------------------ helpers
-
-%   rgw_episode_(?E): E is an episode; enumerates in episode order.
-rgw_episode_(E) :-
-    episode(E, _, _, _).
-
-%   rgw_first_event_(+E, +Event, -T): T is the first time Event happened in E;
-%   fails when it never did.
 %
-%   Speed: the rules look events up by episode only (event(E, T, Ev) with E
-%   bound, then compare Ev), so SWI-Prolog builds one just-in-time index, on
-%   the first argument, and no composite index on (E, Event), whose
-%   construction dominated the first call over large KBs.
-rgw_first_event_(E, Event, T) :-
-    aggregate_all(min(T0), ( event(E, T0, Ev), Ev == Event ), T).
+% Episodes, first events and the network's links: lib/kb_common.pl.
 
-%   rgw_first_enemy_(+E, -T): the first time the agent met the enemy in E.
-rgw_first_enemy_(E, T) :-
-    aggregate_all(min(T0), ( event(E, T0, Ev), rgw_meets_enemy_(Ev) ), T).
+%   first_enemy_(+E, -T): the first time the agent met the enemy in E.
+first_enemy_(E, T) :-
+    aggregate_all(min(T0), ( event(E, T0, Ev), meets_enemy_(Ev) ), T).
 
-rgw_meets_enemy_(defeated(enemy)).
-rgw_meets_enemy_(hurt_by(enemy)).
+meets_enemy_(defeated(enemy)).
+meets_enemy_(hurt_by(enemy)).
 
-%   rgw_visit_(+Event, -Object): the key object an event reaches.
-rgw_visit_(picked(sword), sword).
-rgw_visit_(teleported, teleport).
-rgw_visit_(defeated(enemy), enemy).
-rgw_visit_(hurt_by(enemy), enemy).
-rgw_visit_(reached(terminal), terminal).
-rgw_visit_(fell(pit), pit).
+%   visit_(+Event, -Object): the key object an event reaches.
+visit_(picked(sword), sword).
+visit_(teleported, teleport).
+visit_(defeated(enemy), enemy).
+visit_(hurt_by(enemy), enemy).
+visit_(reached(terminal), terminal).
+visit_(fell(pit), pit).
 
-%   rgw_link_(?A, ?B, -Link): the network relates A and B (either orientation).
-rgw_link_(A, B, R) :- holds(_, _, R, A, B).
-rgw_link_(A, B, R) :- holds(_, _, R, B, A).
-rgw_link_(A, B, attention(H)) :- attention(_, _, H, A, B, _).
-rgw_link_(A, B, attention(H)) :- attention(_, _, H, B, A, _).
-
-%   rgw_entity_type_(-Type): object types of the map, and the agent; each once.
-rgw_entity_type_(Type) :-
+%   entity_type_(-Type): object types of the map, and the agent; each once.
+entity_type_(Type) :-
     distinct(Type, ( Type = agent ; object(_, Type) )).

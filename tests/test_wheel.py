@@ -122,7 +122,9 @@ def test_the_wheel_needs_no_prolog_to_install_and_says_in_one_line_what_to_run(
 def test_the_wheel_carries_the_rule_files_and_the_agents(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
     rules = {n for n in names if n.endswith(".pl") and n.startswith("neurosym/rules/")}
-    assert rules == {f"neurosym/rules/{p.name}" for p in (REPO / "rules").glob("*.pl")}
+    shipped = [*(REPO / "rules").glob("*.pl"), *(REPO / "rules").glob("lib/*.pl")]
+    assert "lib/kb_common.pl" in {p.relative_to(REPO / "rules").as_posix() for p in shipped}
+    assert rules == {f"neurosym/rules/{p.relative_to(REPO / 'rules').as_posix()}" for p in shipped}
     modules = {n for n in names if n.endswith(".pl") and not n.startswith("neurosym/rules/")}
     assert modules == {  # the package's Prolog modules (their .plt files stay behind, see below)
         f"neurosym/{p.relative_to(REPO / 'neurosym')}" for p in (REPO / "neurosym").glob("*/pl/*.pl")

@@ -20,9 +20,14 @@ stops a running goal with :class:`KeyboardInterrupt` (Prolog checks for it
 every 100,000 inferences; the KB stays usable).
 
 Each KnowledgeBase lives in a Prolog module of its own, so several coexist in
-one process even when they load the same rule file. Files are plain Prolog
-(no module header); they are loaded under a per-module source id because
-SWI-Prolog will not load one non-module file into two modules.
+one process even when they load the same rule file. A rule file that is a
+module (the shipped ones: ``rules/rgw.pl`` is module ``rgw``) is loaded for
+each KB as a module of its own (``rgw@<KB module>``) whose default import
+module is the KB's, so its goals for facts are plain calls to that KB's facts
+(``rules/lib/kb_common.pl``), and the KB imports its exports. Any other file
+is plain Prolog, loaded into the KB's module. Either is loaded under a
+per-module source id, because SWI-Prolog will not load one file into two
+modules.
 
 Values cross the boundary as data, never as goal text:
 
@@ -400,15 +405,17 @@ class KnowledgeBase:
         """Load one rule file into this KB, as code (its directives run; a ``.qlf`` loads as is).
 
         A bare name (``"rgw"``) is a shipped rule file (:func:`neurosym.shipped.rule_file`).
-        Syntax and other load errors raise :class:`PrologError` naming the
-        file and line, and the file's clauses are unloaded again; warnings
-        become :class:`PrologWarning`.
+        A module file gets a copy of its module per KB, whose goals for facts
+        resolve to this KB's facts, and the KB imports its exports. Syntax and
+        other load errors raise
+        :class:`PrologError` naming the file and line, and the file's clauses
+        are unloaded again; warnings become :class:`PrologWarning`.
         """
         from neurosym.shipped import rule_file
 
         self._check_open()
         path = _existing(rule_file(path))
-        fmt = "qlf" if path.suffix == ".qlf" else "source"
+        fmt = "qlf" if path.suffix == ".qlf" else "rules"
         before = len(self._source_ids)
         self._finish(path, *self._load_file(path, fmt))
         self._rule_ids.extend([*self._source_ids[before:], str(path)])
@@ -650,6 +657,8 @@ class KnowledgeBase:
             raise NeurosymError(f"knowledge base {self.module} is closed")
 
     def _clean(self, text: str) -> str:
+        """Prolog's text without this KB's module names (``neurosym_kb_3:``, ``'rgw@neurosym_kb_3'``)."""
+        text = re.sub(rf"'([a-z]\w*)@{self.module}'", r"\1", text)
         return _one_line(text.replace(f"{self.module}:", ""))
 
     def _check_status(self, status: Any, goal: str) -> None:

@@ -15,7 +15,12 @@ What it does, and why in Prolog:
     so several fact files add up instead of replacing each other. Errors and
     warnings printed during the load are captured with message_hook/3 and
     returned instead of being printed. The dynamic, discontiguous and
-    multifile directives a =|.qlf|= replays land in the KB's module.
+    multifile directives a =|.qlf|= replays land in the KB's module. A rule
+    file (format =rules=) that is a module file, as the shipped rule files
+    are, is loaded for each KB as a module of its own (=|rgw@KB|=) whose
+    default import module is the KB's module, so that the rules' goals for
+    facts resolve to that KB's facts as plain calls; the KB imports its
+    exports (see =|rules/lib/kb_common.pl|=).
   - solve/8 parses the goal text in the KB module, binds the inputs by
     variable name (values never pass through goal text), runs it under
     limit/2 and returns every answer in one call, each value encoded so
@@ -100,6 +105,7 @@ new_kb(M) :-
 close_kb(M, Files) :-
     forall(member(File, Files), catch(unload_file(File), _, true)),
     retractall(system:'$load_context_module'(_, M, _)),
+    forall(retract(rule_module_(M, Own)), drop_rule_module_(M, Own)),
     '$destroy_module'(M).
 
 %!  load(+Module, +Id, +File, +Format, +CStack, -Messages) is det.
@@ -136,6 +142,11 @@ multifile_loaded_(M) :-
              \+ predicate_property(M:Head, imported_from(_)) ),
            ( functor(Head, Name, Arity), multifile(M:Name/Arity) )).
 
+load_(M, Id, File, rules) :-
+    (   module_file_(File, Name)
+    ->  load_rule_module_(M, Id, File, Name)
+    ;   load_(M, Id, File, source)
+    ).
 load_(M, Id, File, source) :-
     setup_call_cleanup(
         open(File, read, S, [encoding(utf8)]),
@@ -146,6 +157,71 @@ load_(M, Id, File, qlf) :-
         open(File, read, S, [type(binary)]),
         load_files(M:Id, [stream(S), format(qlf), silent(true)]),
         close(S)).
+
+%   module_file_(+File, -Name): File's first term is the header of module
+%   Name. A file whose first term cannot be read is no module file: loading
+%   it as source reports the syntax error.
+module_file_(File, Name) :-
+    setup_call_cleanup(
+        open(File, read, S, [encoding(utf8)]),
+        catch(read_term(S, First, []), error(_, _), fail),
+        close(S)),
+    nonvar(First),
+    (   First = (:- module(Name, _))
+    ;   First = (:- module(Name, _, _))
+    ),
+    atom(Name),
+    !.
+
+%   load_rule_module_(+M, +Id, +File, +Name): the module file File loaded
+%   for KB M as a module of its own, Name@M, whose default import module is
+%   M instead of user: the rules' unqualified goals for facts resolve to M's
+%   facts (plain calls, linked on first use), and M imports the exports.
+%   Each KB loads its own copy (SWI-Prolog loads one module file into one
+%   module only, and a module's goals resolve in the module, then its
+%   default import modules); close_kb/2 empties it (drop_rule_module_/2).
+load_rule_module_(M, Id, File, Name) :-
+    format(atom(Own), '~w@~w', [Name, M]),
+    setup_call_cleanup(
+        assertz(renaming_(Id, File, Name, Own)),
+        load_(M, Id, File, source),
+        retractall(renaming_(Id, _, _, _))),
+    add_import_module(Own, M, start),
+    delete_import_module(Own, user),
+    assertz(rule_module_(M, Own)).
+
+%   drop_rule_module_(+M, +Own): KB M's rule module Own, its file
+%   unloaded, emptied and cut off from M, which is about to be destroyed.
+%   The empty module stays: SWI-Prolog destroys only temporary modules, and
+%   a module that a file declared is no longer one.
+drop_rule_module_(M, Own) :-
+    forall(( current_predicate(_, Own:Head),
+             \+ predicate_property(Own:Head, imported_from(_)) ),
+           catch(abolish(Own:Head), _, true)),
+    delete_import_module(Own, M),
+    add_import_module(Own, system, end).
+
+:- thread_local renaming_/4.   % renaming_(Id, File, Name, Own): the header to rename
+:- dynamic rule_module_/2.     % rule_module_(KB, Own): the KB's rule modules
+
+% In system, not user: the file is loaded into the KB's module, whose
+% default import module is system, and SWI-Prolog asks the term_expansion/2
+% of that module and the modules it imports from.
+:- multifile system:term_expansion/2.
+:- dynamic system:term_expansion/2.
+
+system:term_expansion((:- module(Name, Exports)), (:- module(Own, Exports))) :-
+    renaming_source_(Name, Own).
+system:term_expansion((:- module(Name, Exports, Dialect)), (:- module(Own, Exports, Dialect))) :-
+    renaming_source_(Name, Own).
+
+% The header of the very file load_rule_module_/4 loads (SWI-Prolog names
+% its source by the file, or by the source id), not of a library it loads.
+renaming_source_(Name, Own) :-
+    renaming_(Id, File, Name, Own),
+    prolog_load_context(source, Source),
+    ( Source == File ; Source == Id ),
+    !.
 
 % A .qlf replays a file's directives qualified with the module it was
 % compiled in. neurosym compiles into neurosym_qlf (see neurosym/prolog/qlf.py),

@@ -152,6 +152,46 @@ test(load_errors_are_returned_with_file_and_line) :-
     format(string(Prefix), "~w:2:", [File]),
     sub_string(Text, 0, _, _, Prefix).
 
+%   rule_file(+Text, -File): a temporary rule file holding Text.
+rule_file(Text, File) :-
+    tmp_file_stream(File, S, [encoding(utf8), extension(pl)]),
+    write(S, Text),
+    close(S).
+
+%   load_rules(+M, +File): File loaded into KB M as a rule file, without a word.
+load_rules(M, File) :-
+    format(atom(Id), "~w#~w", [File, M]),
+    c_stack(CStack),
+    load(M, Id, File, rules, CStack, Messages),
+    assertion(Messages == []).
+
+test(a_module_rule_file_is_loaded_for_each_kb_and_reads_its_facts,
+     [Rows1-Rows2-From == [[1]]-[[2]]-[Own1, Own2]]) :-
+    gensym(plt_bridge_rules_, Mod),
+    format(string(Text), ":- module(~q, [answer/1]).\n\c
+                          answer(X) :- fact(X).\n", [Mod]),
+    rule_file(Text, File),
+    kb("fact(1).\n", M1),
+    kb("fact(2).\n", M2),
+    load_rules(M1, File),
+    load_rules(M2, File),
+    solve(M1, "answer(X)", [], all, [], _, Rows1, ok),
+    solve(M2, "answer(X)", [], all, [], _, Rows2, ok),
+    findall(F, ( member(M, [M1, M2]), predicate_property(M:answer(_), imported_from(F)) ), From),
+    format(atom(Own1), "~w@~w", [Mod, M1]),
+    format(atom(Own2), "~w@~w", [Mod, M2]),
+    close_kb(M1, []),
+    assertion(\+ import_module(Own1, M1)).
+
+test(a_plain_rule_file_is_loaded_into_each_kb, [Rows1-Rows2 == [[1]]-[[2]]]) :-
+    rule_file("answer(X) :- fact(X).\n", File),
+    kb("fact(1).\n", M1),
+    kb("fact(2).\n", M2),
+    load_rules(M1, File),
+    load_rules(M2, File),
+    solve(M1, "answer(X)", [], all, [], _, Rows1, ok),
+    solve(M2, "answer(X)", [], all, [], _, Rows2, ok).
+
 test(close_kb_destroys_the_module) :-
     kb("q(a).\n", M),
     close_kb(M, []),
