@@ -1,8 +1,11 @@
 """Run every plunit test file under rules/ and neurosym/ through pytest, one swipl call per file.
 
-The package's own Prolog modules (``neurosym/prolog/pl/<name>.pl``: the fact
-reader, the janus bridge, Ctrl-C) have their ``<name>.plt`` beside them,
-loading ``<name>.pl`` relative to their own directory like the rule files'.
+The package's own Prolog modules (``neurosym/**/pl/<name>.pl``: the fact
+reader, the janus bridge, Ctrl-C, the text induce copies into learned files,
+the Prolog agent of ``neurosym play``) have their ``<name>.plt`` beside them,
+loading ``<name>.pl`` relative to their own directory like the rule files';
+their small hand-written fact files live in a ``tests/`` folder beside them
+(``neurosym/**/pl/tests/*.pl``), which is neither a module nor shipped.
 
 The convention for ``rules/<name>.plt``:
 
@@ -62,8 +65,15 @@ def test_package_prolog_modules(swipl: Path, plt: Path) -> None:
     assert_plunit_passes(swipl, plt)
 
 
+def package_prolog_modules() -> list[Path]:
+    """The package's Prolog modules: every ``neurosym/**/*.pl`` but the test fixtures in ``tests/`` folders."""
+    return sorted(
+        p for p in (REPO / "neurosym").rglob("*.pl") if "tests" not in p.relative_to(REPO).parts
+    )
+
+
 def test_every_package_prolog_module_has_its_plunit_file() -> None:
-    modules = sorted((REPO / "neurosym").rglob("*.pl"))
+    modules = package_prolog_modules()
     assert modules, "no Prolog module found under neurosym/"
     assert [p.with_suffix(".plt") for p in modules] == PACKAGE_PLT_FILES
 
