@@ -188,10 +188,10 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
 
 
 def test_train_imitate_on_box_world_is_one_line(
-    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+    train_refused: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:
-    proc = neurosym("train", "--env", "bw1", "--module", "predinet", "--algo", "imitate",
-                    "--frames", "10", "--out", tmp_path / "x")  # fmt: skip
+    proc = train_refused("train", "--env", "bw1", "--module", "predinet", "--algo", "imitate",
+                         "--frames", "10", "--out", tmp_path / "x")  # fmt: skip
     assert proc.returncode != 0
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "imitate learns from the RGW planner" in lines[0], proc.stderr

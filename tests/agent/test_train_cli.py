@@ -138,7 +138,7 @@ def test_train_keeps_snapshots(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train", "--env", "rgw2", "--module", "mhdpa", "--out", str(out), "--workers", "1",
-        "--frames", "20000", "--heads", "1", "--snapshot-every", "0.005", *TINY,
+        "--frames", "6000", "--heads", "1", "--snapshot-every", "0.002", *TINY,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     snaps = sorted((out / "snapshots").iterdir())
@@ -149,7 +149,7 @@ def test_train_keeps_snapshots(neurosym, tmp_path: Path) -> None:
         frames == sorted(set(frames))
         and frames[-1] <= load_agent(out / "checkpoint.pt").meta["frames"]
     )
-    assert "--snapshot-every 0.005" in load_agent(out / "checkpoint.pt").meta["command"]
+    assert "--snapshot-every 0.002" in load_agent(out / "checkpoint.pt").meta["command"]
 
 
 @pytest.mark.expensive
@@ -443,17 +443,17 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
     ],
 )
 def test_train_bad_input_is_one_line(
-    neurosym, tmp_path: Path, args: tuple[str, ...], message: str
+    train_refused, tmp_path: Path, args: tuple[str, ...], message: str
 ) -> None:
-    proc = neurosym("train", "--out", str(tmp_path / "run"), "--quiet", *args)
+    proc = train_refused("train", "--out", str(tmp_path / "run"), "--quiet", *args)
     assert proc.returncode == 1, proc.stderr
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.parametrize("value", ["12,x", "0,24", ""])
-def test_train_bad_conv_channels(neurosym, tmp_path: Path, value: str) -> None:
-    proc = neurosym(
+def test_train_bad_conv_channels(train_refused, tmp_path: Path, value: str) -> None:
+    proc = train_refused(
         "train", "--env", "rgw2", "--module", "predinet", "--out", str(tmp_path / "run"),
         "--conv-channels", value,
     )  # fmt: skip
