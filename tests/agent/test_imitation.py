@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import json
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
@@ -165,7 +166,9 @@ def neurosym(
 
 @pytest.mark.expensive
 def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
-    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+    neurosym: Callable[..., subprocess.CompletedProcess[str]],
+    neurosym_main: Callable[..., subprocess.CompletedProcess[str]],
+    tmp_path: Path,
 ) -> None:
     out = tmp_path / "run"
     first = neurosym("train", "--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
@@ -183,8 +186,9 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     assert int(resumed["frames"]) >= frames + 200
     assert "--algo imitate" in resumed["command"] and " && " in resumed["command"]
     load_agent(out / "checkpoint.pt")
-    ev = neurosym("eval", "--checkpoint", out / "checkpoint.pt", "--episodes", "4", "--json")
+    ev = neurosym_main("eval", "--checkpoint", out / "checkpoint.pt", "--episodes", "4", "--json")
     assert ev.returncode == 0, ev.stderr[-2000:]
+    assert json.loads(ev.stdout)["episodes"] == 4
 
 
 def test_train_imitate_on_box_world_is_one_line(
