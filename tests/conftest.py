@@ -77,9 +77,9 @@ def neurosym_main(
     capsys: pytest.CaptureFixture[str],
 ) -> Callable[..., subprocess.CompletedProcess[str]]:
     """Run ``neurosym ARGS...`` in this process (``neurosym.cli.main``), as ``run_neurosym``
-    reports it: exit code (argparse's SystemExit included), stdout, stderr. For the refusals
-    of bad input, where the one-line message and the exit code are what is checked and a
-    Python start per case is not."""
+    reports it: exit code (argparse's SystemExit included), stdout, stderr. For CLI runs whose
+    exit code, one-line error or printed report is what is checked, not the process itself
+    (signals, a terminal, warnings written at start-up): a Python start costs 2-3 s a case."""
 
     def run(*args: object) -> subprocess.CompletedProcess[str]:
         from neurosym.cli import main
