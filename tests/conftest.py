@@ -14,12 +14,22 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Sign .qlf files with a key of the test session, never the user's own (subprocesses inherit it)."""
+    """Sign .qlf files with a key of the test session, never the user's own (subprocesses inherit it).
+
+    Torch computes on one thread in the session and in the subprocesses it starts: the tests'
+    batches are small, and on a machine whose few cores other jobs share, two intra-op
+    threads spin against each other (a Box-World PrediNet's batch of 64 took 0.6-0.8 s on two
+    threads against 0.09 s on one, at a load of 5 on 2 cores). The CLI's own commands and the
+    learners' processes set their threads themselves; this covers the calls made in-process."""
     import tempfile
 
     if "NEUROSYM_KEY_FILE" not in os.environ:
         key_dir = tempfile.mkdtemp(prefix="neurosym-test-key-")
         os.environ["NEUROSYM_KEY_FILE"] = os.path.join(key_dir, "qlf.key")
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    import torch
+
+    torch.set_num_threads(int(os.environ["OMP_NUM_THREADS"]))
 
 
 @pytest.fixture(scope="session")
@@ -60,6 +70,48 @@ def run_neurosym() -> Callable[..., subprocess.CompletedProcess[str]]:
         )  # fmt: skip
 
     return run
+
+
+@pytest.fixture
+def neurosym_main(
+    capsys: pytest.CaptureFixture[str],
+) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """Run ``neurosym ARGS...`` in this process (``neurosym.cli.main``), as ``run_neurosym``
+    reports it: exit code (argparse's SystemExit included), stdout, stderr. For CLI runs whose
+    exit code, one-line error or printed report is what is checked, not the process itself
+    (signals, a terminal, warnings written at start-up): a Python start costs 2-3 s a case."""
+
+    def run(*args: object) -> subprocess.CompletedProcess[str]:
+        from neurosym.cli import main
+
+        argv = [str(a) for a in args]
+        capsys.readouterr()
+        try:
+            code = main(argv)
+        except SystemExit as exc:
+            if isinstance(exc.code, str):  # what Python prints for sys.exit(text)
+                print(exc.code, file=sys.stderr)
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(["neurosym", *argv], code, out, err)
+
+    return run
+
+
+@pytest.fixture
+def train_refused(
+    neurosym_main: Callable[..., subprocess.CompletedProcess[str]], monkeypatch: pytest.MonkeyPatch
+) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """``neurosym_main`` for `neurosym train` input that must be refused before the run starts:
+    a run that gets as far as making its directory fails the test at once instead of
+    training inside pytest."""
+    from neurosym.agent.run import trainer
+
+    def no_run(out: Path) -> None:
+        raise AssertionError(f"the input was taken: the run started in {out}")
+
+    monkeypatch.setattr(trainer, "make_run_directory", no_run)
+    return neurosym_main
 
 
 # Fixtures that start a subprocess (the CLI, training) or a browser: tests using them are left

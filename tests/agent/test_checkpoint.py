@@ -235,7 +235,7 @@ def test_save_refuses_objects(tmp_path: Path) -> None:
     ],
 )
 def test_a_config_out_of_range_or_far_larger_than_its_weights_is_refused_before_building(
-    tmp_path: Path, run_neurosym, edit: dict, message: str
+    tmp_path: Path, neurosym_main, edit: dict, message: str
 ) -> None:
     """Out of a setting's range: the config's own line; in range but larger than every weight
     dimension (a damaged file): refused before the model is built."""
@@ -245,7 +245,7 @@ def test_a_config_out_of_range_or_far_larger_than_its_weights_is_refused_before_
     torch.save({**raw, "model_config": {**raw["model_config"], **edit}}, path)
     expected = f"checkpoint {path} {message}"
     assert error_of(path) == expected
-    proc = run_neurosym("eval", "--checkpoint", path, "--episodes", 1)
+    proc = neurosym_main("eval", "--checkpoint", path, "--episodes", 1)
     assert (proc.returncode, proc.stderr) == (1, f"neurosym eval: error: {expected}\n")
 
 
@@ -269,7 +269,7 @@ def test_a_model_that_cannot_be_allocated_is_one_line(
     )
 
 
-def test_a_checkpoint_edited_to_another_env_names_the_file(tmp_path: Path, run_neurosym) -> None:
+def test_a_checkpoint_edited_to_another_env_names_the_file(tmp_path: Path, neurosym_main) -> None:
     path = tmp_path / "a.pt"
     write(path)
     raw = torch.load(path, weights_only=True)
@@ -280,7 +280,7 @@ def test_a_checkpoint_edited_to_another_env_names_the_file(tmp_path: Path, run_n
     )
     assert error_of(path) == expected
     for command, *more in (("eval",), ("extract", "--out", tmp_path / "o")):
-        proc = run_neurosym(command, "--checkpoint", path, "--episodes", 1, *more)
+        proc = neurosym_main(command, "--checkpoint", path, "--episodes", 1, *more)
         assert (proc.returncode, proc.stderr) == (1, f"neurosym {command}: error: {expected}\n")
     torch.save({**raw, "env": "rgw9"}, path)
     assert error_of(path).startswith(f"checkpoint {path} names an env this neurosym lacks: ")

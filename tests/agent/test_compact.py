@@ -109,14 +109,14 @@ def test_overflowing_weight_is_refused(tmp_path: Path) -> None:
     compact_checkpoint(path, tmp_path / "b.pt", "bfloat16")  # bfloat16 has float32's range
 
 
-def test_cli(neurosym, original: Path, tmp_path: Path) -> None:
+def test_cli(neurosym, neurosym_main, original: Path, tmp_path: Path) -> None:
     small = tmp_path / "small.pt"
     proc = neurosym("compact", original, "--out", small)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith(f"wrote {small}: ") and "float16" in proc.stdout
-    proc = neurosym("eval", "--checkpoint", small, "--episodes", "2", "--json")
+    proc = neurosym_main("eval", "--checkpoint", small, "--episodes", "2", "--json")
     assert proc.returncode == 0, proc.stderr
-    bad = neurosym("compact", tmp_path / "none.pt", "--out", small)
+    bad = neurosym_main("compact", tmp_path / "none.pt", "--out", small)
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "not found" in bad.stderr
 
 

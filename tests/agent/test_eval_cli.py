@@ -1,4 +1,5 @@
-"""`neurosym eval` on real checkpoint files, through the CLI in a subprocess."""
+"""`neurosym eval` on real checkpoint files, through the CLI in a subprocess (its refusals and
+options in this process, through the same ``main``)."""
 
 from __future__ import annotations
 
@@ -79,19 +80,19 @@ def test_eval_text_and_sample(neurosym, untrained: Path) -> None:
     ],
 )
 def test_eval_errors_are_one_line(
-    neurosym, untrained: Path, args: tuple[str, ...], message: str
+    neurosym_main, untrained: Path, args: tuple[str, ...], message: str
 ) -> None:
     full = ("--checkpoint", str(untrained), *args) if args[0] != "--checkpoint" else args
-    proc = neurosym("eval", *full)
+    proc = neurosym_main("eval", *full)
     assert proc.returncode == 1
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
 
 
-def test_eval_env_options_change_the_levels(neurosym, untrained: Path) -> None:
+def test_eval_env_options_change_the_levels(neurosym_main, untrained: Path) -> None:
     """--env-option plays rgw-random's levels with other parameters, recorded in the report."""
     reports = {}
     for mountains in (0, 12):
-        proc = neurosym(
+        proc = neurosym_main(
             "eval", "--checkpoint", str(untrained), "--env", "rgw-random", "--episodes", "20",
             "--seed", "3000000000", "--env-option", f"num_mountains={mountains}", "--json",
         )  # fmt: skip

@@ -96,7 +96,7 @@ def test_one_agent_many_maps(tmp_path: Path) -> None:
         evaluate(agent, "rgw2", 1, env_kwargs={"map": str(small)})
 
 
-def test_eval_cli_on_other_envs(run_neurosym, tmp_path: Path) -> None:
+def test_eval_cli_on_other_envs(run_neurosym, neurosym_main, tmp_path: Path) -> None:
     proc = run_neurosym(
         "eval", "--checkpoint", RGW2_PREDINET, "--env", "rgw-random", "--episodes", "3", "--json"
     )
@@ -107,7 +107,7 @@ def test_eval_cli_on_other_envs(run_neurosym, tmp_path: Path) -> None:
         assert key in report
     mine = tmp_path / "mine.txt"
     mine.write_text(Path(ROOT / "neurosym/envs/maps/rgw2.txt").read_text())
-    proc = run_neurosym("eval", "--checkpoint", RGW2_PREDINET, "--map", mine, "--episodes", "1")
+    proc = neurosym_main("eval", "--checkpoint", RGW2_PREDINET, "--map", mine, "--episodes", "1")
     assert proc.returncode == 0, proc.stderr
     assert "optimal      100.0 %" in proc.stdout
 

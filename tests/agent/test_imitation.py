@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import json
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
@@ -165,7 +166,9 @@ def neurosym(
 
 @pytest.mark.expensive
 def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
-    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+    neurosym: Callable[..., subprocess.CompletedProcess[str]],
+    neurosym_main: Callable[..., subprocess.CompletedProcess[str]],
+    tmp_path: Path,
 ) -> None:
     out = tmp_path / "run"
     first = neurosym("train", "--env", "rgw-random", "--module", "predinet", "--algo", "imitate",
@@ -183,15 +186,16 @@ def test_train_imitate_writes_a_checkpoint_that_resumes_and_evaluates(
     assert int(resumed["frames"]) >= frames + 200
     assert "--algo imitate" in resumed["command"] and " && " in resumed["command"]
     load_agent(out / "checkpoint.pt")
-    ev = neurosym("eval", "--checkpoint", out / "checkpoint.pt", "--episodes", "4", "--json")
+    ev = neurosym_main("eval", "--checkpoint", out / "checkpoint.pt", "--episodes", "4", "--json")
     assert ev.returncode == 0, ev.stderr[-2000:]
+    assert json.loads(ev.stdout)["episodes"] == 4
 
 
 def test_train_imitate_on_box_world_is_one_line(
-    neurosym: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+    train_refused: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:
-    proc = neurosym("train", "--env", "bw1", "--module", "predinet", "--algo", "imitate",
-                    "--frames", "10", "--out", tmp_path / "x")  # fmt: skip
+    proc = train_refused("train", "--env", "bw1", "--module", "predinet", "--algo", "imitate",
+                         "--frames", "10", "--out", tmp_path / "x")  # fmt: skip
     assert proc.returncode != 0
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "imitate learns from the RGW planner" in lines[0], proc.stderr

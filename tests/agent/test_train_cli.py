@@ -41,7 +41,9 @@ TINY = ("--envs", "4", "--quiet", "--eval-interval", "0.5", "--eval-episodes", "
 
 
 @pytest.mark.expensive
-def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Path) -> None:
+def test_train_writes_checkpoint_and_metrics_then_resumes(
+    neurosym, train_refused, tmp_path: Path
+) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train",
@@ -77,7 +79,7 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Pa
     }
     assert int(first[-1]["frames"]) == agent.meta["frames"]
 
-    again = neurosym(
+    again = train_refused(
         "train",
         "--env",
         "rgw2",
@@ -107,7 +109,7 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Pa
     walls = [float(r["wall_s"]) for r in rows]
     assert walls == sorted(walls)
 
-    other = neurosym(
+    other = train_refused(
         "train", "--out", str(out), "--resume", "--module", "mhdpa", "--frames", "9000", *TINY
     )
     assert other.returncode == 1
@@ -116,12 +118,15 @@ def test_train_writes_checkpoint_and_metrics_then_resumes(neurosym, tmp_path: Pa
 
 
 @pytest.mark.expensive
-def test_train_stops_at_target_success(neurosym, tmp_path: Path) -> None:
+def test_train_stops_at_target_success_with_learned_queries(neurosym, tmp_path: Path) -> None:
+    """--target-success stops the run; --set query=learned trains (A3C's recorded-query path
+    included), is kept in the checkpoint and its command, and the saved agent loads with one
+    query vector and no projection (one run for both)."""
     # bw1's random policy solves ~20 % of levels: a full window of 10 reaches 10 % within seconds
     out = tmp_path / "run"
     proc = neurosym(
-        "train", "--env", "bw1", "--module", "predinet", "--out", str(out), "--workers", "1",
-        "--target-success", "0.1", "--window", "10", "--frames", "500000", *TINY,
+        "train", "--env", "bw1", "--module", "predinet", "--set", "query=learned", "--out", str(out),
+        "--workers", "1", "--target-success", "0.1", "--window", "10", "--frames", "500000", *TINY,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     assert "stopped (target) after" in proc.stdout
@@ -132,13 +137,18 @@ def test_train_stops_at_target_success(neurosym, tmp_path: Path) -> None:
     assert "--target-success 0.1 " in agent.meta["command"]
     last = metrics(out)[-1]
     assert float(last["success_rate"]) >= 0.1 and int(last["frames"]) == agent.meta["frames"]
+    assert agent.config.query == "learned" and "--set query=learned" in agent.meta["command"]
+    params = dict(agent.model.relational.named_parameters())
+    assert "queries" in params and "query1.weight" not in params
+    obs = torch.zeros((2, *agent.config.obs_shape), dtype=torch.uint8)
+    assert agent.model(obs)[0].shape == (2, 4)
 
 
 def test_train_keeps_snapshots(neurosym, tmp_path: Path) -> None:
     out = tmp_path / "run"
     proc = neurosym(
         "train", "--env", "rgw2", "--module", "mhdpa", "--out", str(out), "--workers", "1",
-        "--frames", "20000", "--heads", "1", "--snapshot-every", "0.005", *TINY,
+        "--frames", "6000", "--heads", "1", "--snapshot-every", "0.002", *TINY,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     snaps = sorted((out / "snapshots").iterdir())
@@ -149,7 +159,7 @@ def test_train_keeps_snapshots(neurosym, tmp_path: Path) -> None:
         frames == sorted(set(frames))
         and frames[-1] <= load_agent(out / "checkpoint.pt").meta["frames"]
     )
-    assert "--snapshot-every 0.005" in load_agent(out / "checkpoint.pt").meta["command"]
+    assert "--snapshot-every 0.002" in load_agent(out / "checkpoint.pt").meta["command"]
 
 
 @pytest.mark.expensive
@@ -203,7 +213,9 @@ def test_train_mhdpa_single_worker_classic_k1(neurosym, tmp_path: Path) -> None:
 
 
 @pytest.mark.expensive
-def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path: Path) -> None:
+def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(
+    neurosym, train_refused, tmp_path: Path
+) -> None:
     """The synchronous learner: one-hot Box-World by default, event files, resume keeps the algo."""
     from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
@@ -238,9 +250,9 @@ def test_train_ppo_on_boxworld_with_tensorboard_then_resumes(neurosym, tmp_path:
     steps = [e.step for e in events.Scalars("losses/policy_loss")]
     assert steps and steps == sorted(steps) and steps[-1] <= agent.meta["frames"]
 
-    wrong = neurosym("train", "--out", str(out), "--resume", "--algo", "a3c", "--quiet")
+    wrong = train_refused("train", "--out", str(out), "--resume", "--algo", "a3c", "--quiet")
     assert wrong.returncode == 1 and "trained with --algo ppo" in wrong.stderr
-    sil = neurosym("train", "--out", str(out), "--resume", "--sil", "1", "--quiet")
+    sil = train_refused("train", "--out", str(out), "--resume", "--sil", "1", "--quiet")
     assert sil.returncode == 1 and "--sil is a setting of --algo a3c" in sil.stderr
     again = neurosym(
         "train", "--out", str(out), "--resume", "--frames", str(agent.meta["frames"] + 256),
@@ -274,26 +286,6 @@ def test_train_thesis_preset_is_table_4(neurosym, tmp_path: Path) -> None:
         "torch",
     )
     assert "--preset thesis" in agent.meta["command"]
-
-
-@pytest.mark.expensive
-def test_train_a3c_with_learned_queries_records_the_switch(neurosym, tmp_path: Path) -> None:
-    """--set query=learned trains (A3C's recorded-query path included), is kept in the checkpoint
-    and its command, and the saved agent loads with one query vector and no projection."""
-    out = tmp_path / "run"
-    proc = neurosym(
-        "train", "--env", "bw1", "--module", "predinet", "--set", "query=learned", "--out", str(out),
-        "--workers", "1", "--envs", "4", "--frames", "400", "--quiet",
-        "--eval-interval", "0.5", "--eval-episodes", "2",
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    agent = load_agent(out / "checkpoint.pt")
-    assert agent.config.query == "learned" and "--set query=learned" in agent.meta["command"]
-    params = dict(agent.model.relational.named_parameters())
-    assert "queries" in params and "query1.weight" not in params
-    assert agent.meta["frames"] >= 400
-    obs = torch.zeros((2, *agent.config.obs_shape), dtype=torch.uint8)
-    assert agent.model(obs)[0].shape == (2, 4)
 
 
 @pytest.mark.expensive
@@ -443,17 +435,17 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
     ],
 )
 def test_train_bad_input_is_one_line(
-    neurosym, tmp_path: Path, args: tuple[str, ...], message: str
+    train_refused, tmp_path: Path, args: tuple[str, ...], message: str
 ) -> None:
-    proc = neurosym("train", "--out", str(tmp_path / "run"), "--quiet", *args)
+    proc = train_refused("train", "--out", str(tmp_path / "run"), "--quiet", *args)
     assert proc.returncode == 1, proc.stderr
     assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.parametrize("value", ["12,x", "0,24", ""])
-def test_train_bad_conv_channels(neurosym, tmp_path: Path, value: str) -> None:
-    proc = neurosym(
+def test_train_bad_conv_channels(train_refused, tmp_path: Path, value: str) -> None:
+    proc = train_refused(
         "train", "--env", "rgw2", "--module", "predinet", "--out", str(tmp_path / "run"),
         "--conv-channels", value,
     )  # fmt: skip

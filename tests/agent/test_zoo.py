@@ -154,19 +154,19 @@ def test_agents_lists_the_shipped_agents(run_neurosym) -> None:
     assert lines[-2].startswith("held out: success in % on 300 levels")
 
 
-def test_agents_in_a_folder_of_ones_own(run_neurosym, tmp_path: Path) -> None:
+def test_agents_in_a_folder_of_ones_own(neurosym_main, tmp_path: Path) -> None:
     shutil.copy(CHECKPOINTS / "rgw1-mhdpa.pt", tmp_path / "mine.pt")
     (tmp_path / "broken.pt").write_bytes(b"not a checkpoint")
-    proc = run_neurosym("agents", "--dir", tmp_path, "--json")
+    proc = neurosym_main("agents", "--dir", tmp_path, "--json")
     assert proc.returncode == 0, proc.stderr
     assert [a["name"] for a in json.loads(proc.stdout)] == ["mine"]
     assert proc.stderr.startswith("neurosym agents: skipped broken.pt: cannot read")
-    proc = run_neurosym("agents", "--dir", tmp_path / "nowhere")
+    proc = neurosym_main("agents", "--dir", tmp_path / "nowhere")
     assert proc.returncode == 1
     assert proc.stderr == f"neurosym agents: error: --dir {tmp_path / 'nowhere'}: no such folder\n"
     empty = tmp_path / "empty"
     empty.mkdir()
-    proc = run_neurosym("agents", "--dir", empty)
+    proc = neurosym_main("agents", "--dir", empty)
     assert proc.stderr == f"neurosym agents: error: no agents (*.pt files) in {empty}\n"
 
 

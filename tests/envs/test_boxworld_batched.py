@@ -32,8 +32,8 @@ def held_colour(info: dict) -> int:
 @pytest.mark.parametrize(
     ("config", "n", "steps", "max_steps"),
     [
-        ("bw2", 6, 500, 60),
-        ("bw3", 5, 400, 60),
+        pytest.param("bw2", 6, 500, 60, marks=pytest.mark.expensive),
+        pytest.param("bw3", 5, 400, 60, marks=pytest.mark.expensive),
         ("default", 3, 300, 60),
         # 24 envs: next levels are drawn ahead and refilled in batches of 3
         ("bw1", 24, 60, 4),

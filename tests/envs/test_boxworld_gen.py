@@ -29,6 +29,7 @@ def levels_for(config: BoxWorldConfig, count: int, episode: int = 0):
     return generate_levels(config, keys, np.full(count, episode, np.uint64))
 
 
+@pytest.mark.expensive  # a search of each of 5,000 levels per config
 @pytest.mark.parametrize("name", list(CONFIGS))
 def test_every_level_is_solvable_and_distractors_are_dead_ends(name):
     config = BoxWorldConfig(**{k: v for k, v in CONFIGS[name].items() if k != "max_steps"})

@@ -147,6 +147,7 @@ def test_every_level_has_the_configured_objects(levels) -> None:
     assert (cells[np.arange(len(cells)), starts] == R.EMPTY).all()
 
 
+@pytest.mark.expensive  # searches of each of the 600 levels
 def test_every_level_is_solvable_and_long_enough(levels) -> None:
     cells, starts, _ = levels
     for i, (c, s) in enumerate(zip(cells, starts, strict=True)):
@@ -154,6 +155,7 @@ def test_every_level_is_solvable_and_long_enough(levels) -> None:
         assert reach_terminal(c, 10, int(s), set()) >= RandomLevelConfig().min_route_length, i
 
 
+@pytest.mark.expensive  # four searches of each of the 600 levels
 def test_kinds_match_plain_search_and_the_shares(levels) -> None:
     cells, starts, info = levels
     for i, (c, s) in enumerate(zip(cells, starts, strict=True)):
