@@ -27,6 +27,11 @@ _SUBCOMMANDS = {
 }
 
 
+_STEP_PLOTS = ("mhdpa", "predinet")
+"""plots of one state (--step)"""
+_OBJECT_PLOTS = ("mhdpa",)
+"""plots of one object's attention (--object, --cell)"""
+
 MIN_DPI, MAX_DPI = 1, 1200
 """--dpi range: a 4-head figure at 1200 dpi is about 12,700 pixels wide (matplotlib's limit: 65,536)"""
 
@@ -40,9 +45,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
             _probes_options(cmd)
             continue
         _source_options(cmd, gif=name == "episode")
-        if name in ("mhdpa", "predinet"):
+        if name in _STEP_PLOTS:
             cmd.add_argument("--step", type=int, default=0, help="state to show (default: 0)")
-        if name == "mhdpa":
+        if name in _OBJECT_PLOTS:
             which = cmd.add_mutually_exclusive_group()
             which.add_argument(
                 "--object",
@@ -210,22 +215,20 @@ def _draw(args: argparse.Namespace, source: Any, fmt: str) -> str:
     from neurosym.viz.output import save_figure
 
     where = {"episode": args.episode, "seed": args.episode_seed or 0}
-    if args.plot == "mhdpa":
-        fig = attention.mhdpa_figure(
-            source,
-            args.env,
-            step=args.step,
-            object=args.object,
-            cell=args.cell,
-            head=args.head,
-            **where,
-        )
-    elif args.plot == "predinet":
-        fig = predinet.predinet_figure(source, args.env, step=args.step, head=args.head, **where)
-    elif args.plot == "rvectors":
-        fig = predinet.r_vectors_figure(
+    figures = {
+        "mhdpa": lambda: attention.mhdpa_figure(
+            source, args.env, step=args.step, object=args.object, cell=args.cell,
+            head=args.head, **where,
+        ),
+        "predinet": lambda: predinet.predinet_figure(
+            source, args.env, step=args.step, head=args.head, **where
+        ),
+        "rvectors": lambda: predinet.r_vectors_figure(
             source, args.env, head=args.head, max_steps=_positive(args.max_steps), **where
-        )
+        ),
+    }  # fmt: skip
+    if args.plot in figures:
+        fig = figures[args.plot]()
     elif args.plot == "relations":
         fig = relations.relations_figure(
             source,
