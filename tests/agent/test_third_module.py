@@ -84,7 +84,7 @@ def _checkpoint(path: Path) -> Path:
     torch.manual_seed(0)
     config = ModelConfig.for_family(
         "rgw", "torch_attention", probe.observation_space.shape, probe.unwrapped.obs_scale,
-        heads=2, conv_channels=(4, 8), hidden_sizes=(16,),
+        heads=2, key_size=8, conv_channels=(4, 8), hidden_sizes=(16,),
     )  # fmt: skip
     model = ActorCritic(config).eval()
     return save_checkpoint(path, model=model, config=config, env_name="rgw2",
@@ -119,7 +119,7 @@ def test_a_registered_module_goes_through_extract_query_ablation_and_report(
     obs = np.stack([env.reset(seed=s)[0] for s in range(3)])
     plain, _ = head_vectors(agent.model, obs)  # (S, H, F / H)
     assert plain.shape == (3, 2, agent.config.entity_size // 2)
-    with ablate_heads(agent.model, {1: torch.zeros(agent.config.n_entities, 13)}):
+    with ablate_heads(agent.model, {1: torch.zeros(agent.config.n_entities, agent.config.entity_size // 2)}):
         ablated, _ = head_vectors(agent.model, obs)
     np.testing.assert_array_equal(ablated[:, 0], plain[:, 0])
     np.testing.assert_array_equal(ablated[:, 1], 0.0)
