@@ -2,16 +2,17 @@
 
 A strategy that reads ``holds/5``, ``attends/8`` or ``attention/6`` needs
 them for the state being played: :class:`RelationFacts` runs the network on
-the live observations (``introspect=True``) and writes, for episode E and
-state T, what the recorder and the fact writer make of a recorded state
-(:mod:`neurosym.export.recorder`, :mod:`neurosym.export.facts`):
+the live observations (``introspect=True``) and hands the introspection to the
+module's adapter (:mod:`neurosym.agent.networks.adapters`), the one producer of
+a state's relation rows that the recorder also uses; for episode E and state T
+the rows become
 
-* PrediNet: ``attends(E, T, Head, Arg, Entity, Row, Col, Weight)`` for the
-  argmax cell of each head's two attentions, and ``holds(E, T, r(J), A, B)``
-  for each head's relation J whose |value| exceeds ``threshold(J)``,
-  oriented so the value is positive (one fact per E, T, J, A, B);
-* MHDPA: ``attention(E, T, Head, Query, Key, Weight)`` for every query cell
-  that is not empty or wall, with its strongest key.
+* ``attends(E, T, Head, Arg, Entity, Row, Col, Weight)`` (PrediNet: the argmax
+  cell of each head's two attentions), and ``holds(E, T, r(J), A, B)`` for each
+  relation row whose |value| exceeds ``threshold(J)``, oriented so the value is
+  positive (one fact per E, T, J, A, B, as the fact writer's ``holds_table``);
+* ``attention(E, T, Head, Query, Key, Weight)`` (MHDPA, any attention module):
+  every query cell that is not empty or wall, with its strongest key.
 
 Entities are the entity grid's names before the step. Thresholds are those of
 the KB the strategy was learned from: ``threshold/2`` in the strategy file,
