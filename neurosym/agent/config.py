@@ -350,9 +350,11 @@ class ModelConfig:
     0.01 either way (a near uniform first policy)."""
 
     def __post_init__(self) -> None:
-        if self.module not in MODULES:
+        from neurosym.agent.networks.adapters import module_names  # the registry: torch
+
+        if self.module not in module_names():
             raise ConfigError(
-                f"unknown module {self.module!r}; expected one of {', '.join(MODULES)}"
+                f"unknown module {self.module!r}; expected one of {', '.join(module_names())}"
             )
         object.__setattr__(self, "obs_shape", tuple(int(v) for v in self.obs_shape))
         object.__setattr__(self, "conv_channels", tuple(int(v) for v in self.conv_channels))

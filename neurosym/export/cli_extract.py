@@ -35,6 +35,8 @@ from neurosym.flags import ActionMode, EnvChoice, Episodes, Out, Quiet, add_opti
 from neurosym.seeds import check_seed
 
 FORMATS = ("pl", "parquet")
+_FACTS = {"attends": "attends/8", "relations": "relation/7 and holds/5", "attention": "attention/6"}
+"""a recording table's fact predicates, for messages"""
 PRODUCTS = ("kb.pl", "kb.qlf", "kb.qlf.sig", "facts", "recording")
 """what an extract run writes into --out; one run's set replaces the previous run's"""
 
@@ -104,15 +106,18 @@ def run(args: ExtractOptions) -> int:
         raise ConfigError(f"--top-keys must be at least 1, got {args.top_keys}")
 
     from neurosym.agent.checkpoint import env_for, load_agent
+    from neurosym.agent.networks.adapters import adapter_class
     from neurosym.export.facts import extract_facts
     from neurosym.export.recorder import record
     from neurosym.publish import check_out
 
     agent = load_agent(args.checkpoint)
-    if args.top_keys is not None and agent.config.module != "mhdpa":
+    adapter = adapter_class(agent.config.module)
+    if args.top_keys is not None and not adapter.has("attention"):
+        facts = " and ".join(_FACTS[name] for name in adapter.tables if name in _FACTS)
         raise ConfigError(
             f"--top-keys is for MHDPA checkpoints (attention/6 facts); {args.checkpoint} is a "
-            f"{agent.config.module} (its facts are attends/8, relation/7 and holds/5)"
+            f"{agent.config.module} (its facts are {facts})"
         )
     env, overrides = play_options(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)

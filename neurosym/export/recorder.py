@@ -25,17 +25,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.agent.play import Wave, play_waves
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
+from neurosym.play import live
 from neurosym.seeds import check_seed
 
 DEFAULT_BATCH = 64
 """Sub-environments stepped together (fewer when fewer episodes are asked for)."""
-
-# Entities that are never MHDPA queries in the attention table (too many, too dull).
-_BACKGROUND = ("empty", "wall")
-
 
 ACTION_SOURCES = ("agent", "random")
 """who chooses the recorded actions: the agent, or a uniform random draw (the network still runs)"""
@@ -63,6 +61,7 @@ def _meta(
     from neurosym import __version__
 
     config = agent.config
+    adapter = adapter_class(config.module)
     return {
         "checkpoint": str(getattr(agent, "path", "") or ""),
         "env": env_name,
@@ -70,7 +69,7 @@ def _meta(
         "env_kwargs": dict(env_kwargs),
         "module": config.module,
         "heads": int(config.heads),
-        "relations": int(config.relations) if config.module == "predinet" else 0,
+        "relations": adapter.relation_count(config),
         "seed": int(seed),
         "greedy": bool(greedy),
         "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
@@ -117,28 +116,22 @@ class _Trace:
         self.terrain: list[tuple[int, str, int, int]] = []  # (episode, type, row, col)
         self.grids: list[tuple[int, int, int]] = []  # (episode, rows, cols)
 
-    def map(self, episode: int, names: np.ndarray, info: dict[str, Any]) -> None:
-        """Episode's map size and terrain: the (H, W) entity names after its reset.
+    def map(self, episode: int, grid: np.ndarray, names: np.ndarray, info: dict[str, Any]) -> None:
+        """Episode's map size and terrain: its (H, W) entity codes after the reset
+        (:func:`neurosym.play.live.episode_facts`, what the Prolog agent asserts).
 
         Terrain is every cell that is neither empty, nor the agent, nor one of
         the named objects of ``info["objects"]`` (RGW's walls and mountains,
         Box-World's walls). It does not change within an episode.
         """
-        H, W = names.shape
-        self.grids.append((episode, H, W))
-        taken = {(int(r), int(c)) for _, _, r, c in info["objects"]}
-        taken.add(tuple(int(x) for x in info["agent"]))
-        for r, c in zip(*np.nonzero((names != "empty") & (names != "agent")), strict=True):
-            if (int(r), int(c)) not in taken:
-                self.terrain.append((episode, str(names[r, c]), int(r), int(c)))
+        facts = live.episode_facts(info, grid, names)
+        self.grids.append((episode, facts.rows, facts.cols))
+        self.terrain.extend((episode, *row) for row in facts.terrain)
 
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
-        objects = tuple(info["objects"])
-        if not objects or objects[0][0] != "agent":  # the envs list the agent first; be sure
-            objects = (("agent", "agent", *info["agent"]), *objects)
         self.keys.append((episode, t))
-        self.objects.append(objects)
+        self.objects.append(live.state_objects(info))
         self.held.append(tuple(info["holding"]))
 
     def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
@@ -305,7 +298,7 @@ class _Recorder:
         self.top_keys, self.max_steps, self.advance = top_keys, max_steps, advance
         self.n = venv.num_envs
         self.names = np.asarray(venv.entity_names, dtype=object)
-        self.module = agent.config.module
+        self.adapter = adapter_class(agent.config.module)
         self.trace = _Trace()
         self.model = _Columns()  # model outputs per (episode, t)
         self.step_cols = _Columns()  # steps table
@@ -356,11 +349,11 @@ class _Recorder:
 
         action_names = np.asarray(ACTION_NAMES, dtype=object)
         venv = self.venv
-        names = self.names[venv.entity_grid()]  # (n, H, W) entity names after the reset
+        grid = venv.entity_grid()  # (n, H, W) entity codes after the reset
         for i in range(wave.count):
             decoded = venv.decode_info(wave.info, i)
             self.trace.state(wave.first + i, 0, decoded)
-            self.trace.map(wave.first + i, names[i], decoded)
+            self.trace.map(wave.first + i, grid[i], self.names, decoded)
         live_mask = np.arange(self.n) < wave.count
         self._live_seeds, self._t = self.seed + wave.first + np.flatnonzero(live_mask), 0
         for step in wave.steps():
@@ -388,34 +381,9 @@ class _Recorder:
             self._t = step.t + 1
 
     def _model_outputs(self, ep: np.ndarray, t: np.ndarray, grid: np.ndarray, intro: Any) -> None:
-        """Keep the live states' introspection as arrays: argmax cells (PrediNet) or top keys (MHDPA)."""
-        if self.module == "predinet":
-            a1 = np.asarray(intro.attention1)  # (m, H, N)
-            a2 = np.asarray(intro.attention2)
-            i1, i2 = a1.argmax(-1), a2.argmax(-1)  # (m, H)
-            self.model.add(
-                ep=ep,
-                t=t,
-                i1=i1,
-                i2=i2,
-                w1=np.take_along_axis(a1, i1[..., None], -1)[..., 0],
-                w2=np.take_along_axis(a2, i2[..., None], -1)[..., 0],
-                e1=np.take_along_axis(grid, i1, 1),
-                e2=np.take_along_axis(grid, i2, 1),
-                rel=np.asarray(intro.relations),  # (m, H, J)
-                rvec=np.asarray(intro.r_vectors()),  # (m, H, J + 4)
-            )
-        else:
-            att = np.asarray(intro.attention)  # (m, H, N, N) query x key
-            k = min(self.top_keys, att.shape[-1])
-            if k == 1:
-                top = att.argmax(-1)[..., None]  # (m, H, N, 1)
-            else:  # the k largest, strongest first
-                part = np.argpartition(-att, k - 1, axis=-1)[..., :k]
-                order = np.argsort(-np.take_along_axis(att, part, -1), axis=-1, kind="stable")
-                top = np.take_along_axis(part, order, -1)  # (m, H, N, k)
-            weight = np.take_along_axis(att, top, -1)
-            self.model.add(ep=ep, t=t, top=top, weight=weight, grid=grid)
+        """Keep what the module's adapter keeps of the live states' introspection (argmax cells,
+        top keys: small arrays); the tables are built from them once, at the end."""
+        self.model.add(ep=ep, t=t, **self.adapter.keep(intro, grid, self.top_keys))
 
     # -------------------------------------------------------------- tables
 
@@ -430,10 +398,9 @@ class _Recorder:
         positions, holding, events = self.trace.tables()
         terrain, grids = self.trace.map_tables()
         tables: dict[str, pd.DataFrame] = {"terrain": terrain, "grids": grids}
-        if self.module == "predinet":
-            tables.update(self._predinet_tables(W))
-        else:
-            tables["attention"] = self._attention_table(W)
+        m = self.model.sorted_by("ep")  # states in episode order
+        rows = self.adapter.rows(m, m["ep"], m["t"], self.names, W)
+        tables.update({name: pd.DataFrame(cols) for name, cols in rows.items()})
         return Recording(
             episodes=eps,
             steps=steps,
@@ -441,81 +408,4 @@ class _Recorder:
             holding=holding,
             events=events,
             **tables,  # built from state arrays already in episode order
-        )
-
-    def _predinet_tables(self, W: int) -> dict[str, pd.DataFrame]:
-        m = self.model.sorted_by("ep")
-        ep, t = m["ep"], m["t"]  # (S,) states in episode order
-        i1, i2 = m["i1"], m["i2"]  # (S, H)
-        S, H = i1.shape
-        rel = m["rel"]  # (S, H, J)
-        rvec = m["rvec"]  # (S, H, J + 4)
-        J = rel.shape[-1]
-        names = self.names
-        # attends: per (state, head, arg); arg 1 rows then arg 2 rows, sorted later
-        idx = np.stack([i1, i2], axis=-1)  # (S, H, 2)
-        ent = np.stack([m["e1"], m["e2"]], axis=-1)
-        wgt = np.stack([m["w1"], m["w2"]], axis=-1)
-        attends = pd.DataFrame(
-            {
-                "episode": np.repeat(ep, H * 2),
-                "t": np.repeat(t, H * 2),
-                "head": np.tile(np.repeat(np.arange(H), 2), S),
-                "arg": np.tile(np.array([1, 2]), S * H),
-                "entity": names[ent.reshape(-1)],
-                "row": idx.reshape(-1) // W,
-                "col": idx.reshape(-1) % W,
-                "weight": wgt.reshape(-1).astype(np.float64),
-            }
-        )
-        relations = pd.DataFrame(
-            {
-                "episode": np.repeat(ep, H * J),
-                "t": np.repeat(t, H * J),
-                "head": np.tile(np.repeat(np.arange(H), J), S),
-                "j": np.tile(np.arange(J), S * H),
-                "a": names[np.repeat(m["e1"].reshape(-1), J)],
-                "b": names[np.repeat(m["e2"].reshape(-1), J)],
-                "value": rel.reshape(-1).astype(np.float64),
-            }
-        )
-        R = rvec.shape[-1]
-        r_vectors = pd.DataFrame(
-            {
-                "episode": np.repeat(ep, H * R),
-                "t": np.repeat(t, H * R),
-                "head": np.tile(np.repeat(np.arange(H), R), S),
-                "j": np.tile(np.arange(R), S * H),
-                "value": rvec.reshape(-1).astype(np.float64),
-            }
-        )
-        return {"attends": attends, "relations": relations, "r_vectors": r_vectors}
-
-    def _attention_table(self, W: int) -> pd.DataFrame:
-        m = self.model.sorted_by("ep")
-        ep, t = m["ep"], m["t"]  # (S,) states in episode order
-        top, weight, grid = m["top"], m["weight"], m["grid"]  # (S, H, N, k), (S, N)
-        S, H, N, k = top.shape
-        query_code = np.broadcast_to(grid[:, None, :, None], (S, H, N, k))
-        key_code = np.take_along_axis(
-            np.broadcast_to(grid[:, None, :], (S, H, N)), top.reshape(S, H, N * k), -1
-        )
-        query_cell = np.broadcast_to(np.arange(N)[None, None, :, None], (S, H, N, k))
-        background = np.isin(self.names, _BACKGROUND)
-        keep = ~background[query_code].reshape(-1)
-        flat_q = query_cell.reshape(-1)[keep]
-        flat_k = top.reshape(-1)[keep]
-        return pd.DataFrame(
-            {
-                "episode": np.repeat(ep, H * N * k)[keep],
-                "t": np.repeat(t, H * N * k)[keep],
-                "head": np.tile(np.repeat(np.arange(H), N * k), S)[keep],
-                "query": self.names[query_code.reshape(-1)[keep]],
-                "key": self.names[key_code.reshape(-1)[keep]],
-                "weight": weight.reshape(-1)[keep].astype(np.float64),
-                "query_row": flat_q // W,
-                "query_col": flat_q % W,
-                "key_row": flat_k // W,
-                "key_col": flat_k % W,
-            }
         )

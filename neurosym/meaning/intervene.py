@@ -58,6 +58,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.errors import ConfigError
 from neurosym.schema import TRACE, group
 from neurosym.terms import Term
@@ -294,7 +295,7 @@ def _count(grid_map: Any, obj: str) -> int:
 
 def ablation_experiments(heads: int, module: str) -> list[Experiment]:
     """Each head ablated in turn, then all of them."""
-    what = "r_vector" if module == "predinet" else "head_output"
+    what = adapter_class(module).head_term
     detail = Term("replaced", (what, Term("mean_over", ("baseline",))))
     out = [
         Experiment(f"ablate_head_{h}", Term("ablate", (Term("head", (h,)),)), detail, ablate=(h,))
@@ -351,7 +352,7 @@ def relates_table(recording: Any, module: str) -> pd.DataFrame:
     Unordered pairs of different entities, a before b alphabetically, shares > 0.
     """
     states = max(int(recording.episodes["steps"].sum()), 1)
-    if module == "predinet":
+    if adapter_class(module).has("attends"):
         att = recording.attends
         wide = att.pivot_table(
             index=["episode", "t", "head"], columns="arg", values="entity", aggfunc="first"
@@ -584,7 +585,7 @@ class _Run:
             "env": canonical_name(self.name),
             "module": module,
             "heads": int(self.agent.config.heads),
-            "relations": int(self.agent.config.relations) if module == "predinet" else 0,
+            "relations": adapter_class(module).relation_count(self.agent.config),
             "episodes": int(self.episodes),
             "seed": int(self.seed),
             "greedy": bool(self.greedy),
@@ -659,8 +660,8 @@ def _vectors_at_base_states(run: _Run, exp: Experiment, base: _Base) -> tuple[np
 def _shift_rows(agent: Any, exp_id: str, vec: np.ndarray, base_vec: np.ndarray) -> list[tuple]:
     """How far each head's relations (PrediNet) or vector (MHDPA) moved, on average."""
     diff = vec.astype(np.float64) - base_vec.astype(np.float64)  # (S, H, D)
-    if agent.config.module == "predinet":
-        J = int(agent.config.relations)
+    J = adapter_class(agent.config.module).relation_count(agent.config)
+    if J:
         shift = np.abs(diff[:, :, :J]).mean(axis=0)  # (H, J)
         return [
             (exp_id, f"relation_shift({h},{j})", float(shift[h, j]))

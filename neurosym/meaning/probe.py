@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.errors import ConfigError
 from neurosym.meaning.predicates import StateLabels
 from neurosym.progress import Stages
@@ -462,13 +463,13 @@ def _probe_recording(
     finally:
         torch.set_num_threads(saved)
     module = agent.config.module
-    relations = int(agent.config.relations) if module == "predinet" else 0
+    relations = adapter_class(module).relation_count(agent.config)
     fits = (2 if base is not None else 1) * feats.shape[1] * (relations + 1)
     table, skipped = fit_probes(
         feats,
         labels,
         state_types(obs),
-        relations=int(agent.config.relations) if module == "predinet" else None,
+        relations=relations or None,
         seed=seed,
         untrained=base,
         test_fraction=test_fraction,
@@ -483,7 +484,7 @@ def _probe_recording(
         "env": env,
         "module": module,
         "heads": int(agent.config.heads),
-        "relations": int(agent.config.relations) if module == "predinet" else 0,
+        "relations": relations,
         "episodes": int(len(recording.episodes)),
         "states": int(len(labels.states)),
         "seed": int(recording.meta.get("seed", seed)),

@@ -11,7 +11,8 @@ writes for the state being played: for episode E and state T
 * per step: ``step(E, T, Action, Reward)`` and ``event(E, T, Event)`` for
   the transition from T to T + 1.
 
-The rows come from the env's decoded info (``decode_info``, the same dicts
+The recorder (:mod:`neurosym.export.recorder`) builds a recording's world tables
+with these same functions. The rows come from the env's decoded info (``decode_info``, the same dicts
 the recorder reads) and its entity grid, as plain Python values: ids and
 names as text, entity and event texts as :class:`~neurosym.terms.Term` once
 parsed (:func:`encode` turns them into what the Prolog side rebuilds).
@@ -75,9 +76,16 @@ def _codes(names: Sequence[str], wanted: Sequence[str]) -> list[int]:
     return [i for i, n in enumerate(names) if n in wanted]
 
 
+def state_objects(info: dict[str, Any]) -> tuple[tuple[Any, ...], ...]:
+    """(id, type, row, col) of the agent and every object on the map in a decoded info, the
+    agent first (the envs list it first; be sure), values as the env gave them."""
+    objects = tuple(info["objects"])
+    if not objects or objects[0][0] != "agent":
+        objects = (("agent", "agent", *info["agent"]), *objects)
+    return objects
+
+
 def state_rows(info: dict[str, Any]) -> tuple[list[tuple[str, int, int]], list[str]]:
     """at/5 rows (id, row, col), agent first, and holding/3 items of a decoded info."""
-    ats = [(str(i), int(r), int(c)) for i, _, r, c in info["objects"]]
-    if not ats or ats[0][0] != "agent":
-        ats.insert(0, ("agent", *(int(v) for v in info["agent"])))
+    ats = [(str(i), int(r), int(c)) for i, _, r, c in state_objects(info)]
     return ats, [str(h) for h in info["holding"]]

@@ -219,22 +219,20 @@ def _draw(args: Any, source: Any, fmt: str) -> str:
     from neurosym.viz.output import save_figure
 
     where = {"episode": args.episode, "seed": args.seed or 0}
-    if args.plot == "mhdpa":
-        fig = attention.mhdpa_figure(
-            source,
-            args.env,
-            step=args.step,
-            object=args.object,
-            cell=args.cell,
-            head=args.head,
-            **where,
-        )
-    elif args.plot == "predinet":
-        fig = predinet.predinet_figure(source, args.env, step=args.step, head=args.head, **where)
-    elif args.plot == "rvectors":
-        fig = predinet.r_vectors_figure(
+    figures = {
+        "mhdpa": lambda: attention.mhdpa_figure(
+            source, args.env, step=args.step, object=args.object, cell=args.cell,
+            head=args.head, **where,
+        ),
+        "predinet": lambda: predinet.predinet_figure(
+            source, args.env, step=args.step, head=args.head, **where
+        ),
+        "rvectors": lambda: predinet.r_vectors_figure(
             source, args.env, head=args.head, max_steps=_positive(args.max_steps), **where
-        )
+        ),
+    }  # fmt: skip
+    if args.plot in figures:
+        fig = figures[args.plot]()
     elif args.plot == "relations":
         fig = relations.relations_figure(
             source,

@@ -95,8 +95,7 @@ def head_pairs(trace: EpisodeTrace, t: int, heads: Sequence[int]) -> list[tuple[
     out = []
     for hd in heads:
         i = trace.head_index(hd)
-        if trace.module == "predinet":
-            assert trace.attention1 is not None and trace.attention2 is not None
+        if trace.attention1 is not None and trace.attention2 is not None:  # PrediNet's pairs
             a1, a2 = trace.attention1[t, i], trace.attention2[t, i]
             if np.isfinite(a1).any() and np.isfinite(a2).any():
                 out.append((i, int(np.nanargmax(a1)), int(np.nanargmax(a2))))
@@ -143,7 +142,7 @@ def _heads(trace: EpisodeTrace, head: int | None) -> tuple[int, ...]:
 
 
 def _arrow_note(trace: EpisodeTrace, heads: Sequence[int]) -> str:
-    if trace.module == "predinet":
+    if trace.attention1 is not None:
         what = "arrows: each head's E1 -> E2 (argmax of a1 -> a2)"
     else:
         what = "arrows: the cell the agent attends to most, per head"

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.agent.play import SingleAsBatch, play_waves
 from neurosym.errors import ConfigError
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
@@ -73,6 +74,7 @@ class _Play:
         self.agent, self.env, self.env_name, self.seed = agent, env, env_name, seed
         self.greedy, self.keep = greedy, keep
         self.module = str(agent.config.module)
+        self.pairs = adapter_class(self.module).has("attends")  # PrediNet: two attended cells
         self.generator = None if greedy else torch.Generator().manual_seed(seed)
         self.names = np.asarray(env.unwrapped.entity_names, dtype=object)
         self.grids: list[np.ndarray] = []
@@ -135,7 +137,7 @@ class _Play:
         )
 
     def _keep(self, t: int, intro: Any) -> None:
-        if self.module == "predinet":
+        if self.pairs:
             self.predinet.append(intro)
             return
         att = _numpy(intro.attention)[0]  # (heads, N, N) query x key
@@ -168,7 +170,7 @@ class _Play:
             complete=True,
             objects=pd.DataFrame(self.object_rows, columns=OBJECT_COLUMNS),
         )
-        if self.module == "predinet":
+        if self.pairs:
             n, h, j = config.n_entities, len(heads), int(config.relations)
             field_of = {name: _stack(self.predinet, name) for name in _PREDINET_FIELDS}
             a1 = field_of["attention1"] if n_steps else np.zeros((0, h, n))  # (S, heads, N)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import adapter_class, module_names
 from neurosym.errors import ConfigError
 from neurosym.export.recording import Recording
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
@@ -37,10 +38,12 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
         )
     meta = dict(rec.meta)
     module = str(meta.get("module", ""))
-    if module not in ("predinet", "mhdpa"):
+    if module not in module_names():
         raise ConfigError(
-            f"the recording names an unknown module {module!r}: expected predinet or mhdpa"
+            f"the recording names an unknown module {module!r}: expected "
+            f"{' or '.join(module_names())}"
         )
+    adapter = adapter_class(module)
     row = episodes.loc[episodes["episode"] == episode].iloc[0]
     steps_tab = _episode_rows(rec.steps, episode).sort_values("t")
     n_steps = int(row["steps"])
@@ -59,7 +62,7 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
     shape = base.shape if base is not None else _shape_from_tables(positions, attends, attention)
     grids = _grids_from_positions(positions, n_steps, shape, base)
     heads = _head_numbers(meta, attends, attention, r_vectors)
-    relations = int(meta.get("relations", 0) or 0) if module == "predinet" else 0
+    relations = int(meta.get("relations", 0) or 0) if adapter.has("relations") else 0
     common = dict(
         checkpoint=str(meta.get("checkpoint", "")),
         env=env_name,
@@ -76,7 +79,7 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
         complete=False,
         objects=positions[OBJECT_COLUMNS].reset_index(drop=True),
     )
-    if module == "predinet":
+    if adapter.has("attends"):
         a1, a2 = _sparse_argument_maps(attends, n_steps, heads, shape)
         r = _r_vector_array(r_vectors, n_steps, heads, relations)
         return EpisodeTrace(**common, attention1=a1, attention2=a2, r_vectors=r)

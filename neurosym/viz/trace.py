@@ -39,7 +39,7 @@ class EpisodeTrace:
     env: str
     """short environment name"""
     module: str
-    """``"predinet"`` or ``"mhdpa"``"""
+    """the relational module's name (``"predinet"``, ``"mhdpa"``)"""
     episode: int
     """episode number in its recording (0 for a live run)"""
     seed: int | None
@@ -171,17 +171,16 @@ class EpisodeTrace:
         return ", ".join(self.events.loc[self.events["t"] == t, "event"].astype(str))
 
 
-_MODULE_TEXT = {"predinet": "a PrediNet", "mhdpa": "an MHDPA"}
-
-
 def require_module(found: str, wanted: str, what: str, checkpoint: str) -> None:
     """One-line refusal when a plot for ``wanted`` is asked of an agent with module ``found``."""
     if found == wanted:
         return
+    from neurosym.agent.networks.adapters import adapter_class, module_names
+
     name = Path(checkpoint).name if checkpoint else "this agent"
-    found_text = _MODULE_TEXT.get(found, f"a {found!r}")
+    found_text = adapter_class(found).article if found in module_names() else f"a {found!r}"
     raise ConfigError(
-        f"{what} needs {_MODULE_TEXT[wanted]} agent, but {name} is {found_text} agent"
+        f"{what} needs {adapter_class(wanted).article} agent, but {name} is {found_text} agent"
     )
 
 

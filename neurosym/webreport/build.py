@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from neurosym.agent.networks.adapters import adapter_class, module_has
 from neurosym.errors import ConfigError, NeurosymError
 from neurosym.export.recording import Recording
 
@@ -108,10 +109,11 @@ def check_page_meta(meta: dict[str, Any], where: str) -> None:
 
 
 def _strongest_note(rec: Recording, facts: Any) -> str:
-    if str(rec.meta.get("module")) == "mhdpa":
+    module = rec.meta.get("module")
+    if module_has(module, "attention"):
         return (
-            "MHDPA computes no relation values: attention/6 holds the strongest key of every "
-            "query cell, drawn in the player above."
+            f"{adapter_class(module).label} computes no relation values: attention/6 holds the "
+            "strongest key of every query cell, drawn in the player above."
         )
     if facts["relation"].empty:
         return "The recording holds no relation values."
@@ -122,7 +124,7 @@ def _title(meta: dict[str, Any]) -> tuple[str, str]:
     name = Path(str(meta.get("checkpoint") or "recording")).name
     module = str(meta.get("module"))
     shape = f"{module}, {meta.get('heads')} heads"
-    if module == "predinet":
+    if module_has(module, "relations"):
         shape += f", {meta.get('relations')} relations"
     return f"{name} on {meta.get('env')}", shape
 
@@ -165,7 +167,7 @@ def report_context(
         "title": title,
         "subtitle": f"{shape} · {len(episodes)} episodes ({mode}, seed {meta.get('seed')})",
         "module": player["module"],
-        "relations": player["relations"] if player["module"] == "predinet" else 0,
+        "relations": player["relations"] if module_has(player["module"], "relations") else 0,
         "player_heads": [
             {"head": h, "colour": HEAD_COLOURS[i % len(HEAD_COLOURS)]}
             for i, h in enumerate(player["heads"])
@@ -282,7 +284,7 @@ def _other_agent(agent: Any, rec_meta: dict[str, Any]) -> str:
     for key, value in (("module", config.module), ("heads", config.heads)):
         if key in rec_meta and rec_meta[key] != value:
             diffs.append(f"its {key} is {value}, the recording's {rec_meta[key]}")
-    if config.module == "predinet" and rec_meta.get("module") == "predinet":
+    if module_has(config.module, "relations") and rec_meta.get("module") == config.module:
         if "relations" in rec_meta and rec_meta["relations"] != config.relations:
             diffs.append(
                 f"its relations are {config.relations}, the recording's {rec_meta['relations']}"

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from neurosym.agent.networks.adapters import module_has
 from neurosym.cards import check_card, learner, training_frames
 from neurosym.errors import CheckpointError
 
@@ -91,7 +92,7 @@ def agent_card(rec_meta: dict[str, Any], agent: Any | None, note: str | None = N
         ("module", _text(rec_meta.get("module"))),
         ("heads", _text(rec_meta.get("heads"))),
     ]
-    if rec_meta.get("module") == "predinet":
+    if module_has(rec_meta.get("module"), "relations"):
         rows.append(("relations", _text(rec_meta.get("relations"))))
     figures: list[tuple[str, str]] = []
     source = "none: the checkpoint is not at hand"

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 import torch
 
+from neurosym.agent.networks.hooks import cache
 from neurosym.errors import ConfigError
 from neurosym.meaning.features import (
     ablate_heads,
     capture_heads,
     head_means,
     head_vectors,
-    mhdpa_head_outputs,
     replay_observations,
 )
 
@@ -53,21 +53,27 @@ def test_predinet_ablation_replaces_only_that_heads_slice() -> None:
         assert torch.equal(model(obs)[0], logits)
 
 
-def test_mhdpa_head_outputs_are_what_enters_norm1() -> None:
-    model = agent("mhdpa").model
+def _mhdpa_values(model, obs: torch.Tensor) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
+    """The MHDPA's input x and its head_out and resid_mid hook values on ``obs``."""
     rel = model.relational
     seen = {}
-    h1 = rel.register_forward_pre_hook(lambda m, a: seen.__setitem__("x", a[0]))
-    h2 = rel.norm1.register_forward_pre_hook(lambda m, a: seen.__setitem__("y", a[0]))
+    handle = rel.register_forward_pre_hook(lambda m, a: seen.__setitem__("x", a[0]))
     try:
-        with torch.inference_mode():
-            model(torch.from_numpy(observations()))
+        with torch.inference_mode(), cache(rel, ["head_out", "resid_mid"]) as values:
+            model(obs)
     finally:
-        h1.remove()
-        h2.remove()
-    x, y = seen["x"], seen["y"]
-    heads = mhdpa_head_outputs(rel, x)  # (B, H, N, F)
-    torch.testing.assert_close(x + heads.sum(1) + rel.proj.bias, y, atol=1e-5, rtol=1e-5)
+        handle.remove()
+    return seen["x"], values
+
+
+def test_mhdpa_head_outputs_are_what_enters_norm1() -> None:
+    model = agent("mhdpa").model
+    x, values = _mhdpa_values(model, torch.from_numpy(observations()))
+    heads = values["head_out"]  # (B, H, N, F)
+    assert heads.shape[:2] == (x.shape[0], model.relational.heads)
+    torch.testing.assert_close(
+        x + heads.sum(1) + model.relational.proj.bias, values["resid_mid"], atol=1e-5, rtol=1e-5
+    )
 
 
 def test_mhdpa_ablation_swaps_only_that_heads_output() -> None:
@@ -76,31 +82,23 @@ def test_mhdpa_ablation_swaps_only_that_heads_output() -> None:
     obs = torch.from_numpy(observations())
     N, F = obs.shape[-2] * obs.shape[-1], rel.query.in_features
     value = torch.full((N, F), 0.25)
-    seen = {}
-
-    def run() -> torch.Tensor:
-        h = rel.norm1.register_forward_pre_hook(lambda m, a: seen.__setitem__("y", a[0].clone()))
-        h0 = rel.register_forward_pre_hook(lambda m, a: seen.__setitem__("x", a[0]))
-        try:
-            with torch.inference_mode():
-                return model(obs)[0]
-        finally:
-            h.remove()
-            h0.remove()
-
-    run()
-    y_plain, x = seen["y"], seen["x"]
+    _, plain_values = _mhdpa_values(model, obs)
     with ablate_heads(model, {0: value}):
-        run()
-    y_ablated = seen["y"]
-    head0 = mhdpa_head_outputs(rel, x)[:, 0]
-    torch.testing.assert_close(y_ablated - y_plain, value - head0, atol=1e-5, rtol=1e-5)
+        _, ablated_values = _mhdpa_values(model, obs)
+    head0 = plain_values["head_out"][:, 0]
+    torch.testing.assert_close(
+        ablated_values["resid_mid"] - plain_values["resid_mid"], value - head0,
+        atol=1e-5, rtol=1e-5,
+    )  # fmt: skip
     with ablate_heads(model, {0: value}), torch.inference_mode(), capture_heads(model) as got:
         model(obs)
     with torch.inference_mode(), capture_heads(model) as plain:
         model(obs)
     assert torch.equal(got[0][:, 1], plain[0][:, 1])  # the other head is untouched
     torch.testing.assert_close(got[0][:, 0], value.amax(0).expand_as(got[0][:, 0]))
+    with torch.inference_mode():  # the hooks are gone afterwards: the plain forward again
+        assert torch.equal(model(obs)[0], model(obs)[0])
+        assert not rel.hook_head_out.active
 
 
 def test_ablation_with_the_heads_own_output_changes_nothing() -> None:

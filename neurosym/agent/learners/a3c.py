@@ -51,6 +51,7 @@ from neurosym.agent.learners.process import (
 )
 from neurosym.agent.learners.returns import AdvantageScale, gae_advantages
 from neurosym.agent.learners.sil import EpisodeMemory, SILBatch, sil_loss
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import Rollout, RolloutState, collect_rollout
 
@@ -152,9 +153,10 @@ def worker(ctx: LearnerContext) -> None:
         memory = None
         if config.a3c.sil > 0:
             memory = EpisodeMemory(config.envs, config.gamma, config.a3c.sil_episodes)
-        # MHDPA's cost is per-sample attention, cheapest in small batches: from 8 envs up,
-        # keeping each acting step's graph beats a second forward over the rollout
-        keep_graph = ctx.model_config.module == "mhdpa" and config.envs >= 8
+        # the module's adapter says from how many envs keeping each acting step's graph beats
+        # a second forward over the rollout (MHDPA: 8; never for PrediNet)
+        from_envs = adapter_class(ctx.model_config.module).keep_graph_envs
+        keep_graph = from_envs is not None and config.envs >= from_envs
         scale = AdvantageScale()
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:  # also stop if the parent died

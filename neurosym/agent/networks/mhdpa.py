@@ -31,6 +31,7 @@ import torch
 import torch.nn.functional as F_
 from torch import nn
 
+from neurosym.agent.networks.hooks import HookPoint, introspected
 from neurosym.agent.networks.introspection import MHDPAIntrospection
 
 
@@ -61,6 +62,13 @@ class MHDPA(nn.Module):
             nn.Identity() if output_size == entity_size else nn.Linear(entity_size, output_size)
         )
         self.scale = attention_gain / math.sqrt(key_size)
+        # hook points (neurosym.agent.networks.hooks), computed explicitly only when a hook
+        # listens: the attention maps (B, H, N, N) and each head's output A^h x W_V^h W_O^h
+        # (B, H, N, F); a value put in place of a head's output moves the residual x +
+        # attended (B, N, F, the point resid_mid, what norm1 reads) by the difference
+        self.hook_attention = HookPoint()
+        self.hook_head_out = HookPoint()
+        self.hook_resid_mid = HookPoint()
 
     def folded_weights(self) -> tuple[torch.Tensor, torch.Tensor]:
         """(F, H * F) W_Q^h W_K^h^T * scale and (F, H * F) W_V^h W_O^h, heads side by side."""
@@ -75,6 +83,12 @@ class MHDPA(nn.Module):
         return qk.permute(1, 0, 2).reshape(F, H * F), vo.permute(1, 0, 2).reshape(F, H * F)
 
     def forward(self, x: torch.Tensor, introspect: bool = False):
+        """(out, None), or (out, :class:`MHDPAIntrospection` of the cached attention maps)."""
+        if not introspect:
+            return self._forward(x), None
+        return introspected(self, MHDPAIntrospection, lambda: self._forward(x))
+
+    def _forward(self, x: torch.Tensor) -> torch.Tensor:
         B, N, F = x.shape
         H = self.heads
         w_qk, w_vo = self.folded_weights()
@@ -83,10 +97,27 @@ class MHDPA(nn.Module):
         keys = x.unsqueeze(1).expand(B, H, N, F)  # (B, H, N, F)
         heads_out = F_.scaled_dot_product_attention(xq, keys, xv, scale=1.0)  # (B, H, N, F)
         attended = heads_out.sum(dim=1) + self.proj.bias  # (B, N, F)
-        x = self.norm1(x + attended)  # (B, N, F)
+        resid = x + attended
+        if self.hook_attention.active or self.hook_head_out.active:
+            delta = self._explicit_heads(xq, keys, xv)
+            if delta is not None:
+                resid = resid + delta
+        x = self.norm1(self.hook_resid_mid(resid))  # (B, N, F)
         x = self.norm2(x + self.mlp(x))  # (B, N, F)
-        out = self.out(x.amax(dim=1))  # (B, output_size)
-        if not introspect:
-            return out, None
-        att = torch.softmax(xq @ keys.transpose(-1, -2), dim=-1)  # (B, H, N, N)
-        return out, MHDPAIntrospection(att)
+        return self.out(x.amax(dim=1))  # (B, output_size)
+
+    def _explicit_heads(
+        self, xq: torch.Tensor, keys: torch.Tensor, xv: torch.Tensor
+    ) -> torch.Tensor | None:
+        """Pass the explicit attention and head outputs through their points; the change
+        the head-output hooks made, summed over the changed heads (None if none)."""
+        att = self.hook_attention(torch.softmax(xq @ keys.transpose(-1, -2), dim=-1))
+        if not self.hook_head_out.active:
+            return None
+        with torch.no_grad():  # what the fused kernel computes; never part of a training graph
+            heads = att @ xv  # (B, H, N, F)
+        new = self.hook_head_out(heads)
+        if new is heads:
+            return None
+        changed = [h for h in range(self.heads) if not torch.equal(new[:, h], heads[:, h])]
+        return new[:, changed].sum(1) - heads[:, changed].sum(1)  # (B, N, F)

@@ -1,4 +1,4 @@
-"""The actor-critic network: encoder -> PrediNet | MHDPA -> MLP -> policy logits and value.
+"""The actor-critic network: encoder -> relational module (PrediNet, MHDPA, any registered) -> MLP -> policy logits and value.
 
 Table 4: the relational module's 26-wide output goes through 26 -> 256 -> 128
 -> 64 (ReLU) and then two linear heads, 4 policy logits and 1 value. The
@@ -18,36 +18,16 @@ import torch
 from torch import nn
 
 from neurosym.agent.config import ModelConfig
+from neurosym.agent.networks.adapters import adapter_class
 from neurosym.agent.networks.encoder import Encoder
 from neurosym.agent.networks.introspection import Introspection
-from neurosym.agent.networks.mhdpa import MHDPA
 from neurosym.agent.networks.predinet import PrediNet, QueryRecord
 from neurosym.errors import ConfigError
 
 
 def build_relational(config: ModelConfig) -> nn.Module:
-    """The relational module named by ``config.module``."""
-    if config.module == "predinet":
-        return PrediNet(
-            config.n_entities,
-            config.entity_size,
-            config.heads,
-            config.key_size,
-            config.relations,
-            config.output_size,
-            config.attention_gain,
-            config.query,
-            config.keys,
-            config.obs_shape[0],
-        )
-    return MHDPA(
-        config.entity_size,
-        config.heads,
-        config.key_size,
-        config.value_size,
-        config.output_size,
-        config.attention_gain,
-    )
+    """The relational module named by ``config.module``, built by its registered adapter."""
+    return adapter_class(config.module).build(config)
 
 
 class ActorCritic(nn.Module):

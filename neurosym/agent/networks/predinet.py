@@ -71,6 +71,7 @@ from typing import NamedTuple
 import torch
 from torch import nn
 
+from neurosym.agent.networks.hooks import HookPoint, introspected
 from neurosym.agent.networks.introspection import PrediNetIntrospection
 
 
@@ -178,6 +179,14 @@ class PrediNet(nn.Module):
         self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
         self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
+        # hook points (neurosym.agent.networks.hooks): the attention maps a1, a2 (B, H, N) and
+        # the positions (B, H, 2) are read-only in effect (E1, E2 are computed with them inside
+        # the attention); a value put in place of D^h (B, H, J) or of R^h (B, H, J + 4, what
+        # ``out`` reads) is what the rest of the forward uses
+        self.hook_attention1, self.hook_attention2 = HookPoint(), HookPoint()
+        self.hook_relations = HookPoint()
+        self.hook_positions1, self.hook_positions2 = HookPoint(), HookPoint()
+        self.hook_r = HookPoint()
 
     def weights_key(self) -> tuple:
         """Identifies the current W_Q values. A recorded query also depends on its entities, so
@@ -247,9 +256,18 @@ class PrediNet(nn.Module):
         queries: QueryRecord | None = None,
         cells: torch.Tensor | None = None,
     ):
-        """``queries``: a record of this module's own earlier forwards over the first rows of
-        ``L``, used only while the weights are unchanged (else recomputed). ``cells``: (B, N, C)
-        each cell's observation, the keys' input when ``keys="cells"`` (needed then)."""
+        """(out, None), or (out, :class:`PrediNetIntrospection` of the cached hook values) with
+        ``introspect``. ``queries``: a record of this module's own earlier forwards over the
+        first rows of ``L``, used only while the weights are unchanged (else recomputed).
+        ``cells``: (B, N, C) each cell's observation, the keys' input when ``keys="cells"``
+        (needed then)."""
+        if not introspect:
+            return self._forward(L, queries, cells), None
+        return introspected(self, PrediNetIntrospection, lambda: self._forward(L, queries, cells))
+
+    def _forward(
+        self, L: torch.Tensor, queries: QueryRecord | None, cells: torch.Tensor | None
+    ) -> torch.Tensor:
         B, N, F = L.shape
         H = self.heads
         if self.keys == "cells":
@@ -262,11 +280,11 @@ class PrediNet(nn.Module):
             )
         else:
             a, e = self._scene_attention(L, queries)
-        a1, a2, e1, e2 = a[:, :H], a[:, H:], e[:, :H], e[:, H:]  # (B, H, N), (B, H, F)
-        rel = self.embed(e1[..., :-2] - e2[..., :-2])  # (B, H, J)  D^h
-        pos1, pos2 = e1[..., -2:], e2[..., -2:]  # (B, H, 2)
-        r = torch.cat([rel, pos1, pos2], dim=-1)  # (B, H, J + 4)
-        out = self.out(r.reshape(B, H * (self.relations + 4)))  # (B, output_size)
-        if not introspect:
-            return out, None
-        return out, PrediNetIntrospection(a1, a2, rel, pos1, pos2)
+        e1, e2 = e[:, :H], e[:, H:]  # (B, H, F)
+        self.hook_attention1(a[:, :H])  # (B, H, N)
+        self.hook_attention2(a[:, H:])
+        rel = self.hook_relations(self.embed(e1[..., :-2] - e2[..., :-2]))  # (B, H, J)  D^h
+        pos1 = self.hook_positions1(e1[..., -2:])  # (B, H, 2)
+        pos2 = self.hook_positions2(e2[..., -2:])
+        r = self.hook_r(torch.cat([rel, pos1, pos2], dim=-1))  # (B, H, J + 4)
+        return self.out(r.reshape(B, H * (self.relations + 4)))  # (B, output_size)
