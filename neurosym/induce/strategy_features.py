@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from neurosym.agent.networks.adapters import module_has
 from neurosym.errors import ConfigError, FactError
 from neurosym.induce.prolog_text import pl_text
 from neurosym.induce.strategy_data import KINDS, Trace
@@ -293,7 +294,8 @@ def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature],
     feats: list[Feature] = []
     cols: list[list[float]] = []
     rows = list(pairs.itertuples(index=False))
-    if not trace.attends.empty or trace.meta.get("module") == "predinet":
+    module = trace.meta.get("module")
+    if not trace.attends.empty or module_has(module, "attends"):
         cells = {(e, t, h, a, r, c) for e, t, h, a, r, c in trace.attends.itertuples(index=False)}
         for h in range(heads):
             for a in (1, 2):
@@ -305,7 +307,7 @@ def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature],
             for pos, table in ((1, first), (2, second)):
                 feats.append(Feature(f"related({j},{pos})", goal_term("related", E_, T_, j, pos, O_)))
                 cols.append([float((e, t, j, types[o]) in table) for e, t, o, r, c in rows])
-    if not trace.attention.empty or trace.meta.get("module") == "mhdpa":
+    if not trace.attention.empty or module_has(module, "attention"):
         att = trace.attention
         from_agent = {(e, t, h, k) for e, t, h, q, k in att.itertuples(index=False) if q == "agent"}
         to_agent = {(e, t, h, q) for e, t, h, q, k in att.itertuples(index=False) if k == "agent"}
