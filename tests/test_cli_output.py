@@ -51,19 +51,19 @@ def test_a_closed_pipe_ends_the_command_quietly(args: tuple[object, ...]) -> Non
     assert (proc.returncode, proc.stderr) == (BROKEN_PIPE_EXIT, "")
 
 
-def test_top_keys_is_refused_on_a_predinet(run_neurosym, tmp_path: Path) -> None:  # noqa: ANN001
+def test_top_keys_is_refused_on_a_predinet(neurosym_main, tmp_path: Path) -> None:  # noqa: ANN001
     out = tmp_path / "kb"
-    proc = run_neurosym("extract", "--checkpoint", CHECKPOINTS / "rgw2-predinet.pt",
+    proc = neurosym_main("extract", "--checkpoint", CHECKPOINTS / "rgw2-predinet.pt",
                         "--top-keys", 3, "--episodes", 1, "--out", out)  # fmt: skip
     assert proc.returncode == 1 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert "--top-keys is for MHDPA checkpoints" in proc.stderr and "is a predinet" in proc.stderr
     assert not out.exists()
 
 
-def test_eval_shows_a_checkpoint_name_as_text(run_neurosym, tmp_path: Path) -> None:  # noqa: ANN001
+def test_eval_shows_a_checkpoint_name_as_text(neurosym_main, tmp_path: Path) -> None:  # noqa: ANN001
     hostile = tmp_path / "[red]x\x1b[31m.pt"
     shutil.copy(CHECKPOINTS / "rgw1-predinet.pt", hostile)
-    proc = run_neurosym("eval", "--checkpoint", hostile, "--episodes", 1)
+    proc = neurosym_main("eval", "--checkpoint", hostile, "--episodes", 1)
     assert proc.returncode == 0, proc.stderr
     assert "\x1b" not in proc.stdout
     assert "[red]x\\e[31m.pt (rgw1, predinet" in proc.stdout
@@ -147,8 +147,8 @@ def test_the_training_bar_never_cuts_a_figure(tmp_path: Path) -> None:
     assert "…" not in plain, plain
 
 
-def test_an_error_is_one_line_whatever_the_path_holds(run_neurosym) -> None:  # noqa: ANN001
-    proc = run_neurosym("eval", "--checkpoint", "/nowhere/x\x1b[31mred\nline2.pt")
+def test_an_error_is_one_line_whatever_the_path_holds(neurosym_main) -> None:  # noqa: ANN001
+    proc = neurosym_main("eval", "--checkpoint", "/nowhere/x\x1b[31mred\nline2.pt")
     assert proc.returncode == 1
     assert (
         proc.stderr

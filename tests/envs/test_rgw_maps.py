@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -122,14 +124,15 @@ def test_unknown_map_name_is_refused() -> None:
     ],
 )
 def test_a_map_file_that_is_not_utf8_is_one_line_naming_it(
-    tmp_path, run_neurosym, data: bytes, message: str
+    tmp_path, neurosym_main, monkeypatch, data: bytes, message: str
 ) -> None:
     path = tmp_path / "map.txt"
     path.write_bytes(data)
     with pytest.raises(MapError) as err:
         load_map(str(path))
     assert str(err.value) == f"map {str(path)!r}: {message}; a map is lines of .AWMPSETOQ"
-    proc = run_neurosym(
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])  # checkpoints/ as from the repository
+    proc = neurosym_main(
         "eval", "--checkpoint", "checkpoints/rgw2-predinet.pt", "--map", path, "--episodes", 1
     )
     assert (proc.returncode, proc.stdout) == (1, "")

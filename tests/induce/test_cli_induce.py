@@ -19,10 +19,10 @@ def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     )
 
 
-def test_induce_prints_each_event_and_writes_the_rules(run_neurosym, kbs, tmp_path: Path) -> None:
+def test_induce_prints_each_event_and_writes_the_rules(neurosym_main, kbs, tmp_path: Path) -> None:
     train, held = kbs
     out = tmp_path / "world.pl"
-    done = run_neurosym("induce", "world", "--kb", train, "--out", out, "--holdout", held)
+    done = neurosym_main("induce", "world", "--kb", train, "--out", out, "--holdout", held)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert lines[0].startswith(f"learned from {train} (env rgw-random, 60 episodes, ")
@@ -42,8 +42,8 @@ def test_induce_prints_each_event_and_writes_the_rules(run_neurosym, kbs, tmp_pa
     assert out.read_text().startswith("/** <module> World rules learned")
 
 
-def test_without_holdout_only_train_scores(run_neurosym, kbs, tmp_path: Path) -> None:
-    done = run_neurosym("induce", "world", "--kb", kbs[0], "--out", tmp_path / "w.pl")
+def test_without_holdout_only_train_scores(neurosym_main, kbs, tmp_path: Path) -> None:
+    done = neurosym_main("induce", "world", "--kb", kbs[0], "--out", tmp_path / "w.pl")
     assert done.returncode == 0, done.stderr
     assert "held-out" not in done.stdout and "held out" not in done.stdout
 
@@ -62,7 +62,7 @@ def test_without_holdout_only_train_scores(run_neurosym, kbs, tmp_path: Path) ->
     ],
 )
 def test_bad_input_is_one_line(
-    run_neurosym, kbs, tmp_path: Path, args: list[str], message: str
+    neurosym_main, kbs, tmp_path: Path, args: list[str], message: str
 ) -> None:
     from neurosym.export.facts import extract_facts
     from neurosym.export.recording import Recording
@@ -70,7 +70,7 @@ def test_bad_input_is_one_line(
     empty = extract_facts(Recording()).to_prolog(tmp_path / "empty.pl")
     args = [{"KB": str(kbs[0]), "EMPTY": str(empty)}.get(a, a) for a in args]
     out = tmp_path / "w.pl"
-    done = run_neurosym("induce", *args, "--out", out)
+    done = neurosym_main("induce", *args, "--out", out)
     assert done.returncode == 1
     assert len(done.stderr.splitlines()) == 1 and message in done.stderr
     assert not out.exists()
@@ -88,12 +88,12 @@ def test_induce_imports_no_torch(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
 
 
-def test_extract_random_actions_records_it(run_neurosym, tmp_path: Path) -> None:
+def test_extract_random_actions_records_it(neurosym_main, tmp_path: Path) -> None:
     ckpt = small_checkpoint(tmp_path / "small.pt", "predinet", 12, relations=3)
     outs = []
     for batch in ("3", "1"):
         out = tmp_path / f"kb{batch}"
-        done = run_neurosym(
+        done = neurosym_main(
             "extract", "--checkpoint", ckpt, "--actions", "random", "--episodes", "3",
             "--batch", batch, "--out", out, "--quiet",
         )  # fmt: skip
@@ -102,7 +102,7 @@ def test_extract_random_actions_records_it(run_neurosym, tmp_path: Path) -> None
     assert "kb_meta(actions,random)." in outs[0]
     steps = [sorted(x for x in text.splitlines() if x.startswith("step(")) for text in outs]
     assert steps[0] == steps[1] and len(steps[0]) == 36  # 3 episodes of 12 steps, same at any batch
-    agent = run_neurosym(
+    agent = neurosym_main(
         "extract", "--checkpoint", ckpt, "--episodes", "3", "--out", tmp_path / "a", "--quiet"
     )
     assert agent.returncode == 0

@@ -14,10 +14,10 @@ def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     return nearest_key_kb(folder / "train.pl", 30, seed=3), nearest_key_kb(folder / "test.pl", 10, seed=4)
 
 
-def test_cli_learns_prints_and_writes(run_neurosym, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_learns_prints_and_writes(neurosym_main, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     train, test = kbs
     out = tmp_path / "strategy.pl"
-    r = run_neurosym("induce", "strategy", "--kb", train, "--holdout", test, "--out", out)
+    r = neurosym_main("induce", "strategy", "--kb", train, "--holdout", test, "--out", out)
     assert r.returncode == 0, r.stderr
     assert "fidelity 1.0000 on" in r.stdout and f"wrote {out}" in r.stdout
     text = out.read_text()
@@ -25,10 +25,10 @@ def test_cli_learns_prints_and_writes(run_neurosym, kbs: tuple[Path, Path], tmp_
     assert f"Learned by `neurosym induce strategy` from {train}" in text
 
 
-def test_cli_holdout_share_and_relations(run_neurosym, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_holdout_share_and_relations(neurosym_main, kbs: tuple[Path, Path], tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     train, _ = kbs
     out = tmp_path / "s.pl"
-    r = run_neurosym(
+    r = neurosym_main(
         "induce", "strategy", "--kb", train, "--features", "relations",
         "--holdout-share", "0.5", "--out", out,
     )  # fmt: skip
@@ -51,10 +51,10 @@ def test_cli_holdout_share_and_relations(run_neurosym, kbs: tuple[Path, Path], t
          "induce world ... or neurosym induce strategy ..."),
     ],
 )  # fmt: skip
-def test_cli_errors_are_one_line(run_neurosym, kbs, tmp_path: Path, args, code, message) -> None:  # type: ignore[no-untyped-def]
+def test_cli_errors_are_one_line(neurosym_main, kbs, tmp_path: Path, args, code, message) -> None:  # type: ignore[no-untyped-def]
     train, _ = kbs
     full = [*args[:1], "--kb", train, *args[1:]] if "--kb" not in args else args
-    r = run_neurosym("induce", *full, "--out", tmp_path / "s.pl")
+    r = neurosym_main("induce", *full, "--out", tmp_path / "s.pl")
     assert r.returncode == code
     assert message in r.stderr
     if code == 1 or "--what" in args:
@@ -78,9 +78,9 @@ def test_induce_imports_neither_torch_nor_the_envs() -> None:
     assert out.stdout.split() == ["False", "False"]
 
 
-def test_cli_refuses_a_folder_as_out_before_learning(run_neurosym, kbs, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_refuses_a_folder_as_out_before_learning(neurosym_main, kbs, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     train, _ = kbs
-    r = run_neurosym("induce", "strategy", "--kb", train, "--out", tmp_path)
+    r = neurosym_main("induce", "strategy", "--kb", train, "--out", tmp_path)
     assert r.returncode == 1
     assert r.stderr.startswith("neurosym induce: error: ") and len(r.stderr.strip().splitlines()) == 1
     assert "learned from" not in r.stdout

@@ -44,8 +44,9 @@ def test_features_agree_on_a_generated_kb(tmp_path: Path) -> None:
 
 @pytest.mark.expensive
 @pytest.mark.parametrize(("checkpoint", "env"), [("rgw-random-predinet-cellkeys", "rgw-random"), ("rgw-random-mhdpa", "rgw-random"), ("bw2-predinet", "bw2")])
-def test_features_agree_on_recorded_kbs(run_neurosym, tmp_path: Path, checkpoint: str, env: str) -> None:  # type: ignore[no-untyped-def]
-    r = run_neurosym(
+def test_features_agree_on_recorded_kbs(neurosym_main, monkeypatch, tmp_path: Path, checkpoint: str, env: str) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])  # checkpoints/ as from the repository
+    r = neurosym_main(
         "extract", "--checkpoint", f"checkpoints/{checkpoint}.pt", "--env", env,
         "--episodes", 4, "--seed", 3_000_000_000, "--out", tmp_path / "kb", "--quiet",
     )  # fmt: skip

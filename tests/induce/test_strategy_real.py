@@ -20,10 +20,11 @@ from neurosym.induce.strategy_data import load_trace
         ("bw2-predinet", "bw2", "world"),
     ],
 )
-def test_real_kb_round_trip(run_neurosym, swipl: Path, tmp_path: Path, checkpoint: str, env: str, features: str) -> None:  # type: ignore[no-untyped-def]
+def test_real_kb_round_trip(neurosym_main, monkeypatch, swipl: Path, tmp_path: Path, checkpoint: str, env: str, features: str) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])  # checkpoints/ as from the repository
     kbs = []
     for part, seed, episodes in (("train", 2_000_000_000, 8), ("test", 3_000_000_000, 4)):
-        r = run_neurosym(
+        r = neurosym_main(
             "extract", "--checkpoint", f"checkpoints/{checkpoint}.pt", "--env", env,
             "--episodes", episodes, "--seed", seed, "--out", tmp_path / part, "--quiet",
         )  # fmt: skip

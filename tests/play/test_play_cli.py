@@ -11,8 +11,14 @@ ROOT = Path(__file__).resolve().parents[2]
 RGW = "examples/play/rgw_strategy.pl"
 
 
-def test_json(run_neurosym) -> None:
-    proc = run_neurosym("play", "--policy", RGW, "--env", "rgw2", "--episodes", "2", "--json")
+@pytest.fixture(autouse=True)
+def _from_the_repository(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Relative paths (RGW, the error messages that name them) as from the repository root."""
+    monkeypatch.chdir(ROOT)
+
+
+def test_json(neurosym_main) -> None:
+    proc = neurosym_main("play", "--policy", RGW, "--env", "rgw2", "--episodes", "2", "--json")
     assert proc.returncode == 0, proc.stderr
     report = json.loads(proc.stdout)
     assert report["mean_return"] == pytest.approx(10.7)
@@ -22,8 +28,8 @@ def test_json(run_neurosym) -> None:
     assert report["steps_per_s"] > 0 and report["features"] == "world"
 
 
-def test_text_and_env_option(run_neurosym) -> None:
-    proc = run_neurosym(
+def test_text_and_env_option(neurosym_main) -> None:
+    proc = neurosym_main(
         "play", "--policy", RGW, "--env", "rgw-random", "--episodes", "3", "--seed", "1000",
         "--env-option", "enemy=end",
     )  # fmt: skip
@@ -54,19 +60,19 @@ def test_text_and_env_option(run_neurosym) -> None:
         ),
     ],
 )
-def test_errors(run_neurosym, tmp_path: Path, args: list[str], message: str) -> None:
+def test_errors(neurosym_main, tmp_path: Path, args: list[str], message: str) -> None:
     (tmp_path / "nogoal.pl").write_text("foo(1).\n")
     (tmp_path / "relations.pl").write_text("%! features: relations\ngoal(_, _, terminal).\n")
     args = [
         a.format(nogoal=tmp_path / "nogoal.pl", relations=tmp_path / "relations.pl") for a in args
     ]
-    proc = run_neurosym("play", *args)
+    proc = neurosym_main("play", *args)
     assert proc.returncode == 1, proc.stdout
     assert proc.stderr.startswith("neurosym play: error: ") and message in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
-def test_a_strategy_over_the_networks_relations(run_neurosym, tmp_path: Path) -> None:
+def test_a_strategy_over_the_networks_relations(neurosym_main, tmp_path: Path) -> None:
     """features: both: holds/5 computed live from the checkpoint, thresholds from --kb."""
     policy = tmp_path / "both.pl"
     policy.write_text(
@@ -77,13 +83,13 @@ def test_a_strategy_over_the_networks_relations(run_neurosym, tmp_path: Path) ->
     kb = tmp_path / "kb.pl"
     kb.write_text("".join(f"threshold({j}, 0.5).\n" for j in range(8)))
     args = ["play", "--policy", policy, "--checkpoint", "rgw-random-predinet-cellkeys"]
-    proc = run_neurosym(*args, "--kb", kb, "--episodes", "2", "--seed", "3000000000", "--json")
+    proc = neurosym_main(*args, "--kb", kb, "--episodes", "2", "--seed", "3000000000", "--json")
     assert proc.returncode == 0, proc.stderr
     report = json.loads(proc.stdout)
     assert report["env"] == "rgw-random" and report["env_kwargs"] == {"num_mountains": 12}
     assert report["features"] == "both" and report["success_rate"] == 1.0
     assert report["fallback_steps"] < report["steps"]  # holds/5 facts were there to read
-    proc = run_neurosym(*args, "--episodes", "1")
+    proc = neurosym_main(*args, "--episodes", "1")
     assert proc.returncode == 1
     assert "has no threshold/2 for holds/5: give the KB it was learned from (--kb)" in proc.stderr
 

@@ -59,14 +59,14 @@ DATA_KB = (
 
 @pytest.mark.parametrize("hostile", [False, True])
 def test_kb_facts_cannot_change_a_route(
-    run_neurosym, swipl: Path, tmp_path: Path, hostile: bool
+    neurosym_main, swipl: Path, tmp_path: Path, hostile: bool
 ) -> None:
     """A KB holding facts named like route.pl's private cache answers as one without them:
     a fact KB through neurosym query, and route.plt's states in plain swipl (kb.pl, route.pl)."""
     kb = tmp_path / "kb.pl"
     kb.write_text(DATA_KB + (HOSTILE if hostile else ""))
     goal = "route(0, 0, terminal, A, C), route_moves(0, 0, terminal, D)"
-    proc = run_neurosym("query", "--kb", kb, "--rules", "route", goal, "--csv")
+    proc = neurosym_main("query", "--kb", kb, "--rules", "route", goal, "--csv")
     assert (proc.returncode, proc.stdout.split()) == (0, ["A,C,D", "right,2,2"]), proc.stderr
     code = tmp_path / "states.pl"
     code.write_text(FACTS.read_text() + (HOSTILE if hostile else ""))

@@ -1,4 +1,6 @@
-"""`neurosym query` run as users run it: a subprocess on real files."""
+"""`neurosym query` on real files: through ``main()`` in this process where its exit code and
+output are what is checked, as a subprocess where the process is (Ctrl-C, closed pipes,
+rlimits, a FIFO that an in-process read could hang on)."""
 
 from __future__ import annotations
 
@@ -33,9 +35,9 @@ def kb_files(tmp_path: Path) -> tuple[Path, Path]:
     return facts, rules
 
 
-def test_json_and_csv(run_neurosym, kb_files: tuple[Path, Path]) -> None:
+def test_json_and_csv(neurosym_main, kb_files: tuple[Path, Path]) -> None:
     facts, rules = kb_files
-    proc = run_neurosym(
+    proc = neurosym_main(
         "query", "--kb", facts, "--rules", rules, "--json", "event(E, T, Ev), path(1, P)"
     )
     assert proc.returncode == 0, proc.stderr
@@ -43,22 +45,22 @@ def test_json_and_csv(run_neurosym, kb_files: tuple[Path, Path]) -> None:
         {"E": 0, "T": 3, "Ev": "picked(sword)", "P": ["a", "f(x)"]},
         {"E": 0, "T": 5, "Ev": "opened(lock(red))", "P": ["a", "f(x)"]},
     ]
-    proc = run_neurosym("query", "--kb", facts, "--csv", "object(Id, Type)")
+    proc = neurosym_main("query", "--kb", facts, "--csv", "object(Id, Type)")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "Id,Type\nagent,agent\ns1,sword\nIt's,key(red)\n"
 
 
-def test_table_limit_and_bind(run_neurosym, kb_files: tuple[Path, Path]) -> None:
+def test_table_limit_and_bind(neurosym_main, kb_files: tuple[Path, Path]) -> None:
     facts, rules = kb_files
-    proc = run_neurosym("query", "--kb", facts, "--rules", rules, "picked_item(E, I)")
+    proc = neurosym_main("query", "--kb", facts, "--rules", rules, "picked_item(E, I)")
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     assert any("E" in ln and "I" in ln for ln in lines[:3])
     assert any("sword" in ln for ln in lines)
     assert lines[-1] == "1 answer"
-    proc = run_neurosym("query", "--kb", facts, "--limit", "1", "--csv", "object(Id, _)")
+    proc = neurosym_main("query", "--kb", facts, "--limit", "1", "--csv", "object(Id, _)")
     assert proc.stdout == "Id\nagent\n"
-    proc = run_neurosym(
+    proc = neurosym_main(
         "query", "--kb", facts, "--bind", "Ev=opened(lock(red))", "--bind", "E=0", "--csv",
         "event(E, T, Ev)",
     )  # fmt: skip
@@ -66,11 +68,11 @@ def test_table_limit_and_bind(run_neurosym, kb_files: tuple[Path, Path]) -> None
 
 
 def test_goal_without_outputs_prints_true_or_false(
-    run_neurosym, kb_files: tuple[Path, Path]
+    neurosym_main, kb_files: tuple[Path, Path]
 ) -> None:
     facts, _ = kb_files
-    assert run_neurosym("query", "--kb", facts, "object(s1, sword)").stdout == "true\n"
-    assert run_neurosym("query", "--kb", facts, "object(s1, enemy)").stdout == "false\n"
+    assert neurosym_main("query", "--kb", facts, "object(s1, sword)").stdout == "true\n"
+    assert neurosym_main("query", "--kb", facts, "object(s1, enemy)").stdout == "false\n"
 
 
 @pytest.mark.parametrize(
@@ -103,7 +105,7 @@ def test_goal_without_outputs_prints_true_or_false(
     ],
 )
 def test_errors_are_one_line_and_exit_non_zero(
-    run_neurosym, kb_files: tuple[Path, Path], args: list[str], message: str
+    request: pytest.FixtureRequest, kb_files: tuple[Path, Path], args: list[str], message: str
 ) -> None:
     facts, _ = kb_files
     (facts.parent / "bad.pl").write_text("p(.\n")
@@ -111,7 +113,10 @@ def test_errors_are_one_line_and_exit_non_zero(
     for name in ("k\udcff.pl", "r\udcff.pl"):  # byte 0xff: not UTF-8
         (facts.parent / name).write_text("p(1).\n")
     fill = {"dir": str(facts.parent), "facts": str(facts)}
-    proc = run_neurosym("query", *(a.format(**fill) for a in args))
+    # a FIFO in a subprocess: if a regression opened it, the run would block, and the
+    # subprocess' timeout ends it where an in-process run would hang the suite
+    runner = request.getfixturevalue("run_neurosym" if "fifo" in args[1] else "neurosym_main")
+    proc = runner("query", *(a.format(**fill) for a in args))
     assert proc.returncode == 1
     assert proc.stdout == ""
     assert proc.stderr.count("\n") == 1, proc.stderr
@@ -119,24 +124,24 @@ def test_errors_are_one_line_and_exit_non_zero(
     assert message.format(**fill) in proc.stderr
 
 
-def test_load_warnings_go_to_stderr(run_neurosym, kb_files: tuple[Path, Path]) -> None:
+def test_load_warnings_go_to_stderr(neurosym_main, kb_files: tuple[Path, Path]) -> None:
     facts, _ = kb_files
     rules = facts.parent / "w.pl"
     rules.write_text("p(X) :- true.\n")
-    proc = run_neurosym("query", "--kb", facts, "--rules", rules, "--csv", "p(1)")
+    proc = neurosym_main("query", "--kb", facts, "--rules", rules, "--csv", "p(1)")
     assert proc.returncode == 0
     assert proc.stdout == "\n\n"  # no output variables: an empty header, one empty row
     assert proc.stderr == f"neurosym query: warning: {rules}:1: Singleton variables: [X]\n"
 
 
-def test_help_lists_every_shipped_rule_file(run_neurosym) -> None:
+def test_help_lists_every_shipped_rule_file(neurosym_main) -> None:
     from neurosym.shipped import rules_dir
 
     folder = rules_dir()
     assert folder is not None
     names = sorted(p.stem for p in folder.glob("*.pl"))
     assert "route" in names
-    text = " ".join(run_neurosym("query", "--help").stdout.split())
+    text = " ".join(neurosym_main("query", "--help").stdout.split())
     assert f"a shipped one by name ({', '.join(names)})" in text
 
 
@@ -177,20 +182,20 @@ link(indirect([agent])).
 """
 
 
-def test_the_table_shows_data_as_text(run_neurosym, tmp_path: Path) -> None:
+def test_the_table_shows_data_as_text(neurosym_main, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text(HOSTILE)
-    proc = run_neurosym("query", "--kb", facts, "link(How)")
+    proc = neurosym_main("query", "--kb", facts, "link(How)")
     assert proc.returncode == 0, proc.stderr
     assert "indirect([agent])" in proc.stdout
-    proc = run_neurosym("query", "--kb", facts, "object(Id, T)")
+    proc = neurosym_main("query", "--kb", facts, "object(Id, T)")
     assert proc.returncode == 0, proc.stderr
     assert "[link=https://evil.example]click[/link]" in proc.stdout
     assert "\\e[31mred\\e[0m" in proc.stdout and "\x1b" not in proc.stdout
     assert "[x,y]" in proc.stdout
 
 
-def test_sword_enemy_link_prints_its_list(run_neurosym, tmp_path: Path) -> None:
+def test_sword_enemy_link_prints_its_list(neurosym_main, tmp_path: Path) -> None:
     from conftest import REPO
 
     facts = tmp_path / "kb.pl"
@@ -198,26 +203,26 @@ def test_sword_enemy_link_prints_its_list(run_neurosym, tmp_path: Path) -> None:
         ":- dynamic attention/6.\nobject(s1, sword).\nobject(e1, enemy).\n"
         "holds(0, 1, r(1), sword, agent).\nholds(0, 1, r(1), agent, enemy).\n"
     )
-    proc = run_neurosym("query", "--kb", facts, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(How)")
+    proc = neurosym_main("query", "--kb", facts, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(How)")
     assert proc.returncode == 0, proc.stderr
     assert "indirect([agent])" in proc.stdout
 
 
-def test_json_writes_infinities_as_text(run_neurosym, tmp_path: Path) -> None:
+def test_json_writes_infinities_as_text(neurosym_main, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, "--json", "X is inf, Y is -inf, Z is nan")
+    proc = neurosym_main("query", "--kb", facts, "--json", "X is inf, Y is -inf, Z is nan")
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout) == [{"X": "inf", "Y": "-inf", "Z": "nan"}]
 
 
-def test_answers_holding_variables_print_with_names(run_neurosym, tmp_path: Path) -> None:
+def test_answers_holding_variables_print_with_names(neurosym_main, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, "--json", "X = f(Y, Z, [Y])")
+    proc = neurosym_main("query", "--kb", facts, "--json", "X = f(Y, Z, [Y])")
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout) == [{"X": "f(_G1,_G2,[_G1])", "Y": None, "Z": None}]
-    proc = run_neurosym("query", "--kb", facts, "X = f(Y)")
+    proc = neurosym_main("query", "--kb", facts, "X = f(Y)")
     assert proc.returncode == 0, proc.stderr
     assert "f(_G1)" in proc.stdout and proc.stdout.endswith("1 answer\n")
 
@@ -232,11 +237,11 @@ def test_answers_holding_variables_print_with_names(run_neurosym, tmp_path: Path
 )  # fmt: skip
 @pytest.mark.parametrize("fmt", ["json", "csv", "table"])
 def test_answers_python_cannot_take_are_one_line_and_print_nothing(
-    run_neurosym, tmp_path: Path, goal: str, message: str, fmt: str
+    neurosym_main, tmp_path: Path, goal: str, message: str, fmt: str
 ) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
-    proc = run_neurosym("query", "--kb", facts, *{"table": []}.get(fmt, [f"--{fmt}"]), goal)
+    proc = neurosym_main("query", "--kb", facts, *{"table": []}.get(fmt, [f"--{fmt}"]), goal)
     assert proc.returncode == 1
     assert proc.stdout == ""
     assert proc.stderr == f"neurosym query: error: {message}" + proc.stderr.split(message, 1)[1]
@@ -260,13 +265,13 @@ def test_answers_python_cannot_take_are_one_line_and_print_nothing(
     ],
 )  # fmt: skip
 def test_bad_bounds_and_goals_are_refused_in_one_line(
-    run_neurosym, tmp_path: Path, args: list[str], message: str
+    neurosym_main, tmp_path: Path, args: list[str], message: str
 ) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
     if args[0].startswith("--") and not args[0].startswith("--bind"):
         args = [*args, "ok(X)"]
-    proc = run_neurosym("query", "--kb", facts, *args)
+    proc = neurosym_main("query", "--kb", facts, *args)
     assert proc.returncode == 1, proc.stdout
     assert proc.stdout == ""
     assert proc.stderr.count("\n") == 1, proc.stderr
@@ -274,11 +279,11 @@ def test_bad_bounds_and_goals_are_refused_in_one_line(
     assert message in proc.stderr
 
 
-def test_a_goal_ending_in_a_full_stop_or_comment_is_one_goal(run_neurosym, tmp_path) -> None:
+def test_a_goal_ending_in_a_full_stop_or_comment_is_one_goal(neurosym_main, tmp_path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
     for goal in ("ok(X).", "ok(X). % a comment", "X = 'a. b'"):
-        proc = run_neurosym("query", "--kb", facts, "--csv", goal)
+        proc = neurosym_main("query", "--kb", facts, "--csv", goal)
         assert proc.returncode == 0, proc.stderr
 
 

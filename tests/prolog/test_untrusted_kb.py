@@ -98,10 +98,10 @@ def test_planted_code_in_a_fact_file_is_refused_and_never_runs(
 
 
 @pytest.mark.parametrize("qlf", [False, True])
-def test_the_cli_refuses_planted_code_in_one_line(run_neurosym, tmp_path: Path, marker: Path, qlf):
+def test_the_cli_refuses_planted_code_in_one_line(neurosym_main, tmp_path: Path, marker: Path, qlf):
     path = _plant(tmp_path, marker, ":- initialization({touch}).")
     args = ["query", "--kb", path, "ok(X)"] + (["--qlf"] if qlf else [])
-    proc = run_neurosym(*args)
+    proc = neurosym_main(*args)
     assert proc.returncode == 1
     assert proc.stderr.count("\n") == 1, proc.stderr
     assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}:3: found a directive")
@@ -124,7 +124,7 @@ def _rgw_kb(tmp_path: Path) -> Path:
 
 @pytest.mark.parametrize("qlf", [False, True])
 def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
-    run_neurosym, tmp_path: Path, marker: Path, qlf: bool
+    neurosym_main, tmp_path: Path, marker: Path, qlf: bool
 ) -> None:
     path = _rgw_kb(tmp_path)
     with KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"]) as kb:  # the KB as written works
@@ -133,7 +133,7 @@ def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
     with path.open("a") as fh:
         fh.write(f"attention(_,_,_,_,_,_) => {_touch(marker)}, fail.\n")
     args = ["query", "--kb", path, "--rules", REPO / "rules" / "rgw.pl", "sword_enemy_link(L)"]
-    proc = run_neurosym(*args, *(["--qlf"] if qlf else []))
+    proc = neurosym_main(*args, *(["--qlf"] if qlf else []))
     assert proc.returncode == 1, proc.stdout
     assert proc.stderr.count("\n") == 1, proc.stderr
     assert proc.stderr.startswith(
@@ -145,7 +145,7 @@ def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
     assert not path.with_suffix(".qlf").exists()
 
 
-def test_trust_and_rules_load_the_same_file_as_code(run_neurosym, tmp_path, marker) -> None:
+def test_trust_and_rules_load_the_same_file_as_code(neurosym_main, tmp_path, marker) -> None:
     """Positive controls: the payload does run when the user says the file is code."""
     path = _plant(tmp_path, marker, ":- {touch}.")
     with KnowledgeBase(None, rules=[path]) as kb:
@@ -156,11 +156,11 @@ def test_trust_and_rules_load_the_same_file_as_code(run_neurosym, tmp_path, mark
         assert kb.count("ok(_)") == 2
     assert marker.exists()
     marker.unlink()
-    proc = run_neurosym("query", "--kb", path, "--trust", path, "--csv", "ok(X)")
+    proc = neurosym_main("query", "--kb", path, "--trust", path, "--csv", "ok(X)")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "X\n1\n3\n"
     assert marker.exists()
-    proc = run_neurosym("query", "--kb", path, "--trust", tmp_path / "other.pl", "ok(X)")
+    proc = neurosym_main("query", "--kb", path, "--trust", tmp_path / "other.pl", "ok(X)")
     assert (
         proc.returncode == 1 and "--trust" in proc.stderr and "not one of the --kb" in proc.stderr
     )
@@ -310,14 +310,14 @@ def test_a_planted_qlf_beside_a_source_is_replaced_not_loaded(
 
 
 def test_the_cli_refuses_a_foreign_qlf_and_trust_loads_it(
-    run_neurosym, swipl: Path, tmp_path: Path, marker: Path
+    neurosym_main, swipl: Path, tmp_path: Path, marker: Path
 ) -> None:
     qlf = _attacker_qlf(swipl, tmp_path, marker)
-    proc = run_neurosym("query", "--kb", qlf, "ok(X)")
+    proc = neurosym_main("query", "--kb", qlf, "ok(X)")
     assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
     assert "a .qlf is compiled code" in proc.stderr and f"--trust {qlf.name}" in proc.stderr
     assert not marker.exists()
-    proc = run_neurosym("query", "--kb", qlf, "--trust", qlf, "--csv", "ok(X)")
+    proc = neurosym_main("query", "--kb", qlf, "--trust", qlf, "--csv", "ok(X)")
     assert proc.returncode == 0 and proc.stdout == "X\n666\n", proc.stderr
     assert marker.exists()
 
@@ -371,7 +371,7 @@ def test_bounds_are_checked(kb: KnowledgeBase) -> None:
     ]
 
 
-def test_cli_timeout_and_limits(run_neurosym, tmp_path: Path) -> None:
+def test_cli_timeout_and_limits(neurosym_main, tmp_path: Path) -> None:
     facts = tmp_path / "kb.pl"
     facts.write_text("ok(1).\n")
     rules = tmp_path / "rules.pl"
@@ -388,11 +388,11 @@ def test_cli_timeout_and_limits(run_neurosym, tmp_path: Path) -> None:
         ),
         (["--timeout", "0", "ok(X)"], "--timeout must be a positive number"),
     ]:
-        proc = run_neurosym("query", "--kb", facts, "--rules", rules, *args)
+        proc = neurosym_main("query", "--kb", facts, "--rules", rules, *args)
         assert proc.returncode == 1, proc.stderr
         assert proc.stderr.count("\n") == 1, proc.stderr
         assert proc.stderr.startswith(f"neurosym query: error: {message}"), proc.stderr
-    help_text = run_neurosym("query", "--help").stdout
+    help_text = neurosym_main("query", "--help").stdout
     assert "--timeout SECONDS" in help_text and "(default: none)" in help_text
 
 
@@ -437,10 +437,10 @@ def test_a_fact_100_levels_deep_loads(tmp_path: Path) -> None:
         assert len(kb.once("list(L)")["L"]) == 5000
 
 
-def test_text_that_is_not_utf8_is_refused_in_one_line(run_neurosym, tmp_path: Path) -> None:
+def test_text_that_is_not_utf8_is_refused_in_one_line(neurosym_main, tmp_path: Path) -> None:
     path = tmp_path / "kb.pl"
     path.write_bytes(b"object(a, b).\nobject(\xff\xfe, \x80).\n")
-    proc = run_neurosym("query", "--kb", path, "object(X, Y)")
+    proc = neurosym_main("query", "--kb", path, "object(X, Y)")
     assert proc.returncode == 1 and proc.stdout == ""
     assert proc.stderr.count("\n") == 1, proc.stderr
     assert proc.stderr.startswith(f"neurosym query: error: cannot load {path}: ")
@@ -507,7 +507,7 @@ def test_a_qlf_swapped_after_its_signature_check_is_not_loaded(
 
 
 def test_a_read_only_folder_for_qlf_is_one_line(
-    run_neurosym, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    neurosym_main, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     source = tmp_path / "kb.pl"
     source.write_text("ok(1).\n")

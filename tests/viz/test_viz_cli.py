@@ -141,9 +141,14 @@ def test_svg_is_reproducible_with_the_figure_size_in_points(files: dict[str, Pat
     assert size is not None and float(size[1]) >= 244.8 and size[2] == "417.6"
 
 
-def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path]) -> None:
-    done = _subprocess(
-        "mhdpa", "--checkpoint", str(files["predinet"]), "--out", str(files["tmp"] / "x.png")
+def test_a_bad_request_is_one_line_and_exit_status_1(files: dict[str, Path], neurosym_main) -> None:
+    done = neurosym_main(
+        "plot",
+        "mhdpa",
+        "--checkpoint",
+        str(files["predinet"]),
+        "--out",
+        str(files["tmp"] / "x.png"),
     )
     assert done.returncode == 1
     assert done.stderr == (
