@@ -25,13 +25,16 @@ $(STAMP): pyproject.toml setup.py neurosym/setup_swipl.sh neurosym/setup_prolog.
 	@touch $@
 	@echo "neurosym: set up in $(VENV) (swipl: $$(cat $(SWIPL_PATH_FILE)))"
 
+# Two pytest workers (pytest-xdist): each test computes on one thread (tests/conftest.py), so
+# two keep both cores busy; TEST_WORKERS=0 runs the suite in one process.
+TEST_WORKERS ?= 2
 test: setup
 	@bash scripts/setup_browser.sh
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(TEST_WORKERS)
 
 test-fast: setup
 	@bash scripts/setup_browser.sh
-	$(PY) -m pytest -q -m "not expensive and not subprocess"
+	$(PY) -m pytest -q -n $(TEST_WORKERS) -m "not expensive and not subprocess"
 
 # One story in three steps (under a minute once set up); `neurosym extract --verbose` prints the full tables.
 NS := $(VENV)/bin/neurosym
