@@ -35,9 +35,10 @@ What it does, and why in Prolog:
 
 :- use_module(library(time), [call_with_time_limit/2]).
 :- use_module(library(solution_sequences), [limit/2]).
-:- use_module(library(apply), [maplist/3, exclude/3, partition/4]).
+:- use_module(library(apply), [maplist/3, partition/4]).
 :- use_module(library(lists), [member/2]).
 :- use_module(library(error), [must_be/2]).
+:- use_module(fact_reader, [lines_text/2]).
 
 :- thread_local collecting_/0, collected_/2.
 :- dynamic max_depth_/1.      % set_max_depth/1: the deepest answer passed to Python
@@ -62,20 +63,13 @@ user:message_hook(_Term, Kind, Lines) :-
     collecting_,
     ( Kind == error ; Kind == warning ),
     !,
-    lines_text_(Lines, Text0),
+    lines_text(Lines, Text0),
     (   source_location(File, Line),
         \+ sub_string(Text0, 0, _, _, File)
     ->  format(string(Text), "~w:~w: ~w", [File, Line, Text0])
     ;   Text = Text0
     ),
     assertz(collected_(Kind, Text)).
-
-lines_text_(Lines, Text) :-
-    with_output_to(string(Text0), print_message_lines(current_output, '', Lines)),
-    split_string(Text0, "\n", " \t", Parts0),
-    exclude(==(""), Parts0, Parts),
-    atomic_list_concat(Parts, ' ', Atom),
-    atom_string(Atom, Text).
 
 error_text_(E0, Text) :-
     (   E0 = error(existence_error(procedure, PI), _)
@@ -89,7 +83,7 @@ error_text_(E0, Text) :-
 
 translate_(E, Text) :-
     '$messages':translate_message(E, Lines, []),
-    lines_text_(Lines, Text).
+    lines_text(Lines, Text).
 
 %!  new_kb(+Module) is det.
 %   Makes Module a knowledge base: a temporary module whose default module

@@ -1,5 +1,5 @@
 :- module(neurosym_facts, [load_facts/7, set_chunk_bytes/1, set_reader_threads/1,
-                            chunks_taken/1]).
+                            chunks_taken/1, lines_text/2]).
 
 /** <module> Reading a fact file as data
 
@@ -167,7 +167,7 @@ user:message_hook(_Term, Kind, Lines) :-
 note_warning_(Owner, Lines) :-
     (   warned_(Owner, _)
     ->  true
-    ;   lines_text_(Lines, Text),
+    ;   lines_text(Lines, Text),
         assertz(warned_(Owner, Text))
     ).
 
@@ -644,7 +644,7 @@ message_(neurosym_warned(Warning), File, Text) :- !,
            [File, Warning]).
 message_(error(syntax_error(What), Context), File, Text) :- !,
     (   catch('$messages':translate_message(error(syntax_error(What), _), Lines, []), _, fail),
-        lines_text_(Lines, Msg)
+        lines_text(Lines, Msg)
     ->  true
     ;   format(string(Msg), "Syntax error: ~w", [What])
     ),
@@ -654,13 +654,17 @@ message_(error(syntax_error(What), Context), File, Text) :- !,
     ).
 message_(E, File, Text) :-
     (   catch('$messages':translate_message(E, Lines, []), _, fail),
-        lines_text_(Lines, Msg)
+        lines_text(Lines, Msg)
     ->  true
     ;   format(string(Msg), "~q", [E])
     ),
     format(string(Text), "~w: ~w", [File, Msg]).
 
-lines_text_(Lines, Text) :-
+%!  lines_text(+Lines, -Text:string) is det.
+%   A message's format lines (print_message_lines/3) as one line of text, runs of
+%   white space and the line breaks between them as single spaces. The bridge
+%   words its load messages with it too.
+lines_text(Lines, Text) :-
     with_output_to(string(Text0), print_message_lines(current_output, '', Lines)),
     split_string(Text0, "\n", " \t", Parts0),
     exclude(==(""), Parts0, Parts),
