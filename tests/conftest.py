@@ -21,7 +21,6 @@ def pytest_configure(config: pytest.Config) -> None:
     threads spin against each other (a Box-World PrediNet's batch of 64 took 0.6-0.8 s on two
     threads against 0.09 s on one, at a load of 5 on 2 cores). The CLI's own commands and the
     learners' processes set their threads themselves; this covers the calls made in-process."""
-    import secrets
     import tempfile
 
     if "NEUROSYM_KEY_FILE" not in os.environ:
@@ -29,9 +28,9 @@ def pytest_configure(config: pytest.Config) -> None:
         os.environ["NEUROSYM_KEY_FILE"] = os.path.join(key_dir, "qlf.key")
         # Made here, before pytest-xdist's workers start: they share it, and none of
         # them may read it half-written.
-        fd = os.open(os.environ["NEUROSYM_KEY_FILE"], os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        with os.fdopen(fd, "w") as fh:
-            fh.write(secrets.token_hex(32) + "\n")
+        from neurosym.prolog import signature
+
+        signature._key(create=True)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     import torch
 
