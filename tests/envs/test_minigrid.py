@@ -197,9 +197,9 @@ def test_babyai_mission_and_show(neurosym_main) -> None:
 
 def test_a_training_run_starts_on_a_minigrid_id(tmp_path) -> None:
     """The run's plan (the family's presets, 7 actions), one rollout and one PPO update."""
+    from neurosym.agent.learners.optimizers import shared_optimizer
     from neurosym.agent.learners.ppo import ppo_update
     from neurosym.agent.networks.model import ActorCritic
-    from neurosym.agent.learners.optimizers import shared_optimizer
     from neurosym.agent.rollout import RolloutState, collect_rollout
     from neurosym.agent.run.plan import resolve_run
 

@@ -131,7 +131,10 @@ def test_kb_round_trip_through_swi_prolog(kb_path: Path) -> None:
         ]
         assert rows("door_state(0, 5, I, S)", "I", "S") == [("door_yellow", "open")]
         assert rows("mission(E, M)", "E", "M") == [("0", f"'{MISSION}'"), ("1", f"'{MISSION}'")]
-        assert rows("episode(E, S, _, O)", "E", "S", "O") == [("0", "9", "goal"), ("1", "12", "timeout")]
+        assert rows("episode(E, S, _, O)", "E", "S", "O") == [
+            ("0", "9", "goal"),
+            ("1", "12", "timeout"),
+        ]
         # rules/minigrid.pl over the written facts
         assert rows("key_before_door(E)", "E") == [("0",)]
         assert rows("key_before_door(E, C)", "E", "C") == [("0", "yellow")]
