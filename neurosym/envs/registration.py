@@ -234,6 +234,14 @@ def env_family(name_or_id: str) -> str:
     return entry(name_or_id).family
 
 
+def family_members(family: str) -> str:
+    """The envs of a family as error messages name them: ``rgw1, rgw2, rgw-random``, or for
+    Minigrid's 166 ids a pointer to ``neurosym envs``."""
+    if family == "minigrid":
+        return "the MiniGrid-* and BabyAI-* ids (`neurosym envs` lists them)"
+    return ", ".join(e.short for e in ENTRIES if e.family == family)
+
+
 RENDER_ONLY_OPTIONS = ("render_mode", "tile_size")
 """options that change only what ``env.render()`` draws: no command shows it"""
 

@@ -186,3 +186,31 @@ def test_extract_cli_on_an_untrained_agent(tmp_path: Path, neurosym_main, swipl:
                          capture_output=True, text=True, timeout=120)  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip() == f"'{DOORKEY}'-42-40"  # 2 episodes of 20 steps: 21 states each
+
+
+def test_a_minigrid_agent_on_another_family_or_size_is_one_line(
+    tmp_path: Path, neurosym_main
+) -> None:
+    from neurosym.agent.checkpoint import save_checkpoint
+    from neurosym.agent.config import ModelConfig
+    from neurosym.agent.networks.model import ActorCritic
+    from neurosym.envs.minigrid_state import NUM_PLANES
+
+    config = ModelConfig.for_family(
+        "minigrid", "mhdpa", (NUM_PLANES, 5, 5), heads=1, key_size=4, value_size=4,
+        conv_channels=(4,), hidden_sizes=(8,),
+    )  # fmt: skip
+    ckpt = tmp_path / "mg.pt"
+    save_checkpoint(ckpt, model=ActorCritic(config), config=config, env_name=DOORKEY)
+    trained = f"{ckpt} was trained on {DOORKEY}"
+    for env, message in (
+        ("rgw2", f"{trained} (minigrid family, observations ({NUM_PLANES}, 5, 5)); rgw2 is a rgw "
+                 "environment: pick one of the MiniGrid-* and BabyAI-* ids (`neurosym envs` "
+                 "lists them)"),
+        ("MiniGrid-DoorKey-6x6-v0", f"{trained} with observations ({NUM_PLANES}, 5, 5); "
+                                    f"MiniGrid-DoorKey-6x6-v0 gives ({NUM_PLANES}, 6, 6): pick an "
+                                    "environment of the same shape"),
+    ):  # fmt: skip
+        proc = neurosym_main("extract", "--checkpoint", ckpt, "--env", env, "--out", tmp_path / "x")
+        assert proc.returncode != 0
+        assert proc.stderr.strip().splitlines() == [f"neurosym extract: error: {message}"]
