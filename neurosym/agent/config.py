@@ -49,6 +49,8 @@ MODULES = ("predinet", "mhdpa")
 FAMILIES = ("rgw", "boxworld", "minigrid")
 PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
+IMITATE_FAMILIES = ("rgw", "minigrid")
+"""families with a planner for ``--algo imitate`` (Minigrid's: DoorKey levels)"""
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
@@ -624,9 +626,14 @@ class TrainConfig:
         """A preset's settings for an env family and learner, then the overrides that are not None."""
         _check_family(family)
         _check_preset(preset)
-        if algo == "imitate" and family != "rgw":
+        if algo == "imitate" and family not in IMITATE_FAMILIES:
             raise ConfigError(
-                f"--algo imitate learns from the RGW planner; {family} has none (use a3c or ppo)"
+                f"--algo imitate learns from an env's planner (RGW's, Minigrid DoorKey's); "
+                f"{family} has none (use a3c or ppo)"
+            )
+        if algo == "imitate" and family == "minigrid" and overrides.get("augment"):
+            raise ConfigError(
+                "--augment turns RGW levels; Minigrid's actions turn the agent (leave it off)"
             )
         if preset == "thesis":
             if algo != "a3c":
