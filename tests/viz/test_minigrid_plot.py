@@ -3,7 +3,6 @@ from a recording and from a live run of the same scripted DoorKey episode."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -11,46 +10,17 @@ from typing import Any
 import numpy as np
 from matplotlib.colors import to_hex
 from matplotlib.patches import Polygon, Rectangle
-from test_recorder import small_agent
+from minigrid_scripted import DOOR, DOORKEY, SCRIPT, doorkey_recording, scripted_agent
 
-from neurosym.record.recorder import record
 from neurosym.viz import save_figure, trace_from_agent, trace_from_recording
 from neurosym.viz.episode import GIF_DPI, _Film, episode_trace_figure
 from neurosym.viz.style import entity_colour
 from neurosym.viz.trace import EpisodeTrace
 
-DOORKEY = "MiniGrid-DoorKey-5x5-v0"
-LEFT, RIGHT, FORWARD, PICKUP, DROP, TOGGLE = range(6)
-SCRIPT = [FORWARD, PICKUP, LEFT, FORWARD, TOGGLE, FORWARD, FORWARD, RIGHT, FORWARD]
-"""seed 1: bump into the key, pick it up, turn east, bump into the door, unlock it, the goal"""
-DOOR = (2, 2)
-
-
-@dataclass
-class Scripted:
-    """Plays SCRIPT whatever it sees; the wrapped small agent introspects every state."""
-
-    inner: Any
-    step: int = 0
-    env_name: str = DOORKEY
-    env_kwargs: dict | None = None
-    path: str = "scripted.pt"
-
-    @property
-    def config(self) -> Any:
-        return self.inner.config
-
-    def act(self, obs: np.ndarray, greedy: bool = True, introspect: bool = False,
-            generator: Any = None) -> Any:  # fmt: skip
-        _, intro = self.inner.act(obs, greedy=True, introspect=introspect)
-        self.step += 1
-        return np.full(len(obs), SCRIPT[self.step - 1], dtype=np.int64), intro
-
 
 @cache
 def recorded() -> EpisodeTrace:
-    rec = record(Scripted(small_agent(DOORKEY)), DOORKEY, episodes=1, seed=1, batch=1)
-    return trace_from_recording(rec)
+    return trace_from_recording(doorkey_recording())
 
 
 def test_the_trace_has_directions_and_door_states() -> None:
@@ -60,7 +30,7 @@ def test_the_trace_has_directions_and_door_states() -> None:
     assert trace.door_states(4) == [(*DOOR, "locked")]
     assert trace.door_states(5) == [(*DOOR, "open")]
     assert trace.grids[0][DOOR] == "door(yellow)" and "key(yellow)" in set(trace.grids[0].ravel())
-    live = trace_from_agent(Scripted(small_agent(DOORKEY)), DOORKEY, seed=1)
+    live = trace_from_agent(scripted_agent(), DOORKEY, seed=1)
     assert live.facing == trace.facing
     assert live.doors.values.tolist() == trace.doors.values.tolist()
 
