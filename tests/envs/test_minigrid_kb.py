@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.export.facts import extract_facts
-from neurosym.export.recorder import record
-from neurosym.export.recording import Recording
+from neurosym.facts.tables import extract_facts
+from neurosym.record.recorder import record
+from neurosym.record.recording import Recording
 
 DOORKEY = "MiniGrid-DoorKey-5x5-v0"
 LEFT, RIGHT, FORWARD, PICKUP, DROP, TOGGLE, DONE = range(7)
