@@ -8,7 +8,6 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_recorder import small_agent
 
 from neurosym.envs.minigrid_state import COLOURS
 from neurosym.facts.tables import extract_facts
@@ -26,7 +25,9 @@ CASES = {  # env -> (env options, episodes)
 
 
 @pytest.fixture(scope="module", params=sorted(CASES))
-def kb(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Path:
+def kb(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory, small_agent
+) -> Path:
     env = request.param
     options, episodes = CASES[env]
     rec = record(small_agent(env), env, episodes, seed=0, actions="random", env_kwargs=options)

@@ -9,8 +9,7 @@ from typing import Any
 
 import pytest
 from minigrid_scripted import DOOR, doorkey_recording
-from test_webreport_browser import browser, errors, open_page  # noqa: F401 (a fixture)
-from test_webreport_data import embedded, extract_folder, report
+from pages import embedded, errors, extract_folder, open_page, report
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +55,7 @@ def _marks(driver: Any) -> list[tuple]:
     )
 
 
-def test_the_map_draws_doors_and_the_direction(browser: Any, page: Path) -> None:  # noqa: F811
+def test_the_map_draws_doors_and_the_direction(browser: Any, page: Path) -> None:
     r, c = DOOR
     for t, want in (
         (0, [["door", r, c, "locked"], ["facing", "south"]]),

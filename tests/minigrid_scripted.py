@@ -8,7 +8,7 @@ from functools import cache
 from typing import Any
 
 import numpy as np
-from test_recorder import small_agent
+from builders import small_agent
 
 from neurosym.record.recorder import record
 from neurosym.record.recording import Recording
