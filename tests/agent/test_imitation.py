@@ -203,7 +203,10 @@ def test_train_imitate_on_box_world_is_one_line(
                          "--frames", "10", "--out", tmp_path / "x")  # fmt: skip
     assert proc.returncode != 0
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "imitate learns from the RGW planner" in lines[0], proc.stderr
+    assert lines == [
+        "neurosym train: error: --algo imitate learns from an env's planner (RGW's, Minigrid "
+        "DoorKey's); boxworld has none (use a3c or ppo)"
+    ], proc.stderr
 
 
 def test_regret_names_the_return_each_action_gives_up() -> None:
