@@ -535,8 +535,14 @@ def load_agent(
 ) -> Agent:
     """Load a checkpoint as an :class:`Agent` (CheckpointError, one line, for every bad file).
 
-    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
+    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`. An agent
+    trained elsewhere (``FILE.py:FUNCTION``, an SB3 ``.zip``) loads through
+    :func:`neurosym.outside.load_outside`.
     """
+    from neurosym.outside.load import load_outside, outside_spec
+
+    if config is None and outside_spec(path) is not None:
+        return load_outside(str(path), env)
     path = checkpoint_file(path)
     payload = read_checkpoint(path, env=env, config=config)
     model = build_model(payload, path)
