@@ -1,32 +1,33 @@
 """A Stable-Baselines3 PPO agent, trained on a neurosym env and then taken through neurosym.
 
-    python examples/own_agent/sb3_agent.py --steps 20000 --out ppo_rgw2.zip
-    neurosym extract --checkpoint ppo_rgw2.zip --env rgw2 --episodes 20
+    python examples/own_agent/sb3_agent.py --steps 20000 --out ppo_doorkey.zip
+    neurosym extract --checkpoint ppo_doorkey.zip --env MiniGrid-DoorKey-5x5-v0 --episodes 20
 
-SB3 trains on the env as gymnasium makes it; neurosym reads the saved .zip (nothing in it is
-unpickled: the weights and the policy's plain settings only) and records its behaviour.
+SB3 trains on the env as neurosym makes it; neurosym reads the saved .zip without unpickling
+anything in it (the weights and the policy's plain settings only) and records its behaviour.
 """
 
 import argparse
 
 from stable_baselines3 import PPO
+from stable_baselines3.common.env_util import make_vec_env
 
-import neurosym.envs  # noqa: F401  (registers the neurosym/... gymnasium ids)
-from neurosym.envs import ENVS
+from neurosym.envs import make
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--env", default="rgw2", help="a neurosym env's short name")
+    parser.add_argument("--env", default="MiniGrid-DoorKey-5x5-v0", help="a neurosym env")
     parser.add_argument("--steps", type=int, default=20_000, help="training env steps")
-    parser.add_argument("--out", default="ppo_rgw2.zip", help="where the model is saved")
+    parser.add_argument("--out", default="ppo_doorkey.zip", help="where the model is saved")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
-    model = PPO("MlpPolicy", ENVS[args.env], n_steps=128, batch_size=64, seed=args.seed,
-                policy_kwargs={"net_arch": [64, 64]}, device="cpu")  # fmt: skip
+    venv = make_vec_env(lambda: make(args.env), n_envs=4, seed=args.seed)
+    model = PPO("MlpPolicy", venv, n_steps=64, batch_size=64, seed=args.seed, device="cpu",
+                policy_kwargs={"net_arch": [64, 64]})  # fmt: skip
     model.learn(total_timesteps=args.steps)
     model.save(args.out)
-    print(f"wrote {args.out} ({args.steps} steps of PPO on {args.env})")
+    print(f"wrote {args.out} ({model.num_timesteps} steps of PPO on {args.env})")
 
 
 if __name__ == "__main__":

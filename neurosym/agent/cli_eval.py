@@ -135,7 +135,7 @@ def run(args: EvalOptions) -> int:
     torch.set_num_threads(1)
     from neurosym.agent.checkpoint import env_for
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = play_options(args, agent.env_name)
     env, kwargs = env_for(agent, env, overrides)
     report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs)

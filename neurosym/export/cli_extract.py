@@ -111,7 +111,7 @@ def run(args: ExtractOptions) -> int:
     from neurosym.export.recorder import record
     from neurosym.publish import check_out
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     adapter = adapter_class(agent.config.module)
     if args.top_keys is not None and not adapter.has("attention"):
         facts = " and ".join(_FACTS[name] for name in adapter.tables if name in _FACTS)

@@ -22,4 +22,11 @@ from neurosym.outside.agent import OutsideAgent, OutsideConfig, TorchAgent
 from neurosym.outside.load import load_outside, outside_spec
 from neurosym.outside.sb3 import sb3_agent
 
-__all__ = ["OutsideAgent", "OutsideConfig", "TorchAgent", "load_outside", "outside_spec", "sb3_agent"]
+__all__ = [
+    "OutsideAgent",
+    "OutsideConfig",
+    "TorchAgent",
+    "load_outside",
+    "outside_spec",
+    "sb3_agent",
+]

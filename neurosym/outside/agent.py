@@ -70,7 +70,10 @@ class OutsideModel(nn.Module):
         self.relational = tap if tap is not None else NoHeads()
 
     def forward(self, obs: torch.Tensor, introspect: bool = False) -> tuple[Any, ...]:
-        if obs.dim() != len(self.config.obs_shape) + 1 or tuple(obs.shape[1:]) != self.config.obs_shape:
+        if (
+            obs.dim() != len(self.config.obs_shape) + 1
+            or tuple(obs.shape[1:]) != self.config.obs_shape
+        ):
             raise ConfigError(
                 f"observation batch must have shape (B, {', '.join(map(str, self.config.obs_shape))}), "
                 f"got {tuple(obs.shape)}"
@@ -179,10 +182,14 @@ class OutsideAgent:
 
     def with_path(self, path: str) -> OutsideAgent:
         """The same agent named ``path`` (what recordings and KBs say it was)."""
-        return OutsideAgent(self.model, self.config, self.env_name, self.env_kwargs, self.meta, path)
+        return OutsideAgent(
+            self.model, self.config, self.env_name, self.env_kwargs, self.meta, path
+        )
 
 
-def observation_shape(env: str, env_kwargs: dict[str, Any] | None = None) -> tuple[tuple[int, ...], int]:
+def observation_shape(
+    env: str, env_kwargs: dict[str, Any] | None = None
+) -> tuple[tuple[int, ...], int]:
     """(observation shape, action count) of a neurosym env made with ``env_kwargs``."""
     from neurosym.envs import make
 
@@ -231,4 +238,6 @@ def TorchAgent(  # noqa: N802 (reads as the class it makes)
         n_actions=n_actions,
     )
     model = OutsideModel(net.eval(), act or default_act, config, tap).eval()
-    return OutsideAgent(model, config, name, kwargs, dict(meta or {"train_config": {"algo": "own code"}}))
+    return OutsideAgent(
+        model, config, name, kwargs, dict(meta or {"train_config": {"algo": "own code"}})
+    )

@@ -119,7 +119,9 @@ def read_model_zip(path: Path) -> tuple[dict[str, Any], dict[str, torch.Tensor]]
             infos = {i.filename: i for i in z.infolist()}
             for name, limit in (("data", DATA_BYTES), ("policy.pth", WEIGHTS_BYTES)):
                 if name not in infos:
-                    raise CheckpointError(f"{path} is not a Stable-Baselines3 model: it has no {name!r}")
+                    raise CheckpointError(
+                        f"{path} is not a Stable-Baselines3 model: it has no {name!r}"
+                    )
                 if infos[name].file_size > limit:
                     raise CheckpointError(
                         f"{path}: its {name!r} is {infos[name].file_size:,} bytes, more than {limit:,}"
@@ -136,15 +138,23 @@ def read_model_zip(path: Path) -> tuple[dict[str, Any], dict[str, torch.Tensor]]
         state = torch.load(io.BytesIO(weights), map_location="cpu", weights_only=True)
     except (pickle.UnpicklingError, RuntimeError, EOFError, ValueError) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise CheckpointError(f"{path}: its policy.pth is not a plain state dict ({first})") from None
-    if not isinstance(data, dict) or not isinstance(state, dict) or not all(
-        isinstance(v, torch.Tensor) for v in state.values()
+        raise CheckpointError(
+            f"{path}: its policy.pth is not a plain state dict ({first})"
+        ) from None
+    if (
+        not isinstance(data, dict)
+        or not isinstance(state, dict)
+        or not all(isinstance(v, torch.Tensor) for v in state.values())
     ):
-        raise CheckpointError(f"{path} is not a Stable-Baselines3 model (unexpected 'data' or weights)")
+        raise CheckpointError(
+            f"{path} is not a Stable-Baselines3 model (unexpected 'data' or weights)"
+        )
     return data, state
 
 
-def _policy_parts(path: Path, data: dict[str, Any], state: dict[str, torch.Tensor]) -> tuple[type, dict]:
+def _policy_parts(
+    path: Path, data: dict[str, Any], state: dict[str, torch.Tensor]
+) -> tuple[type, dict]:
     """(policy class, policy kwargs) of a model file, checked against its weights."""
     entry = data.get("policy_class")
     if not isinstance(entry, dict) or ":serialized:" not in entry:
@@ -182,7 +192,9 @@ def _ints(value: Any, depth: int = 0) -> list[int]:
     return []
 
 
-def _spaces(path: Path, data: dict[str, Any], env: str, env_kwargs: dict[str, Any]) -> tuple[Any, Any, bool]:
+def _spaces(
+    path: Path, data: dict[str, Any], env: str, env_kwargs: dict[str, Any]
+) -> tuple[Any, Any, bool]:
     """(observation space, action space, transpose) for the policy, from the env's own spaces.
 
     ``transpose``: the model was trained on channel-first images of the env's channel-last
@@ -214,8 +226,14 @@ def _spaces(path: Path, data: dict[str, Any], env: str, env_kwargs: dict[str, An
         )
     saved_dtype = str(saved.get("dtype", obs_space.dtype))
     if saved_dtype != str(obs_space.dtype):
-        raise ConfigError(f"{path} was trained on {saved_dtype} observations; {env} gives {obs_space.dtype}")
-    saved_n = (data.get("action_space") or {}).get("n") if isinstance(data.get("action_space"), dict) else None
+        raise ConfigError(
+            f"{path} was trained on {saved_dtype} observations; {env} gives {obs_space.dtype}"
+        )
+    saved_n = (
+        (data.get("action_space") or {}).get("n")
+        if isinstance(data.get("action_space"), dict)
+        else None
+    )
     if not isinstance(act_space, spaces.Discrete) or str(saved_n) != str(int(act_space.n)):
         raise ConfigError(
             f"{path} was trained with {saved_n or 'non-discrete'} actions; {env} has {act_space}"
@@ -223,7 +241,9 @@ def _spaces(path: Path, data: dict[str, Any], env: str, env_kwargs: dict[str, An
     return obs_space, act_space, transpose
 
 
-def load_sb3_zip(path: str | Path, env: str | None = None, env_kwargs: dict[str, Any] | None = None) -> OutsideAgent:
+def load_sb3_zip(
+    path: str | Path, env: str | None = None, env_kwargs: dict[str, Any] | None = None
+) -> OutsideAgent:
     """The SB3 model file at ``path`` as an agent on ``env`` (default: the first neurosym env
     whose observations have the model's shape). Nothing in the file is run."""
     _require_sb3()
@@ -240,7 +260,9 @@ def load_sb3_zip(path: str | Path, env: str | None = None, env_kwargs: dict[str,
         policy.load_state_dict(state, strict=True)
     except RuntimeError as exc:
         line = " ".join(str(exc).splitlines()[1:2]) or str(exc).splitlines()[0]
-        raise CheckpointError(f"{path}: the weights do not fit its policy ({line.strip()})") from None
+        raise CheckpointError(
+            f"{path}: the weights do not fit its policy ({line.strip()})"
+        ) from None
     algo = _algorithm(data)
     meta = {
         "frames": _count(data.get("num_timesteps")),
@@ -287,8 +309,7 @@ def _require_sb3() -> None:
         import stable_baselines3  # noqa: F401
     except ImportError:
         raise ConfigError(
-            "reading a Stable-Baselines3 model needs stable-baselines3: pip install "
-            "'neurosym[sb3]'"
+            "reading a Stable-Baselines3 model needs stable-baselines3: pip install 'neurosym[sb3]'"
         ) from None
 
 
