@@ -183,3 +183,45 @@ def test_an_sb3_file_that_would_run_code_is_refused_and_nothing_runs(
         "which neurosym does not load from a file"
     )
     assert line.endswith("name it with --checkpoint FILE.py:FUNCTION (neurosym.outside.sb3_agent)")
+
+
+def test_an_sb3_policy_with_an_attention_extractor_gives_attention_facts_and_ablates() -> None:
+    """The user's file route for SB3: a policy whose features extractor holds an
+    nn.MultiheadAttention over the cells, named by its dotted path."""
+    import numpy as np
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+    from torch import nn
+
+    from neurosym.envs import make
+    from neurosym.export.recorder import record
+    from neurosym.meaning.features import ablate_heads, head_vectors
+    from neurosym.outside import sb3_agent
+
+    class CellAttention(BaseFeaturesExtractor):
+        def __init__(self, space, width: int = 16) -> None:
+            super().__init__(space, features_dim=width)
+            self.embed = nn.Conv2d(space.shape[0], width, 1)
+            self.attn = nn.MultiheadAttention(width, 2, batch_first=True)
+
+        def forward(self, obs: torch.Tensor) -> torch.Tensor:
+            x = self.embed(obs).flatten(2).transpose(1, 2)
+            return self.attn(x, x, x)[0].amax(dim=1)
+
+    torch.manual_seed(0)
+    model = PPO("MlpPolicy", make("rgw2"), n_steps=8, batch_size=8, device="cpu",
+                policy_kwargs={"features_extractor_class": CellAttention})  # fmt: skip
+    agent = sb3_agent(
+        model, "rgw2", attention="features_extractor.attn", env_kwargs={"max_steps": 5}
+    )
+    rec = record(agent, episodes=1)
+    assert rec.meta["module"] == "outside_attention" and rec.meta["heads"] == 2
+    assert set(rec.attention["head"]) == {0, 1} and len(rec.attention) > 0
+    obs = np.stack([make("rgw2").reset(seed=s)[0] for s in range(3)])
+    plain, probs = head_vectors(agent.model, obs)  # (3, 2, 8): each head's values, pooled
+    with ablate_heads(agent.model, {0: torch.zeros(100, 8)}):
+        ablated, ablated_probs = head_vectors(agent.model, obs)
+    np.testing.assert_array_equal(ablated[:, 0], 0.0)
+    np.testing.assert_array_equal(ablated[:, 1], plain[:, 1])
+    assert not np.allclose(ablated_probs, probs)
