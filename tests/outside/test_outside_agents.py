@@ -195,7 +195,7 @@ def test_an_sb3_policy_with_an_attention_extractor_gives_attention_facts_and_abl
     from torch import nn
 
     from neurosym.envs import make
-    from neurosym.export.recorder import record
+    from neurosym.record.recorder import record
     from neurosym.meaning.features import ablate_heads, head_vectors
     from neurosym.outside import sb3_agent
 
