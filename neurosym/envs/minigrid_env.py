@@ -9,6 +9,8 @@ the entity grid, and an ``info`` with the symbolic state and the step's events.
 
 from __future__ import annotations
 
+import contextlib
+import io
 from collections.abc import Sequence
 from typing import Any
 
@@ -40,7 +42,14 @@ def _inner(env_id: str, max_steps: int | None, render_mode: str | None) -> Any:
         raise ConfigError(f"{env_id} does not take these options ({exc})") from None
     if getattr(env.action_space, "n", None) != len(ms.ACTION_NAMES):
         raise ConfigError(f"{env_id} has {env.action_space} actions, not Minigrid's 7")
+    # Minigrid's own observation (the agent's 7 x 7 view, cropped and rotated cell by cell) is
+    # never read here and took two thirds of a step; its step and reset return None for it.
+    env.gen_obs = _no_observation
     return env
+
+
+def _no_observation() -> None:
+    return None
 
 
 class MinigridEnv(gym.Env[np.ndarray, np.int64]):
@@ -91,7 +100,8 @@ class MinigridEnv(gym.Env[np.ndarray, np.int64]):
         self.render_mode = render_mode
         self.tile_size = int(tile_size)
         self.inner = _inner(env_id, max_steps, render_mode)
-        self.inner.reset(seed=0)  # the grid's size (fixed per env id)
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.inner.reset(seed=0)  # the grid's size (fixed per env id)
         height, width = self.inner.grid.height, self.inner.grid.width
         self.observation_space = spaces.Box(0, 1, (ms.NUM_PLANES, height, width), np.uint8)
         self.action_space = spaces.Discrete(len(ms.ACTION_NAMES))
@@ -102,9 +112,15 @@ class MinigridEnv(gym.Env[np.ndarray, np.int64]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
-        self.inner.reset(seed=seed, options=options)
+        with contextlib.redirect_stdout(io.StringIO()):  # BabyAI prints its rejected samples
+            self.inner.reset(seed=seed, options=options)
         self._namer = ms.Namer()
         self._snap = ms.snapshot(self.inner, self._namer)
+        if self._snap.cells.shape[:2] != self.observation_space.shape[1:]:
+            raise ConfigError(
+                f"{self.env_id} drew a {self._snap.cells.shape[:2]} grid after "
+                f"{self.observation_space.shape[1:]}: neurosym needs one grid size per env"
+            )
         return ms.observation(self._snap), _info(self._snap, (), None)
 
     def step(self, action: int) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -135,7 +151,7 @@ class MinigridEnv(gym.Env[np.ndarray, np.int64]):
         if self.render_mode == "rgb_array":
             return self.inner.get_frame(highlight=False, tile_size=self.tile_size)
         if self.render_mode == "ansi":
-            return str(self.inner) + "\n" + self.inner.mission
+            return self.inner.pprint_grid() + "\n" + self.inner.mission
         return None
 
     def close(self) -> None:

@@ -137,6 +137,25 @@ def _register(e: EnvEntry) -> None:
         )
 
 
+MINIGRID_UNSUPPORTED: dict[str, str] = {
+    "minigrid.envs:DynamicObstaclesEnv": "its env takes 3 actions (left, right, forward), "
+    "not Minigrid's 7",
+    "minigrid.envs.wfc": "its env needs Minigrid's wfc extra (imageio, networkx), which neurosym "
+    "does not install",
+}
+"""Minigrid env classes (``module:Class``) or modules left out of the family, and why"""
+
+
+def _minigrid_class(spec: Any) -> str:
+    return str(spec.entry_point).rpartition(":")[2] if isinstance(spec.entry_point, str) else ""
+
+
+def _unsupported(spec: Any) -> str | None:
+    """Why neurosym does not play the env of a Minigrid spec, or None when it does."""
+    point = str(spec.entry_point) if isinstance(spec.entry_point, str) else ""
+    return MINIGRID_UNSUPPORTED.get(point) or MINIGRID_UNSUPPORTED.get(point.partition(":")[0])
+
+
 @functools.cache
 def minigrid_entries() -> tuple[EnvEntry, ...]:
     """One EnvEntry per id Farama's Minigrid registers (``MiniGrid-*``, ``BabyAI-*``).
@@ -152,10 +171,12 @@ def minigrid_entries() -> tuple[EnvEntry, ...]:
     for name, spec in gymnasium.registry.items():
         if not name.startswith(MINIGRID_PREFIXES):
             continue
-        cls = str(spec.entry_point).rpartition(":")[2] if isinstance(spec.entry_point, str) else ""
+        if _unsupported(spec) is not None:
+            continue
+        cls = _minigrid_class(spec)
         options = ", ".join(f"{k}={v!r}" for k, v in sorted(spec.kwargs.items()))
         package = "BabyAI" if name.startswith("BabyAI-") else "Minigrid"
-        description = f"{package} {cls}{f' ({options})' if options else ''}, fully observed"
+        description = f"{package} {cls}{f' ({options})' if options else ''}"
         out.append(EnvEntry(name, f"neurosym/{name}", "minigrid", _MG, _MG_VEC, description,
                             {"env_id": name}))  # fmt: skip
     return tuple(out)
@@ -184,13 +205,19 @@ def _minigrid_entry(name: str) -> EnvEntry:
     """The Minigrid family's entry of an id, or one line naming the nearest ids."""
     import difflib
 
+    import gymnasium
+
     entries = {e.short: e for e in minigrid_entries()}
     found = entries.get(name)
     if found is not None:
         _register(found)
         return found
-    near = difflib.get_close_matches(name, list(entries), n=3, cutoff=0.6)
-    hint = f"did you mean {' or '.join(near)}? " if near else ""
+    spec = gymnasium.registry.get(name)
+    why = _unsupported(spec) if spec is not None else None
+    if why is not None:
+        raise ConfigError(f"Minigrid environment {name!r} is not one neurosym plays: {why}")
+    near = difflib.get_close_matches(name, list(entries), n=3, cutoff=0.75)
+    hint = f"did you mean {', '.join(near[:-1]) + ' or ' if near[1:] else ''}{near[-1]}? " if near else ""
     raise ConfigError(
         f"unknown Minigrid environment {name!r}; {hint}`neurosym envs` lists the "
         f"{len(entries)} Minigrid and BabyAI ids"
@@ -205,6 +232,14 @@ def canonical_name(name_or_id: str) -> str:
 def env_family(name_or_id: str) -> str:
     """``"rgw"``, ``"boxworld"`` or ``"minigrid"``."""
     return entry(name_or_id).family
+
+
+def family_members(family: str) -> str:
+    """The envs of a family as error messages name them: ``rgw1, rgw2, rgw-random``, or for
+    Minigrid's 166 ids a pointer to ``neurosym envs``."""
+    if family == "minigrid":
+        return "the MiniGrid-* and BabyAI-* ids (`neurosym envs` lists them)"
+    return ", ".join(e.short for e in ENTRIES if e.family == family)
 
 
 RENDER_ONLY_OPTIONS = ("render_mode", "tile_size")
