@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Both outside agents of this folder through neurosym, end to end (about two minutes on 2 cores):
+# Both outside agents of this folder through neurosym, end to end (a minute of CPU time):
 # a user's own PyTorch module (my_agent.py) and a Stable-Baselines3 PPO model (sb3_agent.py),
 # each recorded, written as a KB, queried, intervened on and shown on a report page.
 set -euo pipefail
@@ -17,6 +17,7 @@ neurosym query --kb "$OUT/torch-ablate/kb.pl" 'effect(X, kl, KL)'
 neurosym report --recording "$OUT/torch" --quiet
 
 # 2. A Stable-Baselines3 model: the saved .zip, read without unpickling anything in it.
+#    (STEPS=20000 shows the mechanics; train_doorkey_sb3.py trains one that solves DoorKey.)
 python examples/own_agent/sb3_agent.py --steps "${STEPS:-20000}" --out "$OUT/ppo_doorkey.zip"
 neurosym extract --checkpoint "$OUT/ppo_doorkey.zip" --env "$ENV" --episodes 10 --out "$OUT/sb3"
 neurosym query --kb "$OUT/sb3/kb.pl" --rules minigrid 'episode(E, Steps, Return, Outcome)'
