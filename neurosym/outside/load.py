@@ -2,9 +2,10 @@
 
 * ``FILE.py:FUNCTION`` -- the user's Python file, imported, and ``FUNCTION()`` called: it
   returns an agent (:func:`neurosym.outside.TorchAgent` or :func:`neurosym.outside.sb3_agent`).
-  This runs the user's own code, which they named on their own command line; a name read from
-  a recording, a KB or any other data file is never loaded this way (:func:`outside_spec` is
-  asked only for what a user typed, and an existing file of that name is a checkpoint).
+  This runs the user's own code, which they named on their own command line. A name read from
+  a data file must never come here: the one such caller, the report page's card (a recording's
+  ``checkpoint``), loads only names that are existing files, and an existing file is never
+  read as ``FILE.py:FUNCTION`` (a bare ``FILE.py`` is refused, asking for the function).
 * ``MODEL.zip`` (or ``sb3:MODEL.zip``) -- a Stable-Baselines3 model, read without running
   anything in it (:mod:`neurosym.outside.sb3`); its env is ``--env`` or the first neurosym env
   with its observation shape.
