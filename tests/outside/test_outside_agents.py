@@ -67,6 +67,20 @@ def test_the_torch_example_goes_through_extract_query_intervene_and_report(tmp_p
     page = (out / "index.html").read_text()
     assert "outside_attention, 2 heads" in page
 
+    # a recording naming Python code as its checkpoint: the page is built, the code never runs
+    marker = tmp_path / "ran"
+    evil = tmp_path / "evil.py"
+    evil.write_text(f"open({str(marker)!r}, 'w').close()\ndef make_agent():\n    pass\n")
+    meta_file = out / "recording" / "meta.json"
+    for name in (f"{evil}:make_agent", str(evil)):
+        meta = json.loads(meta_file.read_text())
+        meta["meta"]["checkpoint"] = name
+        meta_file.unlink()  # published files are read-only links into the store
+        meta_file.write_text(json.dumps(meta))
+        assert main(["report", "--recording", str(out), "--quiet"]) == 0
+        assert not marker.exists()
+        assert "evil.py" in (out / "index.html").read_text()  # the page names it, nothing more
+
 
 def test_the_sb3_example_trains_and_its_zip_is_extracted_and_queried(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
@@ -195,9 +209,9 @@ def test_an_sb3_policy_with_an_attention_extractor_gives_attention_facts_and_abl
     from torch import nn
 
     from neurosym.envs import make
-    from neurosym.record.recorder import record
     from neurosym.meaning.features import ablate_heads, head_vectors
     from neurosym.outside import sb3_agent
+    from neurosym.record.recorder import record
 
     class CellAttention(BaseFeaturesExtractor):
         def __init__(self, space, width: int = 16) -> None:
