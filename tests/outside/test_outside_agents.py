@@ -239,3 +239,20 @@ def test_an_sb3_policy_with_an_attention_extractor_gives_attention_facts_and_abl
     np.testing.assert_array_equal(ablated[:, 0], 0.0)
     np.testing.assert_array_equal(ablated[:, 1], plain[:, 1])
     assert not np.allclose(ablated_probs, probs)
+
+
+def test_an_sb3_model_without_heads_goes_through_intervene_with_no_ablations(
+    tmp_path: Path,
+) -> None:
+    from stable_baselines3 import PPO
+
+    from neurosym.envs import make
+
+    model = tmp_path / "ppo_rgw2.zip"
+    PPO("MlpPolicy", make("rgw2"), n_steps=8, batch_size=8, seed=0, device="cpu").save(model)
+    out = tmp_path / "intervene"
+    argv = ["intervene", "--checkpoint", str(model), "--env", "rgw2", "--episodes", "1"]
+    assert main([*argv, "--out", str(out)]) == 0
+    kinds = [row["X"] for row in _query(out / "kb.pl", "experiment(X, _, _)")]
+    assert kinds == ["baseline", "remove_sword", "remove_enemy", "move_enemy", "move_sword",
+                     "swap_sword_enemy"]  # no heads: no ablation experiments  # fmt: skip
