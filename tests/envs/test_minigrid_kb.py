@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import subprocess
 from dataclasses import dataclass, field
-from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -13,9 +12,9 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.export.facts import extract_facts
-from neurosym.export.recorder import record
-from neurosym.export.recording import Recording
+from neurosym.facts.tables import extract_facts
+from neurosym.record.recorder import record
+from neurosym.record.recording import Recording
 
 DOORKEY = "MiniGrid-DoorKey-5x5-v0"
 LEFT, RIGHT, FORWARD, PICKUP, DROP, TOGGLE, DONE = range(7)
@@ -53,16 +52,15 @@ class ScriptedAgent:
         return np.array([p[k] if p else LEFT for p in live], dtype=np.int64), intro
 
 
-@cache
-def scripted() -> Recording:
-    from test_recorder import small_agent
-
+@pytest.fixture(scope="module")
+def scripted(small_agent) -> Recording:
+    """Episode 0 (seed 1) along SCRIPT, episode 1 (seed 2) turning left until the time limit."""
     agent = ScriptedAgent(small_agent(DOORKEY), [SCRIPT, []])
     return record(agent, DOORKEY, episodes=2, seed=1, batch=2)
 
 
-def test_scripted_recording_tables() -> None:
-    rec = scripted()
+def test_scripted_recording_tables(scripted: Recording) -> None:
+    rec = scripted
     assert rec.episodes[["episode", "steps", "outcome", "seed"]].values.tolist() == [
         [0, 9, "goal", 1],
         [1, MAX_STEPS, "timeout", 2],
@@ -91,9 +89,9 @@ def test_scripted_recording_tables() -> None:
 
 
 @pytest.fixture(scope="module")
-def kb_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def kb_path(tmp_path_factory: pytest.TempPathFactory, scripted: Recording) -> Path:
     path = tmp_path_factory.mktemp("minigrid") / "kb.pl"
-    extract_facts(scripted()).to_prolog(path)
+    extract_facts(scripted).to_prolog(path)
     return path
 
 
