@@ -59,9 +59,12 @@ def test_the_torch_example_goes_through_extract_query_intervene_and_report(tmp_p
         ("ablate_head_0", 0),
         ("ablate_head_1", 1),
     ]
-    kl = {row["X"]: row["V"] for row in _query(ablated / "kb.pl", "effect(X, kl, V)")}
-    assert set(kl) == {"ablate_head_0", "ablate_head_1", "ablate_heads"}
-    assert kl["ablate_heads"] > 0.0  # the ablation reached the policy
+    shifts = _query(ablated / "kb.pl", "effect(X, head_shift(H), V)")
+    moved = {(row["X"], row["H"]) for row in shifts if row["V"] > 0.0}
+    assert moved == {("ablate_head_0", 0), ("ablate_head_1", 1), ("ablate_heads", 0),
+                     ("ablate_heads", 1)}  # each ablation moves its own heads and no other  # fmt: skip
+    assert {row["X"] for row in _query(ablated / "kb.pl", "effect(X, kl, _)")} == {
+        "ablate_head_0", "ablate_head_1", "ablate_heads"}  # fmt: skip
 
     assert main(["report", "--recording", str(out), "--quiet"]) == 0
     page = (out / "index.html").read_text()
