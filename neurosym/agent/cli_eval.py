@@ -32,7 +32,7 @@ class EvalOptions(EnvChoice, Episodes, ActionMode, Json):
     """``neurosym eval``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """checkpoint file (.pt) written by neurosym train, or a shipped agent's name"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     json: bool = False
     """print one JSON object"""
 

@@ -40,7 +40,7 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """``neurosym extract``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """trained agent (.pt)"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     actions: Literal["agent", "random"] = "agent"
     """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
     seed (the network still runs on every state, so its facts are extracted;

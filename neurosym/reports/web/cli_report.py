@@ -41,7 +41,7 @@ class ReportOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """``neurosym report``'s options."""
 
     checkpoint: str | None = option(None, metavar="FILE", exclusive="source", required_one=True)
-    """trained agent (.pt) to record"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip, to record"""
     recording: str | None = option(None, metavar="DIR", exclusive="source")
     """report the folder `neurosym extract --out DIR` wrote"""
     threshold: str | None = option(None, metavar="SPEC")
