@@ -52,6 +52,7 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
     "holding": _arguments("holding"),
     "terrain": _arguments("terrain"),
     "grids": _arguments("grid"),
+    "optimal": _arguments("optimal_visits"),
     "events": _arguments("event"),
     "attends": _arguments("attends"),
     "relations": _arguments("relation"),
@@ -75,7 +76,7 @@ META_KEYS = (
     "checkpoint", "env", "module", "heads", "relations", "seed", "actions", "created", "version",
 )  # fmt: skip
 
-OPTIONAL_TABLES = ("terrain", "grids")
+OPTIONAL_TABLES = ("terrain", "grids", "optimal")
 """tables that recordings of older versions lack: they load as empty tables"""
 
 MAX_COUNT = 1024
@@ -126,7 +127,8 @@ class Recording:
     Missing tables default to empty ones (an MHDPA recording has no ``relations``,
     a PrediNet one no ``attention``; a hand-made one may have no ``terrain``
     (the cells of each episode's map that hold terrain, read after the reset)
-    or ``grids`` (each episode's map size)). Tables are brought to the schema on
+    or ``grids`` (each episode's map size) or ``optimal`` (each RGW level's optimal
+    visit order, Prolog list text)). Tables are brought to the schema on
     construction, so column order and dtypes are always the documented ones.
     """
 
@@ -136,6 +138,7 @@ class Recording:
     holding: pd.DataFrame = field(default_factory=lambda: empty_table("holding"))
     terrain: pd.DataFrame = field(default_factory=lambda: empty_table("terrain"))
     grids: pd.DataFrame = field(default_factory=lambda: empty_table("grids"))
+    optimal: pd.DataFrame = field(default_factory=lambda: empty_table("optimal"))
     events: pd.DataFrame = field(default_factory=lambda: empty_table("events"))
     attends: pd.DataFrame = field(default_factory=lambda: empty_table("attends"))
     relations: pd.DataFrame = field(default_factory=lambda: empty_table("relations"))
