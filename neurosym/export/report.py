@@ -133,8 +133,8 @@ def link_text(answer: Any, sides: tuple[str, str]) -> str:
 
     ``direct([r(1)], share(4, 124))`` -> ``direct: r(1) on 4 of 124 states``;
     ``indirect([via(agent, share(2, 124))])`` -> ``indirect via agent on 2 of 124 states``;
-    ``co_occurring([apart(agent, share(6, 40), share(8, 40))])`` -> ``co-occurring only,
-    via agent: with sword on 6, with enemy on 8 of 40 states, never within one step``.
+    ``co_occurring([apart(agent, share(6, 40), share(8, 40))])`` -> ``co-occurring only:
+    agent: with sword on 6, with enemy on 8 of 40 states, never within one step``.
     """
     from neurosym.terms import Term
 
@@ -153,7 +153,7 @@ def link_text(answer: Any, sides: tuple[str, str]) -> str:
         parts = [f"{v.args[0]}: with {a} on {v.args[1].args[0]}, with {b} on "
                  f"{v.args[2].args[0]} of {v.args[1].args[1]} states"
                  for v in answer.args[0]]
-        return "co-occurring only, via " + "; ".join(parts) + ", never within one step"
+        return "co-occurring only: " + "; ".join(parts) + ", never within one step"
     return str(answer)
 
 

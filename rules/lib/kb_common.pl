@@ -46,9 +46,18 @@ kb_link_(A, B, R) :- kb_link_at_(_, _, A, B, R).
 %   kb_acted_states_(-D): the states the agent acted in, over every episode:
 %   the sum of episode/4's Steps (states 0..Steps-1 of each episode, the ones
 %   with a step/4 fact and the network's outputs). The denominator of every
-%   share(N, D) the link answers give.
+%   share(N, D) the link answers give. A hand-made KB without episode/4
+%   facts counts instead the distinct states that have a network fact
+%   (holds/5, attention/6).
 kb_acted_states_(D) :-
-    aggregate_all(sum(S), episode(_, S, _, _), D).
+    aggregate_all(sum(S), kb_fact_(episode(_, S, _, _)), D0),
+    (   D0 > 0
+    ->  D = D0
+    ;   aggregate_all(count, distinct(E-T, kb_network_state_(E, T)), D)
+    ).
+
+kb_network_state_(E, T) :- kb_fact_(holds(E, T, _, _, _)).
+kb_network_state_(E, T) :- kb_fact_(attention(E, T, _, _, _, _)).
 
 %   kb_link_answer_(+As, +Bs, -Answer): how the network relates the entities
 %   As to the entities Bs (lists: key(red) and held(red) are one key), state
