@@ -187,10 +187,8 @@ sword_enemy_direct(Link) :-
 %       X = teleport.
 
 sword_enemy_via(X) :-
-    kb_links_of_([sword], SLinks),
-    kb_links_of_([enemy], ELinks),
-    kb_by_third_(SLinks, [sword], [enemy], SStates),
-    kb_by_third_(ELinks, [sword], [enemy], EStates),
+    kb_thirds_([sword], [sword], [enemy], SStates),
+    kb_thirds_([enemy], [sword], [enemy], EStates),
     kb_via_(SStates, EStates, 0, Near, _),
     member(via(X, _), Near).
 

@@ -82,15 +82,14 @@ kb_network_state_(E, T) :- kb_fact_(attention(E, T, _, _, _, _)).
 %   Z ranges over the agent, the map's object types (object/2) and
 %   Box-World's held key held(C); never one of As or Bs. Speed: one lookup of
 %   the links of each A and each B (indexed on that argument), then sorted
-%   lists of E-T states per Z merged in order: no scan per pair of states.
+%   lists of E-T states per Z intersected in order: no scan per pair of
+%   states, no pass over facts that involve neither side.
 kb_link_answer_(As, Bs, Answer) :-
     kb_acted_states_(D),
-    kb_links_of_(As, ALinks),
-    (   kb_direct_(ALinks, Bs, Links, N)
+    (   kb_direct_(As, Bs, Links, N)
     ->  Answer = direct(Links, share(N, D))
-    ;   kb_links_of_(Bs, BLinks),
-        kb_by_third_(ALinks, As, Bs, AStates),
-        kb_by_third_(BLinks, As, Bs, BStates),
+    ;   kb_thirds_(As, As, Bs, AStates),
+        kb_thirds_(Bs, As, Bs, BStates),
         kb_via_(AStates, BStates, D, Near, Apart),
         (   Near \== []
         ->  Answer = indirect(Near)
@@ -100,29 +99,31 @@ kb_link_answer_(As, Bs, Answer) :-
         )
     ).
 
-%   kb_links_of_(+Xs, -Links): every l(E-T, Z, Link) with an X of Xs related to
-%   Z at state T of episode E, in the order of the facts.
-kb_links_of_(Xs, Links) :-
-    findall(l(E-T, Z, L), ( member(X, Xs), kb_link_at_(E, T, X, Z, L) ), Links).
-
-%   kb_direct_(+ALinks, +Bs, -Links, -N): Links (each once, in the order found)
-%   relate an A to a B; N states have one. Fails when none does.
-kb_direct_(ALinks, Bs, Links, N) :-
-    findall(S-L, ( member(l(S, Z, L), ALinks), memberchk(Z, Bs) ), Found),
+%   kb_direct_(+As, +Bs, -Links, -N): Links (each once, in the order found)
+%   relate an A to a B at some state; N states have one. Fails when none
+%   does.
+kb_direct_(As, Bs, Links, N) :-
+    findall(S-L, ( member(A, As), member(B, Bs), kb_link_at_(E, T, A, B, L), S = E-T ), Found),
     Found \== [],
     pairs_keys_values(Found, States, Ls),
     list_to_set(Ls, Links),
     sort(States, Distinct),
     length(Distinct, N).
 
-%   kb_by_third_(+Links, +As, +Bs, -ZStates): Z-States (States the sorted E-T
-%   states) for each third entity Z of Links, in standard order of Z.
-kb_by_third_(Links, As, Bs, ZStates) :-
-    findall(Z-S, ( member(l(S, Z, _), Links),
-                   \+ memberchk(Z, As), \+ memberchk(Z, Bs),
-                   kb_third_entity_(Z) ), Pairs),
+%   kb_thirds_(+Xs, +As, +Bs, -ZStates): Z-States for each third entity Z
+%   that the network relates to an X of Xs, in standard order of Z; States
+%   are the sorted states of those links, each E-T as the integer
+%   E << 32 + T (integers compare faster than pairs, and T - 1 and T + 1
+%   stay within the episode: no state has T >= 2^32). One findall over the links of
+%   each X (indexed on X's argument), one sort, then a filter on the few
+%   distinct Zs.
+kb_thirds_(Xs, As, Bs, ZStates) :-
+    findall(Z-S, ( member(X, Xs), kb_link_at_(E, T, X, Z, _), S is E << 32 + T ), Pairs),
     sort(Pairs, Sorted),
-    group_pairs_by_key(Sorted, ZStates).
+    group_pairs_by_key(Sorted, Groups),
+    findall(Z-States, ( member(Z-States, Groups),
+                        \+ memberchk(Z, As), \+ memberchk(Z, Bs),
+                        kb_third_entity_(Z) ), ZStates).
 
 kb_third_entity_(agent) :- !.
 kb_third_entity_(held(_)) :- !.
@@ -147,7 +148,7 @@ kb_via_(AStates, BStates, D, Near, Apart) :-
 
 %   kb_near_count_(+SA, +SB, -N): the states of SA or SB at which the other
 %   side holds at that state, the one before or the one after (same
-%   episode). SA and SB are sorted E-T lists.
+%   episode). SA and SB are sorted state keys (kb_thirds_/4).
 kb_near_count_(SA, SB, N) :-
     kb_widen_(SB, WB),
     kb_widen_(SA, WA),
@@ -156,10 +157,10 @@ kb_near_count_(SA, SB, N) :-
     ord_union(InA, InB, Near),
     length(Near, N).
 
-%   kb_widen_(+States, -Wide): States with each E-T's neighbours E-(T-1) and
-%   E-(T+1) added, sorted.
+%   kb_widen_(+States, -Wide): sorted States with each state's neighbours
+%   (the state keys one less and one more) added, sorted.
 kb_widen_(States, Wide) :-
-    findall(E-T1, ( member(E-T, States), ( T1 is T - 1 ; T1 = T ; T1 is T + 1 ) ), Ws),
+    findall(S1, ( member(S, States), ( S1 is S - 1 ; S1 = S ; S1 is S + 1 ) ), Ws),
     sort(Ws, Wide).
 
 %   kb_fact_(+Fact): Fact, for facts a KB may lack altogether: fails, rather
