@@ -282,7 +282,7 @@ def optimal_table(name: str, venv: Any, seed: int, episodes: int) -> pd.DataFram
     """
     from neurosym.envs import env_family
     from neurosym.envs.rgw_solver import optimal_visit_orders
-    from neurosym.export.recording import conform
+    from neurosym.record.recording import conform
 
     if env_family(name) != "rgw":
         return conform("optimal", None)

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from neurosym.export.report import link_text
 from neurosym.prolog.knowledge_base import KnowledgeBase
+from neurosym.reports.terminal import link_text
 from neurosym.terms import Term
 
 REPO = Path(__file__).resolve().parents[2]

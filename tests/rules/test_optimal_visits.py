@@ -140,8 +140,8 @@ def test_box_world_kbs_have_no_optimal_visits(tmp_path: Path) -> None:
     (solution_chain/2, followed_solution/1): no optimal_visits/2 facts."""
     from test_recorder import small_agent
 
-    from neurosym.export.facts import extract_facts
-    from neurosym.export.recorder import record
+    from neurosym.facts.tables import extract_facts
+    from neurosym.record.recorder import record
 
     rec = record(small_agent("bw1", "predinet"), "bw1", episodes=2, seed=0, actions="random")
     assert rec.optimal.empty
