@@ -142,7 +142,7 @@ SCHEMA: dict[str, Predicate] = {
            "them, as the env's own solver plays it (RGW: `[sword, teleport, enemy, terminal]` on "
            "rgw2; the first of equally fast routes); none for a level without an optimal return "
            "(unsolvable, or too large to search) and none on Box-World",
-           TRACE, "extract"),
+           TRACE, "extract intervene"),
         _p("step", "episode:E:int t:T:int action:atom reward:float",
            "the action taken in state T (`up, right, down, left`) and its reward",
            TRACE, "extract intervene"),
