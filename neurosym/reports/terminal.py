@@ -70,7 +70,7 @@ SCOPES: dict[str, dict[str, tuple[str, str, str]]] = {
     "rgw": {
         "level's optimal order followed": (
             "current_predicate(optimal_visits/2), optimal_visits(E, _)",
-            "episodes with an optimal order",
+            "episodes of solved levels",
             "no optimal order in this KB (recorded before optimal_visits/2, or no level solved)",
         ),
     },

@@ -106,7 +106,7 @@ def test_extract_on_a_held_out_map_writes_and_compares_the_order(
     assert proc.returncode == 0, proc.stderr
     text = " ".join(proc.stdout.split())
     assert "levels' optimal orders (most common) │ [sword,enemy,terminal] x3" in text
-    assert "level's optimal order followed │ 0 of 3 episodes with an optimal order" in text
+    assert "level's optimal order followed │ 0 of 3 episodes of solved levels" in text
     with KnowledgeBase(out / "kb.pl", rules=["rgw"]) as kb:
         assert kb.query("optimal_visits(E, O)") == [
             {"E": e, "O": ("sword", "enemy", "terminal")} for e in range(3)
