@@ -135,11 +135,9 @@ def test_extract_on_procedural_levels_records_each_levels_order(
     assert followed == [e for e in range(4) if visits[e] == got[e]]
 
 
-def test_box_world_kbs_have_no_optimal_visits(tmp_path: Path) -> None:
+def test_box_world_kbs_have_no_optimal_visits(small_agent, tmp_path: Path) -> None:
     """Box-World's chain to the gem is read from the map by rules/boxworld.pl
     (solution_chain/2, followed_solution/1): no optimal_visits/2 facts."""
-    from test_recorder import small_agent
-
     from neurosym.facts.tables import extract_facts
     from neurosym.record.recorder import record
 
