@@ -602,24 +602,32 @@ def optimal_visit_orders(venv: object, seeds: list[int]) -> list[tuple[str, ...]
     env = getattr(venv, "unwrapped", venv)
     n = int(env.num_envs)
     out: list[tuple[str, ...] | None] = []
+    plans: dict[tuple[bytes, int], Plan | None] = {}  # a fixed map is searched once
     for first in range(0, len(seeds), n):
         wave = list(seeds[first : first + n])
         wave += [wave[-1] + 1 + i for i in range(n - len(wave))]  # idle sub-envs
-        out += _wave_orders(env, wave)[: len(seeds) - first]
+        out += _wave_orders(env, wave, plans)[: len(seeds) - first]
+        if len(plans) > Planner.MAX_PLANS:
+            plans.clear()
     return out
 
 
-def _wave_orders(env: Any, seeds: list[int]) -> list[tuple[str, ...] | None]:
-    """:func:`optimal_visit_orders` of one reset of every sub-env."""
+def _wave_orders(
+    env: Any, seeds: list[int], cache: dict[tuple[bytes, int], Plan | None]
+) -> list[tuple[str, ...] | None]:
+    """:func:`optimal_visit_orders` of one reset of every sub-env (plans kept in ``cache``)."""
     _, info = env.reset(seed=seeds)
     cells, starts = env.current_levels()
     plans: list[Plan | None] = []
     for i in range(len(seeds)):
-        try:
-            ok = np.isfinite(info["optimal_return"][i])
-            plans.append(Plan(cells[i], starts[i], env.height, env.width, env.rules) if ok else None)
-        except ValueError:
-            plans.append(None)
+        key = (cells[i].tobytes(), int(starts[i]))
+        if key not in cache:
+            try:
+                ok = np.isfinite(info["optimal_return"][i])
+                cache[key] = Plan(cells[i], starts[i], env.height, env.width, env.rules) if ok else None
+            except ValueError:
+                cache[key] = None
+        plans.append(cache[key])
     limit = env.rules.max_steps
     visits: list[list[str]] = [[] for _ in seeds]
     live = np.array([p is not None for p in plans])
