@@ -31,6 +31,12 @@ QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("distractor avoided", "distractor_avoided(E)", "E"),
         ("key opens lock", "key_opens(K, L), X = K-L", "X"),
     ),
+    "minigrid": (
+        ("key before door", "key_before_door(E)", "E"),
+        ("key opens door", "opens(K, D), X = K-D", "X"),
+        ("mission done", "mission_done(E)", "E"),
+        ("key-door links in the network", "key_door_link(C, L), X = C-L", "X"),
+    ),
 }
 LINKS: dict[str, tuple[tuple[str, str, str, str, tuple[str, str]], ...]] = {
     "rgw": (
@@ -51,6 +57,7 @@ LINK_NOTE = (
 RULE_FILES: dict[str, tuple[str, ...]] = {
     "rgw": ("rgw.pl", "relations.pl"),
     "boxworld": ("boxworld.pl", "relations.pl"),
+    "minigrid": ("minigrid.pl", "relations.pl"),
 }
 
 
