@@ -51,7 +51,7 @@ def run(args: EvalOptions) -> int:
 
     torch.set_num_threads(1)
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
     env, kwargs = env_for(agent, env, overrides)
     report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs).as_dict()

@@ -89,7 +89,7 @@ def run(args: ExtractOptions) -> int:
     formats = parse_formats(args.format)
     parse_threshold(args.threshold)
     check_extract_options(args.episodes, args.seed, args.batch, args.top_keys)
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once, before anything is recorded: the default folder needs the env

@@ -150,7 +150,7 @@ def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path
     from neurosym.reports.web.card import agent_card
     from neurosym.reports.web.page import render
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     out = Path(args.out) if args.out else Path("kb_out") / env
