@@ -140,7 +140,9 @@ def untrained_agent(agent: Any, seed: int = CONTROL_SEED) -> Any:
     return replace(agent, model=untrained_like(agent.config, seed), path=None)
 
 
-def record_control(agent: Any, rec: Any, *, seed: int = CONTROL_SEED, **record_options: Any) -> Any:
+def record_control(
+    agent: Any, rec: Any, *, control_seed: int = CONTROL_SEED, **record_options: Any
+) -> Any:
     """The untrained network's recording of the states ``agent`` visited in ``rec``.
 
     ``record_options`` are the options ``rec`` was recorded with. ConfigError
@@ -149,7 +151,7 @@ def record_control(agent: Any, rec: Any, *, seed: int = CONTROL_SEED, **record_o
     """
     from neurosym.record.recorder import record
 
-    control = record(ControlledAgent(agent, untrained_agent(agent, seed)), **record_options)
+    control = record(ControlledAgent(agent, untrained_agent(agent, control_seed)), **record_options)
     for name in ("positions", "steps", "episodes"):
         if not getattr(control, name).equals(getattr(rec, name)):
             raise ConfigError(
@@ -189,7 +191,9 @@ def trace_from_facts(facts: Any, relations: Any = None) -> Any:
     tables = {}
     for name, columns in _TRACE_COLUMNS.items():
         source = relations if relations is not None and name in RELATION_TABLES else facts
-        tables[name] = source[name].loc[:, list(columns)].rename(columns=columns).reset_index(drop=True)
+        tables[name] = (
+            source[name].loc[:, list(columns)].rename(columns=columns).reset_index(drop=True)
+        )
     meta = {
         k: format_value(v)  # as load_trace reads them: Prolog text ('rgw-random' quoted)
         for k, v in zip(facts["kb_meta"]["key"], facts["kb_meta"]["value"], strict=True)
@@ -256,7 +260,9 @@ def next_object_table(trace: Any, got: Pairs, episodes: list[int]) -> Any:
     return Table(pairs, got.x[keep], y, state[keep], states)
 
 
-def next_object(trace: Any, got: Pairs, fit_eps: list[int], test_eps: list[int], seed: int = 0) -> tuple[float, int]:
+def next_object(
+    trace: Any, got: Pairs, fit_eps: list[int], test_eps: list[int], seed: int = 0
+) -> tuple[float, int]:
     """Held-out share of states whose next object the strategy learner (its tree) picks, and the states."""
     from neurosym.induce.strategy import MAX_CLAUSES, fidelity
     from neurosym.induce.strategy_tree import fit
@@ -357,9 +363,14 @@ def measure(
     trace = trace_from_facts(facts)
     episodes = trace.episodes()
     fit_eps, test_eps = split(episodes)
-    sets: list[tuple[str, Any, str]] = [("relations", trace, "relations"), ("world", trace, "world")]
+    sets: list[tuple[str, Any, str]] = [
+        ("relations", trace, "relations"),
+        ("world", trace, "world"),
+    ]
     if control is not None:
-        sets.append(("untrained_relations", trace_from_facts(facts, relations=control), "relations"))
+        sets.append(
+            ("untrained_relations", trace_from_facts(facts, relations=control), "relations")
+        )
     rows: list[tuple[str, str, float, int]] = []
     notes: list[str] = []
     for name, source, which in sets:
@@ -383,17 +394,22 @@ def measure(
     table = pd.DataFrame(rows, columns=["target", "features", "score", "states"])
     order = {(t, f): i for i, (t, f) in enumerate((t, f) for t in TARGETS for f in FEATURES)}
     table = table[table["states"] > 0]
-    table = table.iloc[np.argsort([order[k] for k in zip(table["target"], table["features"], strict=True)], kind="stable")]
+    table = table.iloc[
+        np.argsort(
+            [order[k] for k in zip(table["target"], table["features"], strict=True)], kind="stable"
+        )
+    ]
     table = table.reset_index(drop=True).assign(episodes=len(test_eps))
     return Faithfulness(table, len(episodes), time.perf_counter() - start, tuple(notes))
 
 
 def faithfulness(
-    agent: Any, rec: Any, facts: Any, *, seed: int = CONTROL_SEED, **record_options: Any
+    agent: Any, rec: Any, facts: Any, *, control_seed: int = CONTROL_SEED, **record_options: Any
 ) -> Faithfulness:
     """Record the untrained control on ``rec``'s states, then :func:`measure` (timed together).
 
-    ``record_options``: what ``rec`` was recorded with (env, episodes, seed, greedy, ...).
+    ``record_options``: what ``rec`` was recorded with (env, episodes, seed, greedy, ...);
+    ``control_seed`` initialises the untrained network.
     Fewer than 2 episodes: an empty table and the reason in ``notes``.
     """
     from neurosym.facts.tables import extract_facts
@@ -403,6 +419,6 @@ def faithfulness(
         empty = pd.DataFrame({c: [] for c in ("target", "features", "score", "states", "episodes")})
         note = f"{len(rec.episodes)} episode: faithfulness needs at least 2 (one to learn from, one to score on)"
         return Faithfulness(empty, len(rec.episodes), 0.0, (note,))
-    control = record_control(agent, rec, seed=seed, **record_options)
+    control = record_control(agent, rec, control_seed=control_seed, **record_options)
     control_facts = extract_facts(control, threshold=facts.threshold)
-    return measure(facts, control_facts, seed=seed, started=start)
+    return measure(facts, control_facts, started=start)
