@@ -177,6 +177,25 @@ def test_the_printed_table_is_the_kbs_facts(run_neurosym, tmp_path: Path) -> Non
         assert printed[(target, "states")] == str(n)
     assert len(printed) == 5 * len(set(facts["T"]))  # four figures and the states per target
 
+    # the report page's section: the KB's facts (a page rebuilt from the recording re-extracts
+    # facts without them, so they are read from kb.pl)
+    from neurosym.reports.web.build import load_extract
+    from neurosym.reports.web.tables import faithfulness_rows
+
+    got = load_extract(out)
+    assert got.facts["faithfulness"].empty
+    rows = faithfulness_rows(got.facts, got.kb_path)
+    kb_rows = {
+        (str(t), str(f)): (float(s), int(n)) for t, f, s, n, _ in facts.itertuples(index=False)
+    }
+    for row in rows:
+        target = row["target"].replace(" ", "_")
+        names = ("relations", "world", "untrained_relations", "chance")
+        for name, score in zip(names, row["scores"], strict=True):
+            assert score == kb_rows.get((target, name), (None,))[0]
+        assert row["states"] == kb_rows[(target, "chance")][1] and row["episodes"] == 2
+    assert len(rows) == len(set(facts["T"]))
+
 
 def test_no_faithfulness_measures_nothing() -> None:
     from neurosym.record.extraction import extract
