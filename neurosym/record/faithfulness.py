@@ -372,12 +372,12 @@ def measure(
             ("untrained_relations", trace_from_facts(facts, relations=control), "relations")
         )
     rows: list[tuple[str, str, float, int]] = []
-    notes: list[str] = []
+    notes: dict[str, list[str]] = {}  # why -> the figures it leaves out
     for name, source, which in sets:
         try:
             got = pair_features(source, which)
         except NeurosymError as exc:
-            notes.append(f"{name}: {exc}")
+            notes.setdefault(str(exc), []).append(name)
             continue
         for target in TARGETS:
             try:
@@ -386,7 +386,7 @@ def measure(
                 else:
                     score, states = action(source, got, fit_eps, seed)
             except NeurosymError as exc:
-                notes.append(f"{target} from {name}: {exc}")
+                notes.setdefault(str(exc), []).append(f"{target} from {name}")
                 continue
             rows.append((target, name, score, states))
     rows.append(("next_object", "chance", *next_object_chance(trace, test_eps)))
@@ -400,7 +400,8 @@ def measure(
         )
     ]
     table = table.reset_index(drop=True).assign(episodes=len(test_eps))
-    return Faithfulness(table, len(episodes), time.perf_counter() - start, tuple(notes))
+    said = tuple(f"{', '.join(what)}: {why}" for why, what in notes.items())
+    return Faithfulness(table, len(episodes), time.perf_counter() - start, said)
 
 
 def faithfulness(
