@@ -19,14 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from test_recorder_scripted import scripted_recording
-from test_webreport_data import (
-    SCRIPT,
-    TAG,
-    extract_folder,
-    hostile_recording,
-    report,
-)
+from pages import SCRIPT, TAG, extract_folder, report
 
 from neurosym.record.recording import Recording
 
@@ -71,7 +64,7 @@ def errors(driver: Any) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def predinet_page(tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path]:
+def predinet_page(scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path]:
     rec = scripted_recording("predinet")
     folder = extract_folder(rec, tmp_path_factory.mktemp("browser") / "out")
     report(folder)
@@ -186,7 +179,7 @@ def test_screenshot_is_not_blank(browser: Any, predinet_page: tuple) -> None:
     assert (0x1F, 0x77, 0xB4) in found and (0x2C, 0xA0, 0x2C) in found
 
 
-def test_hostile_kb_text_runs_nothing(browser: Any, tmp_path: Path) -> None:
+def test_hostile_kb_text_runs_nothing(hostile_recording, browser: Any, tmp_path: Path) -> None:
     from selenium.common.exceptions import NoAlertPresentException
 
     folder = extract_folder(hostile_recording(), tmp_path / "out")
@@ -203,9 +196,8 @@ def test_hostile_kb_text_runs_nothing(browser: Any, tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def other_pages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Recording, Path]]:
+def other_pages(explorer_recording, scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Recording, Path]]:
     """An MHDPA page and a Box-World page."""
-    from test_recorder_scripted import explorer_recording
 
     pages = {}
     for name, rec in (
