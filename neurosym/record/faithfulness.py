@@ -55,6 +55,9 @@ MAX_LEAVES = 20
 
 DIRECTIONS = ("up", "right", "down", "left")
 
+FAMILIES = {"rgw": "Relational-Grid-World", "boxworld": "Box-World"}
+"""the env families measured (the strategy learner's: its contacts and object kinds are theirs)"""
+
 
 @dataclass(frozen=True)
 class Faithfulness:
@@ -411,14 +414,24 @@ def faithfulness(
 
     ``record_options``: what ``rec`` was recorded with (env, episodes, seed, greedy, ...);
     ``control_seed`` initialises the untrained network.
-    Fewer than 2 episodes: an empty table and the reason in ``notes``.
+    Fewer than 2 episodes, or an env family the strategy learner does not know (Minigrid):
+    an empty table and the reason in ``notes``.
     """
+    from neurosym.envs import env_family
     from neurosym.facts.tables import extract_facts
 
     start = time.perf_counter()
-    if len(rec.episodes) < 2:
-        empty = pd.DataFrame({c: [] for c in ("target", "features", "score", "states", "episodes")})
+    family = env_family(str(rec.meta.get("env")))
+    note = None
+    if family not in FAMILIES:
+        note = (
+            f"not measured on {family} envs: the strategy learner knows the objects and contacts "
+            f"of {' and '.join(FAMILIES.values())}"
+        )
+    elif len(rec.episodes) < 2:
         note = f"{len(rec.episodes)} episode: faithfulness needs at least 2 (one to learn from, one to score on)"
+    if note is not None:
+        empty = pd.DataFrame({c: [] for c in ("target", "features", "score", "states", "episodes")})
         return Faithfulness(empty, len(rec.episodes), 0.0, (note,))
     control = record_control(agent, rec, control_seed=control_seed, **record_options)
     control_facts = extract_facts(control, threshold=facts.threshold)

@@ -7,7 +7,6 @@ from dataclasses import replace
 
 import numpy as np
 import torch
-from test_recorder import small_agent
 
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.meaning import features
@@ -15,7 +14,10 @@ from neurosym.meaning.probe import probe_recording
 from neurosym.record.recorder import record
 
 
-def test_the_untrained_probes_read_a_fresh_network_on_the_same_states(monkeypatch) -> None:  # noqa: ANN001
+def test_the_untrained_probes_read_a_fresh_network_on_the_same_states(
+    monkeypatch,
+    small_agent,  # noqa: ANN001
+) -> None:
     agent = small_agent("rgw2")
     with torch.random.fork_rng():
         torch.manual_seed(7)  # weights of another seed than the control's: a stand-in for training

@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
-from functools import cache
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 import torch
-from test_recorder import small_agent
-from test_recorder_scripted import PLANS, scripted_recording
 
 from neurosym.agent.agent import Agent
 from neurosym.agent.networks.model import ActorCritic
@@ -30,8 +28,8 @@ from neurosym.record.faithfulness import (
 from neurosym.record.recorder import record
 
 
-@cache
-def trained_agent() -> Agent:
+@pytest.fixture(scope="module")
+def trained(small_agent) -> Agent:  # noqa: ANN001
     """The small rgw2 agent with weights of another seed than the control's (a stand-in for training)."""
     agent = small_agent("rgw2")
     with torch.random.fork_rng():
@@ -43,8 +41,8 @@ def trained_agent() -> Agent:
 OPTIONS = {"env": "rgw2", "episodes": 3, "seed": 4, "greedy": True}
 
 
-def test_the_control_is_a_fresh_network_on_the_agents_very_states() -> None:
-    agent = trained_agent()
+def test_the_control_is_a_fresh_network_on_the_agents_very_states(trained: Agent) -> None:
+    agent = trained
     control = untrained_agent(agent)
     with torch.random.fork_rng():
         torch.manual_seed(CONTROL_SEED)
@@ -64,8 +62,8 @@ def test_the_control_is_a_fresh_network_on_the_agents_very_states() -> None:
     assert not rec.attends.equals(shown.attends)  # another network was introspected
 
 
-def test_the_controlled_agent_acts_as_one_and_shows_the_other() -> None:
-    agent = trained_agent()
+def test_the_controlled_agent_acts_as_one_and_shows_the_other(trained: Agent) -> None:
+    agent = trained
     control = untrained_agent(agent)
     both = ControlledAgent(agent, control)
     obs = np.stack([make("rgw2").reset(seed=s)[0] for s in range(8)])
@@ -81,18 +79,19 @@ def test_the_controlled_agent_acts_as_one_and_shows_the_other() -> None:
     assert not np.array_equal(intro.attention1, own.attention1)
 
 
-@cache
-def scripted_facts() -> tuple[object, object]:
+@pytest.fixture(scope="module")
+def scripted_facts(scripted_recording) -> tuple[object, object]:  # noqa: ANN001
     """The scripted routes' facts (contacts on every route but the timeout), twice: the
     second stands in for the control's, so its figures must be the relation figures."""
     rec = scripted_recording()
+    assert len(rec.episodes) == 5
     return extract_facts(rec), extract_facts(rec)
 
 
-def test_figures_count_held_out_episodes_only() -> None:
-    facts, control = scripted_facts()
+def test_figures_count_held_out_episodes_only(scripted_facts) -> None:  # noqa: ANN001
+    facts, control = scripted_facts
     got = measure(facts, control)
-    episodes = list(range(len(PLANS)))
+    episodes = list(range(5))  # the five scripted routes
     fit, test = split(episodes)
     assert (fit, test) == (episodes[:3], episodes[3:])  # ceil(0.3 * 5) = 2 held out
     trace = trace_from_facts(facts)
@@ -114,10 +113,10 @@ def test_figures_count_held_out_episodes_only() -> None:
         assert got.score(target, "untrained_relations") == got.score(target, "relations")
 
 
-def test_the_trace_in_memory_is_the_written_kbs(tmp_path: Path) -> None:
+def test_the_trace_in_memory_is_the_written_kbs(scripted_facts, tmp_path: Path) -> None:  # noqa: ANN001
     from neurosym.induce.strategy_data import load_trace
 
-    facts, _ = scripted_facts()
+    facts, _ = scripted_facts
     facts.to_prolog(tmp_path / "kb.pl")
     read = load_trace(tmp_path / "kb.pl")
     mine = trace_from_facts(facts)
@@ -151,9 +150,7 @@ def _printed(stdout: str) -> dict[tuple[str, str], str]:
     return cells
 
 
-def test_the_printed_table_is_the_kbs_facts(run_neurosym, tmp_path: Path) -> None:  # noqa: ANN001
-    from test_extract import small_checkpoint
-
+def test_the_printed_table_is_the_kbs_facts(run_neurosym, small_checkpoint, tmp_path: Path) -> None:  # noqa: ANN001
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
     ckpt = small_checkpoint(tmp_path / "small.pt", "predinet", 15, relations=3)
@@ -197,17 +194,17 @@ def test_the_printed_table_is_the_kbs_facts(run_neurosym, tmp_path: Path) -> Non
     assert len(rows) == len(set(facts["T"]))
 
 
-def test_no_faithfulness_measures_nothing() -> None:
+def test_no_faithfulness_measures_nothing(trained: Agent) -> None:
     from neurosym.record.extraction import extract
 
-    got = extract(trained_agent(), episodes=2, seed=4, faithfulness=False)
+    got = extract(trained, episodes=2, seed=4, faithfulness=False)
     assert got.faithfulness is None and got.facts["faithfulness"].empty
 
 
-def test_one_episode_has_no_figures_and_says_why() -> None:
+def test_one_episode_has_no_figures_and_says_why(trained: Agent) -> None:
     from neurosym.record.faithfulness import faithfulness
 
-    agent = trained_agent()
+    agent = trained
     options = {**OPTIONS, "episodes": 1}
     rec = record(agent, **options)
     got = faithfulness(agent, rec, extract_facts(rec), **options)
