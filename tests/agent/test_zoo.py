@@ -21,7 +21,7 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
     from neurosym.shipped import checkpoint_file, rule_file, rules_dir, shipped_rule_names
 
     assert rules_dir() == REPO / "rules"
-    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "relations", "rgw", "route"]
+    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "minigrid", "relations", "rgw", "route"]
     monkeypatch.chdir(tmp_path)
     assert rule_file("rgw") == REPO / "rules" / "rgw.pl"
     assert rule_file("boxworld.pl") == REPO / "rules" / "boxworld.pl"

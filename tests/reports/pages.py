@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from typing import Any
 
 from neurosym.cli import main
 from neurosym.facts.tables import extract_facts
@@ -37,3 +38,14 @@ SCRIPT = "</script><script>alert(1)</script>"
 TAG = "<img src=x onerror=alert(2)>"
 HOSTILE = f"'{SCRIPT}'"  # quoted atoms: legal Prolog, so a KB can hold them
 HOSTILE_EVENT = f"'{TAG}'"
+
+
+def errors(driver: Any) -> list[str]:
+    """Console messages of level SEVERE since the last call (CSP violations included)."""
+    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def open_page(driver: Any, page: Path, fragment: str = "") -> None:
+    """Load ``page`` afresh (not a fragment change of the page already open)."""
+    driver.get("about:blank")
+    driver.get(page.resolve().as_uri() + fragment)
