@@ -138,6 +138,12 @@ SCHEMA: dict[str, Predicate] = {
            "every non-empty cell of E's map after the reset that holds no object and is not "
            "the agent (RGW `wall`, `mountain`; Box-World `wall`; Minigrid `wall`, `lava`, "
            "`floor`); terrain never changes within an episode", TRACE, "extract intervene"),
+        _p("optimal_visits", "episode:E:int order:term",
+           "the key objects of E's level in the order its fastest optimal route first reaches "
+           "them, as the env's own solver plays it (RGW: `[sword, teleport, enemy, terminal]` on "
+           "rgw2; the first of equally fast routes); none for a level without an optimal return "
+           "(unsolvable, or too large to search) and none on Box-World or Minigrid",
+           TRACE, "extract intervene"),
         _p("step", "episode:E:int t:T:int action:atom reward:float",
            "the action taken in state T (`up, right, down, left`; Minigrid `left, right, forward, "
            "pickup, drop, toggle, done`) and its reward",

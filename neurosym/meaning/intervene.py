@@ -66,7 +66,7 @@ from neurosym.terms import Term
 DEFAULT_EPISODES = 100
 """episodes per experiment by default (sampled actions, seeds S..S+99)"""
 
-TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
+TRACE_TABLES = ("episodes", "grids", "terrain", "optimal", "steps", "positions", "holding", "events")
 
 NETWORK_FACTS = tuple(p.name for p in group(TRACE) if "intervene" not in p.writers)
 """the trace predicates an experiment KB leaves out (:mod:`neurosym.facts.schema`: those intervene does
@@ -294,7 +294,10 @@ def _count(grid_map: Any, obj: str) -> int:
 
 
 def ablation_experiments(heads: int, module: str) -> list[Experiment]:
-    """Each head ablated in turn, then all of them."""
+    """Each head ablated in turn, then all of them; none for a network without heads (an
+    outside agent whose attention nobody named)."""
+    if heads < 1:
+        return []
     what = adapter_class(module).head_term
     detail = Term("replaced", (what, Term("mean_over", ("baseline",))))
     out = [

@@ -169,7 +169,8 @@ def test_the_cell_keys_predinet_plays_rgw2_and_relates_objects(tmp_path: Path) -
     rules = [folder / name for name in RULE_FILES["rgw"]]
     kb_path = extract_facts(rec).to_prolog(tmp_path / "kb.pl")
     with KnowledgeBase(kb_path, rules=rules) as kb:
-        assert kb.once("sword_enemy_link(A)")["A"] == Term("indirect", (("agent",),))
+        apart = Term("apart", ("agent", Term("share", (12, 42)), Term("share", (16, 42))))
+        assert kb.once("sword_enemy_link(A)")["A"] == Term("co_occurring", ((apart,),))
 
 
 @pytest.mark.parametrize("name", RGW)

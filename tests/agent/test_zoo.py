@@ -27,7 +27,7 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
     assert rule_file("boxworld.pl") == REPO / "rules" / "boxworld.pl"
     assert rule_file("mine.pl") == Path("mine.pl")  # not there: the loader says so
     with pytest.raises(
-        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw, route\)"
+        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, minigrid, relations, rgw, route\)"
     ):
         rule_file("rgx")
     (tmp_path / "rgw").write_text("my_rule.\n")  # a file of the user's wins over the shipped name
