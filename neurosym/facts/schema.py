@@ -179,6 +179,14 @@ SCHEMA: dict[str, Predicate] = {
         _p("attention", "episode:E:int t:T:int head:int query:term key:term weight:float",
            "MHDPA: each query cell's strongest key (`--top-keys N`: N of them)",
            TRACE, "extract"),
+        _p("faithfulness", "target:atom features:atom score:float states:int episodes:int",
+           "Target `next_object` or `action`: the share Score of States held-out states (of "
+           "Episodes held-out episodes) whose target a decision tree learned on the other "
+           "episodes predicts from Features: `relations` (the network's relation facts), "
+           "`world` (world facts only), `untrained_relations` (an untrained network of the same "
+           "config on the same states: the control) or `chance` (a uniform pick among the "
+           "objects; the commonest action)",
+           TRACE, "extract"),
         _p("probe", "head:int j:J:value predicate:term accuracy:float control:float",
            "held-out accuracy and control accuracy", PROBE, "probe"),
         _p("probe_untrained", "head:int j:J:value predicate:term accuracy:float control:float",

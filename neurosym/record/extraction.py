@@ -14,6 +14,7 @@ from typing import Any
 
 from neurosym.errors import ConfigError
 from neurosym.facts.tables import DEFAULT_THRESHOLD, FactSet
+from neurosym.record.faithfulness import Faithfulness
 from neurosym.record.recording import Recording
 from neurosym.seeds import check_seed
 
@@ -39,6 +40,9 @@ class Extraction:
     env_kwargs: dict[str, Any]
     recording: Recording
     facts: FactSet
+    faithfulness: Faithfulness | None = None
+    """how much of the agent's choices the relation facts predict, beside controls (None: not
+    measured); also in ``facts`` as faithfulness/5"""
 
 
 def check_extract_options(
@@ -67,6 +71,7 @@ def extract(
     top_keys: int | None = None,
     actions: str = "agent",
     progress: bool = False,
+    faithfulness: bool = True,
 ) -> Extraction:
     """Record ``episodes`` episodes of ``agent`` on ``env`` and extract their facts.
 
@@ -75,6 +80,9 @@ def extract(
     ``threshold``: the relations' threshold spec (``quantile:0.9``, ``abs:X``, ``z:K``).
     ``top_keys``: MHDPA's strongest keys kept per query cell (refused for a module without
     attention/6 facts).
+    ``faithfulness``: also measure how much of the agent's choices the relation facts
+    predict on held-out episodes, beside world facts and an untrained network's relation
+    facts on the same states (:mod:`neurosym.record.faithfulness`; needs 2 episodes).
     """
     from neurosym.agent.agent import env_for, load_agent
     from neurosym.agent.networks.adapters import adapter_class
@@ -95,11 +103,19 @@ def extract(
             f"{agent.config.module} (its facts are {facts})"
         )
     env, env_kwargs = env_for(agent, env, env_kwargs)
-    rec = record(
-        agent, env, episodes=episodes, seed=seed, greedy=greedy, batch=batch,
-        progress=progress, top_keys=top_keys or 1, env_kwargs=env_kwargs, actions=actions,
+    options = dict(
+        env=env, episodes=episodes, seed=seed, greedy=greedy, batch=batch,
+        top_keys=top_keys or 1, env_kwargs=env_kwargs, actions=actions,
     )  # fmt: skip
-    return Extraction(agent.path, env, env_kwargs, rec, extract_facts(rec, threshold=threshold))
+    rec = record(agent, progress=progress, **options)
+    facts = extract_facts(rec, threshold=threshold)
+    measured = None
+    if faithfulness:
+        from neurosym.record.faithfulness import faithfulness as measure
+
+        measured = measure(agent, rec, facts, **options)
+        facts.tables["faithfulness"] = measured.facts()
+    return Extraction(agent.path, env, env_kwargs, rec, facts, measured)
 
 
 def write_outputs(

@@ -425,8 +425,61 @@ def _print_answers(kb: Path | None, family: str, say: Any, table_type: Any, verb
     say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
 
 
+FAITHFULNESS_COLUMNS = (
+    ("relations", "relations"),
+    ("world", "world"),
+    ("untrained_relations", "untrained"),
+    ("chance", "chance"),
+)
+"""faithfulness/5's feature sets -> the printed table's column"""
+
+
+def faithfulness_rows(table: Any) -> list[tuple[str, ...]]:
+    """The printed faithfulness rows (target, then a score per feature set, then the states) of
+    a faithfulness/5 table: what the KB holds, to two decimals (``-``: not measured)."""
+    rows = []
+    for target in dict.fromkeys(table["target"]):
+        mine = table[table["target"] == target]
+        scores = dict(zip(mine["features"], mine["score"], strict=True))
+        cells = [f"{scores[f]:.2f}" if f in scores else "-" for f, _ in FAITHFULNESS_COLUMNS]
+        rows.append((target.replace("_", " "), *cells, str(int(mine["states"].max()))))
+    return rows
+
+
+def _print_faithfulness(facts: Any, measured: Any, say: Any, table_type: Any) -> None:
+    """The faithfulness/5 facts in one table, with what they count and why a figure is missing."""
+    table = facts["faithfulness"]
+    notes = tuple(getattr(measured, "notes", ()))
+    if table.empty and not notes:
+        return
+    if not table.empty:
+        held = int(table["episodes"].max())
+        total = getattr(measured, "episodes", None)
+        of = f" of {total}" if total else ""
+        ft = table_type(
+            title=f"faithfulness (held out: {held}{of} episodes)",
+            show_edge=False,
+        )
+        for col in ("target", *(name for _, name in FAITHFULNESS_COLUMNS), "states"):
+            ft.add_column(col)
+        add_rows(ft, faithfulness_rows(table), whole=tuple(range(6)))
+        say(ft)
+        say(
+            "  (share of the held-out states whose next object or action a tree learned on the "
+            "other episodes predicts from: the relation facts, world facts, an untrained network's "
+            "relation facts on the same states; chance: a uniform pick, the commonest action)"
+        )
+    for note in notes:
+        say(f"  faithfulness: {show(note)}")
+
+
 def print_report(
-    rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None, verbose: bool = True
+    rec: Any,
+    facts: Any,
+    written: dict[str, Path],
+    kb: Path | None = None,
+    verbose: bool = True,
+    faithfulness: Any = None,
 ) -> None:
     """Print the summary of an extract run with rich (plain text when not a terminal).
 
@@ -437,6 +490,8 @@ def print_report(
     Without ``verbose`` it is the short report: the episodes in one line, the
     heads and the rule answers (episode lists as counts); ``verbose`` adds the
     episodes, fact counts, thresholds and relation tables and every answer.
+    The faithfulness table is ``facts``' faithfulness/5 (``faithfulness``, the
+    :class:`~neurosym.record.faithfulness.Faithfulness` measured, adds its notes).
     """
     from rich.console import Console
     from rich.table import Table
@@ -448,6 +503,7 @@ def print_report(
     _print_summary(rec, facts, console, Table, verbose)
     _print_heads(rec, say, Table, verbose)
     _print_relations(facts, say, Table, verbose)
+    _print_faithfulness(facts, faithfulness, say, Table)
     _print_answers(kb, env_family(str(rec.meta.get("env"))), say, Table, verbose)
     for path in written.values():
         say(f"wrote {show(path)}", soft_wrap=True)  # a path is never broken over two lines
