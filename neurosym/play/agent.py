@@ -127,7 +127,8 @@ class PrologAgent:
         try:
             with interruptible():
                 self.kb.query(
-                    "forall(member(PI, Ps), dynamic(PI))", Ps=[Term("/", (p.name, p.arity)) for p in SCHEMA]
+                    "forall(member(PI, Ps), dynamic(PI))",
+                    Ps=[Term("/", (p.name, p.arity)) for p in SCHEMA],
                 )
                 self.kb.load_rules(rule_file("route"))
                 _load_policy(self.kb, self.policy.path)
@@ -397,7 +398,9 @@ class _Watched:
         no events (the action was not the strategy's); their outcome is the cause
         (:meth:`episode_outcome`)."""
         rows = list(self.ended)
-        reward, terminated, truncated = (np.array(x, copy=True) for x in (reward, terminated, truncated))
+        reward, terminated, truncated = (
+            np.array(x, copy=True) for x in (reward, terminated, truncated)
+        )
         reward[rows], terminated[rows], truncated[rows] = 0.0, True, False
         if isinstance(info, dict) and "events" in info:
             info = {**info, "events": np.array(info["events"], copy=True)}

@@ -114,8 +114,12 @@ def run(args: PlayOptions) -> int:
     if names:
         report["compare"] = {
             name: play_policy(
-                compare_file(name, report["env"]), report["env"], args.episodes, args.seed,
-                report["env_kwargs"], fallback=args.fallback,
+                compare_file(name, report["env"]),
+                report["env"],
+                args.episodes,
+                args.seed,
+                report["env_kwargs"],
+                fallback=args.fallback,
             )  # fmt: skip
             for name in names
         }
@@ -178,7 +182,9 @@ def print_report(report: dict) -> None:
     causes = ", ".join(f"{k} {v}" for k, v in report["fallbacks"].items())
     share = f"{100 * fallbacks / steps:.1f} %" if steps else "0 %"
     undecided = "ended" if report["fallback"] == "none" else "fallbacks"
-    print(f"{undecided:<12} {fallbacks} of {steps} steps ({share}){f': {causes}' if causes else ''}")
+    print(
+        f"{undecided:<12} {fallbacks} of {steps} steps ({share}){f': {causes}' if causes else ''}"
+    )
     shares = ", ".join(f"{k} {100 * v:.1f} %" for k, v in report["decider_shares"].items() if v)
     print(f"decided by   {shares or 'nothing'}")
     print(f"speed        {report['steps_per_s']:.0f} steps/s")
@@ -205,8 +211,10 @@ def print_compare(report: dict) -> None:
             f"{_pct(shares['strategy']):>9} {_pct(fallback):>8} {_pct(shares['none']):>7} "
             f"{r['steps_per_s']:>8.0f}"
         )
-    print(f"(same {report['episodes']} levels from seed {report['seed']}, fallback {report['fallback']}; "
-          "by goal/3, fallback, ended: shares of steps)")
+    print(
+        f"(same {report['episodes']} levels from seed {report['seed']}, fallback {report['fallback']}; "
+        "by goal/3, fallback, ended: shares of steps)"
+    )
 
 
 def _pct(x: float) -> str:
