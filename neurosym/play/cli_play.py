@@ -87,7 +87,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: PlayOptions) -> int:
     from neurosym.errors import ConfigError
-    from neurosym.play.evaluate import play_policy
+    from neurosym.play.evaluate import score_strategy
 
     env, overrides = map_option(args.env, args.map, args.env or "rgw2")
     if env is None and args.checkpoint is None:
@@ -107,19 +107,15 @@ def run(args: PlayOptions) -> int:
 
         torch.set_num_threads(1)
     names = compare_names(args.compare)
-    report = play_policy(
+    report = score_strategy(
         args.policy, env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb,
         fallback=args.fallback,
     )  # fmt: skip
     if names:
         report["compare"] = {
-            name: play_policy(
-                compare_file(name, report["env"]),
-                report["env"],
-                args.episodes,
-                args.seed,
-                report["env_kwargs"],
-                fallback=args.fallback,
+            name: score_strategy(
+                compare_file(name, report["env"]), report["env"], args.episodes, args.seed,
+                report["env_kwargs"], fallback=args.fallback,
             )  # fmt: skip
             for name in names
         }
@@ -169,8 +165,8 @@ def compare_file(name: str, env: str) -> Path:
 
 def print_report(report: dict) -> None:
     """The report for people: eval's figure lines, then fallbacks and speed."""
-    from neurosym.agent.cli_eval import print_figures
     from neurosym.display import plain
+    from neurosym.reports.terminal import print_figures
 
     print(
         f"policy       {plain(report['policy'])} ({plain(report['env'])}, features {report['features']})"
