@@ -114,8 +114,13 @@ def run(args: PlayOptions) -> int:
     if names:
         report["compare"] = {
             name: score_strategy(
-                compare_file(name, report["env"]), report["env"], args.episodes, args.seed,
-                report["env_kwargs"], fallback=args.fallback,
+                compare_file(name, report["env"]),
+                report["env"],
+                args.episodes,
+                args.seed,
+                report["env_kwargs"],
+                fallback=args.fallback,
+                refuse_undecided=False,
             )  # fmt: skip
             for name in names
         }

@@ -31,6 +31,7 @@ def score_strategy(
     batch: int = BATCH,
     kb: str | os.PathLike[str] | None = None,
     fallback: str = "default",
+    refuse_undecided: bool = True,
 ) -> dict[str, Any]:
     """Play ``episodes`` episodes of the strategy ``policy`` on ``env``; a dict of plain values.
 
@@ -41,7 +42,9 @@ def score_strategy(
     none). ``fallback``: what decides a state the strategy leaves undecided
     (:data:`~neurosym.play.agent.FALLBACKS`: ``default``, route.pl's
     default_goal/3, safe_step/3, up; ``none``, nothing: the episode ends as a
-    failure, its outcome the cause). Keys: those of ``neurosym eval --json``
+    failure, its outcome the cause). ``refuse_undecided``: ConfigError when the strategy
+    chose nothing in any step (:func:`check_decided`; off for the strategies a run is compared
+    with, whose failing everywhere is a figure). Keys: those of ``neurosym eval --json``
     that do not describe a network (mean_return ... outcomes), plus
     ``policy``, ``features``, ``fallback``, ``fallbacks`` (undecided steps by
     cause: no_goal, no_route, loop), ``fallback_steps``, ``deciders`` (steps
@@ -87,7 +90,8 @@ def score_strategy(
             batch,
         )
         seconds = time.perf_counter() - start
-        check_decided(agent, env)
+        if refuse_undecided:
+            check_decided(agent, env)
         steps = int(sum(done.lengths))
         return {
             "policy": str(spec.path),

@@ -78,7 +78,9 @@ def test_kb_facts_cannot_change_a_route(
         [str(swipl), "-q", "-g", shown, "-t", "halt", str(code), str(ROOT / "rules" / "route.pl")],
         capture_output=True, text=True, timeout=60, check=False,
     )  # fmt: skip
-    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7-7\nsword-down-8-4\n"), plain.stderr
+    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7-7\nsword-down-8-4\n"), (
+        plain.stderr
+    )
 
 
 def _only(tmp_path: Path, body: str) -> Path:
