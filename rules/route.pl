@@ -59,7 +59,8 @@ action in the order up, right, down, left.
 
 The search: a breadth-first search with mountains closed, which answers
 whenever a path without a mountain exists (every such path is cheaper than
-any with one); else Dijkstra's search over library(heaps). The map and the
+any with one); else a search by layers of mountains crossed, which visits
+the paths in the order of Dijkstra's (search_/4). The map and the
 visited cells are terms with one argument per cell, read with arg/3; each
 episode's terrain is built once, the cells' neighbours once per grid size.
 
@@ -77,7 +78,6 @@ which live in another module, cannot plant answers there. route_forget/1
 forgets an episode.
 */
 
-:- use_module(library(heaps)).
 :- use_module(library(assoc)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
@@ -557,97 +557,149 @@ expand_cell_([J|Js], MI, Cells, Target, Done, Q0, Q, Hit) :-
         expand_cell_(Js, MI, Cells, Target, Done, Q1, Q, Hit)
     ).
 
-%   search_(+Start, +Map, -Action, -Cost): Dijkstra from Start; each queue
-%   entry keeps the first action of its path and is keyed Cost * 4 + the
-%   action's index, so that of equally cheap paths the one whose first
-%   action comes first in up, right, down, left wins. The target is always
-%   enterable. Done cells are marked in a term with one argument per cell.
+%   search_(+Start, +Map, -Action, -Cost): the cheapest path over
+%   mountains, where level_search_/3 found none without. Its cost is
+%   Steps + Mountains * Mountain (Map's mountain cost, more than any number
+%   of steps), so paths rank by their mountains, then their steps, then
+%   their first action (up, right, down, left), as in Dijkstra's search
+%   keyed Cost * 4 + the action's index; the search visits them in that
+%   order without a priority queue: layer by layer of mountains crossed
+%   (the cells first entered over one more mountain start the next layer,
+%   in the order they were met), and in a layer step by step (the cells
+%   reached in S steps: those that start the layer with S, merged by first
+%   action with those the layer's breadth-first search reached). The first
+%   path to reach the target is the cheapest. A cell is marked in Done when
+%   queued (a teleport end marks the cell it lands on).
 search_(R0-C0, Map, Action, Cost) :-
-    Map = map(Rows, Cols, _, _, _, _),
+    Map = map(Rows, Cols, Cells, Mountain, Target, _),
     Start is R0 * Cols + C0,
     N is Rows * Cols,
     functor(Done, done, N),
     S1 is Start + 1,
     nb_setarg(S1, Done, x),
-    empty_heap(Heap0),
-    expand_start_(Start, Map, Done, Heap0, Heap1),
-    loop_(Heap1, Map, Done, Action, Cost).
+    Up is R0 - 1, Down is R0 + 1, Left is C0 - 1, Right is C0 + 1,
+    first_layer_steps_([Up-C0-0, R0-Right-1, Down-C0-2, R0-Left-3], Rows, Cols, Cells,
+                       Target, Done, Frontier, Seeds, Hit),
+    (   Hit \== none
+    ->  MI = Hit, Cost = 1
+    ;   layers_(0, [], Frontier, 1, Seeds, Map, Done, MI, Steps, Crossed),
+        Cost is Steps + Crossed * Mountain
+    ),
+    move_index_(Action, MI).
 
-loop_(Heap0, Map, Done, Action, Cost) :-
-    get_from_heap(Heap0, Key, Cell-First, Heap1),
-    D is Key // 4,
+%   first_layer_steps_(+Steps, +Rows, +Cols, +Cells, +Target, !Done,
+%   -Frontier, -Seeds, -Hit): the start's neighbours: Frontier the ones
+%   entered without a mountain (MI-Cell), Seeds the mountains (1-MI-Cell),
+%   Hit the move index of the target, else none.
+first_layer_steps_([], _, _, _, _, _, [], [], none).
+first_layer_steps_([R-C-MI|Steps], Rows, Cols, Cells, Target, Done, F0, S0, Hit) :-
+    (   R >= 0, R < Rows, C >= 0, C < Cols
+    ->  Cell0 is R * Cols + C,
+        (   Cell0 =:= Target
+        ->  Hit = MI
+        ;   I0 is Cell0 + 1,
+            arg(I0, Cells, Kind),
+            layer_enter_(Kind, Cell0, Done, 1, MI, F0, F1, S0, S1),
+            first_layer_steps_(Steps, Rows, Cols, Cells, Target, Done, F1, S1, Hit)
+        )
+    ;   first_layer_steps_(Steps, Rows, Cols, Cells, Target, Done, F0, S0, Hit)
+    ).
+
+%   layer_enter_(+Kind, +Cell0, !Done, +S, +MI, -F0, ?F, -S0, ?S): a path
+%   with first action MI enters Cell0 of Kind (not the target) in its S-th
+%   step: the cell it lands on is queued in F0-F (MI-Cell), a mountain in
+%   S0-S (S-MI-Cell, the next layer's), unless closed or marked.
+layer_enter_(Kind, Cell0, Done, S, MI, F0, F, Q0, Q) :-
+    Kind == mountain,
+    !,
+    F0 = F,
+    I is Cell0 + 1,
+    arg(I, Done, Seen),
+    (   var(Seen)
+    ->  nb_setarg(I, Done, x),
+        Q0 = [S-MI-Cell0|Q]
+    ;   Q0 = Q
+    ).
+layer_enter_(Kind, Cell0, Done, _, MI, F0, F, Q, Q) :-
+    (   var(Kind)
+    ->  Cell = Cell0
+    ;   Kind = jump(Cell)
+    ),
     I is Cell + 1,
     arg(I, Done, Seen),
-    (   arg(5, Map, Target), Cell =:= Target
-    ->  Action = First, Cost = D
-    ;   nonvar(Seen)
-    ->  loop_(Heap1, Map, Done, Action, Cost)
-    ;   nb_setarg(I, Done, x),
-        expand_(Cell, First, D, Map, Done, Heap1, Heap2),
-        loop_(Heap2, Map, Done, Action, Cost)
+    var(Seen),
+    !,
+    nb_setarg(I, Done, x),
+    F0 = [MI-Cell|F].
+layer_enter_(_, _, _, _, _, F, F, Q, Q).
+
+%   layers_(+M, +Seeds, +Frontier, +S, +Next, +Map, !Done, -MI, -Steps,
+%   -Crossed): layer M (paths over M mountains): Frontier holds its cells S
+%   steps away (MI-Cell, by first action), Seeds its cells entered over a
+%   mountain not yet taken (S-MI-Cell, in order), Next the next layer's
+%   seeds met so far. The target reached in Steps steps over Crossed
+%   mountains with first action MI; fails when no layer is left.
+layers_(M, Seeds, Frontier, S, Next, Map, Done, MI, Steps, Crossed) :-
+    seeds_at_(Seeds, S, Now, Later),
+    merge_by_action_(Now, Frontier, Level),
+    (   Level == []
+    ->  (   Later = [S2-_-_|_]
+        ->  layers_(M, Later, [], S2, Next, Map, Done, MI, Steps, Crossed)
+        ;   Next = [S3-_-_|_]
+        ->  M1 is M + 1,
+            layers_(M1, Next, [], S3, [], Map, Done, MI, Steps, Crossed)
+        )
+    ;   Map = map(_, _, Cells, _, Target, Adj),
+        S1 is S + 1,
+        append(Next, More, Next1),       % this layer's mountains after those met before
+        expand_layer_(Level, S1, Adj, Cells, Target, Done, Frontier1, [], More, [], Hit),
+        (   Hit \== none
+        ->  MI = Hit, Steps = S1, Crossed = M
+        ;   layers_(M, Later, Frontier1, S1, Next1, Map, Done, MI, Steps, Crossed)
+        )
     ).
 
-%   From the start: each neighbour's move is the first action of the paths
-%   through it.
-expand_start_(Cell, Map, Done, Heap0, Heap) :-
-    arg(2, Map, Cols),
-    R is Cell // Cols, C is Cell mod Cols,
-    Up is R - 1, Down is R + 1, Left is C - 1, Right is C + 1,
-    neighbour_(Up, C, up, none, 0, Map, Done, Heap0, Heap1),
-    neighbour_(R, Right, right, none, 0, Map, Done, Heap1, Heap2),
-    neighbour_(Down, C, down, none, 0, Map, Done, Heap2, Heap3),
-    neighbour_(R, Left, left, none, 0, Map, Done, Heap3, Heap).
+%   seeds_at_(+Seeds, +S, -Now, -Later): the seeds S steps away (MI-Cell),
+%   and the rest.
+seeds_at_([S0-MI-Cell|Seeds], S, [MI-Cell|Now], Later) :-
+    S0 =:= S,
+    !,
+    seeds_at_(Seeds, S, Now, Later).
+seeds_at_(Seeds, _, [], Seeds).
 
-%   Past the start, a path keeps its first action: the neighbours come from
-%   the grid's adjacency (Adj), their order does not matter (a queue key
-%   holds cost and first action, so equal keys are equal paths).
-expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
-    arg(6, Map, Adj),
+%   merge_by_action_(+A, +B, -Merged): two lists of MI-Cell, each ordered
+%   by MI, merged (stable: A first on equal MI).
+merge_by_action_([], B, B) :- !.
+merge_by_action_(A, [], A) :- !.
+merge_by_action_([MA-CA|As], [MB-CB|Bs], [X|Xs]) :-
+    (   MA =< MB
+    ->  X = MA-CA, merge_by_action_(As, [MB-CB|Bs], Xs)
+    ;   X = MB-CB, merge_by_action_([MA-CA|As], Bs, Xs)
+    ).
+
+%   expand_layer_(+Level, +S1, +Adj, +Cells, +Target, !Done, -F0, ?F, -Q0,
+%   ?Q, -Hit): the neighbours of Level's cells (MI-Cell, in order), S1
+%   steps away: queued in F0-F, mountains in Q0-Q; Hit the move index of
+%   the first next to the target, else none.
+expand_layer_([], _, _, _, _, _, F, F, Q, Q, none).
+expand_layer_([MI-Cell|Rest], S1, Adj, Cells, Target, Done, F0, F, Q0, Q, Hit) :-
     I is Cell + 1,
     arg(I, Adj, Neighbours),
-    move_index_(First, MI),
-    adjacent_(Neighbours, First, MI, D, Map, Done, Heap0, Heap).
-
-adjacent_([], _, _, _, _, _, Heap, Heap).
-adjacent_([J|Js], First, MI, D, Map, Done, Heap0, Heap) :-
-    Map = map(_, _, Cells, Mountain, Target, _),
-    Cell0 is J - 1,
-    (   arg(J, Cells, Kind),
-        enter_(Kind, Cell0, Target, Mountain, Cell, Step),
-        I is Cell + 1,
-        arg(I, Done, Seen),
-        var(Seen)
-    ->  Key is (D + Step) * 4 + MI,
-        add_to_heap(Heap0, Key, Cell-First, Heap1)
-    ;   Heap1 = Heap0
-    ),
-    adjacent_(Js, First, MI, D, Map, Done, Heap1, Heap).
-
-neighbour_(R, C, Move, First, D, Map, Done, Heap0, Heap) :-
-    Map = map(Rows, Cols, Cells, Mountain, Target, _),
-    (   R >= 0, R < Rows, C >= 0, C < Cols,
-        Cell0 is R * Cols + C,
-        I0 is Cell0 + 1,
-        arg(I0, Cells, Kind),
-        enter_(Kind, Cell0, Target, Mountain, Cell, Step),
-        I is Cell + 1,
-        arg(I, Done, Seen),
-        var(Seen)
-    ->  D1 is D + Step,
-        ( First == none -> First1 = Move ; First1 = First ),
-        move_index_(First1, MI),
-        Key is D1 * 4 + MI,
-        add_to_heap(Heap0, Key, Cell-First1, Heap)
-    ;   Heap = Heap0
+    expand_layer_cell_(Neighbours, MI, S1, Cells, Target, Done, F0, F1, Q0, Q1, Hit0),
+    (   Hit0 == none
+    ->  expand_layer_(Rest, S1, Adj, Cells, Target, Done, F1, F, Q1, Q, Hit)
+    ;   Hit = Hit0
     ).
 
-%   enter_(+Kind, +Cell0, +Target, +Mountain, -Cell, -Step): entering Cell0
-%   of Kind puts the agent on Cell at the cost Step; fails for a cell a path
-%   may not enter.
-enter_(_, Target, Target, _, Target, 1) :- !.
-enter_(Kind, Cell0, _, _, Cell0, 1) :- var(Kind), !.
-enter_(mountain, Cell0, _, Mountain, Cell0, Step) :- !, Step is 1 + Mountain.
-enter_(jump(Landing), _, _, _, Landing, 1).
+expand_layer_cell_([], _, _, _, _, _, F, F, Q, Q, none).
+expand_layer_cell_([J|Js], MI, S1, Cells, Target, Done, F0, F, Q0, Q, Hit) :-
+    Cell0 is J - 1,
+    (   Cell0 =:= Target
+    ->  Hit = MI
+    ;   arg(J, Cells, Kind),
+        layer_enter_(Kind, Cell0, Done, S1, MI, F0, F1, Q0, Q1),
+        expand_layer_cell_(Js, MI, S1, Cells, Target, Done, F1, F, Q1, Q, Hit)
+    ).
 
 % --------------------------------------------------------------- default goal
 
