@@ -36,8 +36,9 @@ files and beside a strategy (whose own helpers may be called anything but the
 exports above). It reads the facts as unqualified goals, which resolve through
 its default import module: user in plain swipl, the KB's own module in
 neurosym.prolog.KnowledgeBase (which loads a copy of the module per KB, see
-rules/lib/kb_common.pl), so the five predicates above must be defined there
-(a neurosym KB declares every schema predicate dynamic).
+rules/lib/kb_common.pl). A KB without at/5 has nothing to route; one that
+defines none of the others (no holding/3, say) is read as holding none of
+them (a neurosym KB declares every schema predicate dynamic).
 
 Moves: up, right, down, left (row - 1, col + 1, row + 1, col - 1). A path may
 not leave the grid, enter a wall, or enter a cell of an object other than the
@@ -178,7 +179,7 @@ route_exists(E, T, Goal) :-
 
 safe_step(E, T, Action) :-
     at(E, T, agent, R, C),
-    grid(E, Rows, Cols),
+    kb_grid_(E, Rows, Cols),
     blocked_(E, T, none, Blocked),
     move_(Action, R-C, R1-C1),
     inside_(R1-C1, Rows, Cols),
@@ -285,7 +286,7 @@ nearer_(Cells, I, D0, D) :-
 %   Objects a contact-free path may cross: the sword (a type sword, or a
 %   compound of that name).
 passable_(Id) :-
-    object(Id, Type),
+    kb_object_(Id, Type),
     (   compound(Type) -> functor(Type, sword, _) ; Type == sword ),
     !.
 
@@ -296,7 +297,7 @@ passable_(Id) :-
 grid_terrain_(E, Rows, Cols, Cells) :-
     (   grid_(E, Rows0, Cols0, Cells0)
     ->  Rows = Rows0, Cols = Cols0, Cells = Cells0
-    ;   grid(E, Rows, Cols),
+    ;   kb_grid_(E, Rows, Cols),
         !,
         terrain_(E, Rows, Cols, Cells),
         assertz(grid_(E, Rows, Cols, Cells))
@@ -305,7 +306,7 @@ grid_terrain_(E, Rows, Cols, Cells) :-
 terrain_(E, Rows, Cols, Cells) :-
     N is Rows * Cols,
     functor(Cells, cells, N),
-    forall(terrain(E, Type, R, C),
+    forall(kb_terrain_(E, Type, R, C),
            ( I is R * Cols + C + 1,
              ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )).
 
@@ -365,8 +366,8 @@ search_route_(E, T, Goal, Action, Cost) :-
     at(E, T, Goal, GR, GC),
     Goal \== agent,
     \+ (R0 == GR, C0 == GC),
-    \+ object(Goal, pit),
-    \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
+    \+ kb_object_(Goal, pit),
+    \+ ( kb_object_(Goal, enemy), \+ kb_holding_(E, T, sword) ),
     !,
     mode_(Mode),
     map_(E, T, Goal, Mode, GR-GC, Map),
@@ -416,7 +417,7 @@ map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target, Adj)) :-
 %   the other end, when the map has exactly two.
 jumps_(E, T, Goal, Mode, Cols, Cells) :-
     (   Mode \== strict,
-        findall(Id-(R-C), ( object(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
+        findall(Id-(R-C), ( kb_object_(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
         A \== Goal, B \== Goal
     ->  CellA is RA * Cols + CA, CellB is RB * Cols + CB,
         IA is CellA + 1, IB is CellB + 1,
@@ -426,15 +427,15 @@ jumps_(E, T, Goal, Mode, Cols, Cells) :-
     ).
 
 %   Objects a path may cross: enemies, while the agent holds the sword.
-open_(E, T, Id) :- object(Id, enemy), holding(E, T, sword).
+open_(E, T, Id) :- kb_object_(Id, enemy), kb_holding_(E, T, sword).
 
 %   blocked_(+E, +T, +Goal, -Blocked): assoc of the cells a path may not
 %   enter (walls, and the objects other than Goal that route/4 does not
 %   cross), for safe_step/3.
 blocked_(E, T, Goal, Blocked) :-
-    grid(E, _, Cols),
+    kb_grid_(E, _, Cols),
     findall(Cell-wall,
-            ( terrain(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
+            ( kb_terrain_(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
             Walls),
     findall(Cell-Id,
             ( at(E, T, Id, R, C), Id \== agent, Id \== Goal,
@@ -701,6 +702,16 @@ expand_layer_cell_([J|Js], MI, S1, Cells, Target, Done, F0, F, Q0, Q, Hit) :-
         expand_layer_cell_(Js, MI, S1, Cells, Target, Done, F1, F, Q1, Q, Hit)
     ).
 
+% --------------------------------------------------------------- facts
+
+%   The KB's facts but at/5, read where the KB may have none of them at all
+%   (a KB of one's own that declares only what it holds): no such predicate
+%   visible through the default import module is no answer, not an error.
+kb_object_(Id, Type) :- current_predicate(_, object(_, _)), object(Id, Type).
+kb_holding_(E, T, Item) :- current_predicate(_, holding(_, _, _)), holding(E, T, Item).
+kb_terrain_(E, Type, R, C) :- current_predicate(_, terrain(_, _, _, _)), terrain(E, Type, R, C).
+kb_grid_(E, Rows, Cols) :- current_predicate(_, grid(_, _, _)), grid(E, Rows, Cols).
+
 % --------------------------------------------------------------- default goal
 
 %!  default_goal(+E, +T, -Object) is semidet.
@@ -722,26 +733,26 @@ default_goal(E, T, Goal) :-
     !.
 
 default_(E, T, sword) :-
-    \+ holding(E, T, sword),
+    \+ kb_holding_(E, T, sword),
     at(E, T, sword, _, _).
 default_(E, T, Enemy) :-
-    holding(E, T, sword),
-    nearest_(E, T, X, object(X, enemy), Enemy).
+    kb_holding_(E, T, sword),
+    nearest_(E, T, X, kb_object_(X, enemy), Enemy).
 default_(_, _, terminal).
 default_(E, T, End) :-
-    object(End, teleport),
+    kb_object_(End, teleport),
     at(E, T, End, _, _).
 default_(E, T, Lock) :-
-    holding(E, T, key(C)),
-    object(Lock, lock(C)),
+    kb_holding_(E, T, key(C)),
+    kb_object_(Lock, lock(C)),
     useful_(E, T, Lock).
 default_(E, T, Key) :-
     nearest_(E, T, K,
-             ( object(K, key(C)), loose_(E, T, K),
-               object(L, lock(C)), useful_(E, T, L) ),
+             ( kb_object_(K, key(C)), loose_(E, T, K),
+               kb_object_(L, lock(C)), useful_(E, T, L) ),
              Key).
 default_(E, T, Key) :-
-    nearest_(E, T, K, ( object(K, key(_)), loose_(E, T, K) ), Key).
+    nearest_(E, T, K, ( kb_object_(K, key(_)), loose_(E, T, K) ), Key).
 
 %   nearest_(+E, +T, ?X, +Cond, -Nearest): of the objects X on the map for
 %   which Cond holds, the one with the cheapest route.
@@ -755,14 +766,14 @@ content_(E, T, Lock, Content) :-
     at(E, T, Lock, R, C),
     Left is C - 1,
     at(E, T, X, R, Left),
-    object(X, Content).
+    kb_object_(X, Content).
 
 useful_(E, T, Lock) :-
     at(E, T, Lock, _, _),
     (   content_(E, T, Lock, gem)
     ->  true
     ;   content_(E, T, Lock, key(C)),
-        object(Next, lock(C)),
+        kb_object_(Next, lock(C)),
         Next \== Lock,
         useful_(E, T, Next)
     ),
@@ -771,4 +782,4 @@ useful_(E, T, Lock) :-
 loose_(E, T, Key) :-
     at(E, T, Key, R, C),
     Right is C + 1,
-    \+ ( at(E, T, X, R, Right), object(X, lock(_)) ).
+    \+ ( at(E, T, X, R, Right), kb_object_(X, lock(_)) ).

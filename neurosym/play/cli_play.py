@@ -134,7 +134,7 @@ def run(args: PlayOptions) -> int:
 
 
 SHIPPED = ("trivial", "handwritten")
-"""the shipped strategies ``--compare`` names: neurosym/play/pl/<family>_<name>.pl"""
+"""the shipped strategies ``--compare`` names: neurosym/play/strategies/<family>_<name>.pl"""
 
 
 def compare_names(text: str | None) -> list[str]:
@@ -155,7 +155,6 @@ def compare_file(name: str, env: str) -> Path:
     """The strategy file a ``--compare`` name stands for: a shipped one of the env's family
     (rgw*, bw*) for trivial and handwritten, else the name as a path."""
     from neurosym.errors import ConfigError
-    from neurosym.play.prolog import FILE
 
     if name not in SHIPPED:
         return Path(name)
@@ -165,7 +164,7 @@ def compare_file(name: str, env: str) -> Path:
             f"--compare {name}: neurosym ships {' and '.join(SHIPPED)} strategies for rgw* and "
             f"bw* envs, not {env}; give a strategy file instead"
         )
-    return FILE.with_name(f"{family}_{name}.pl")
+    return Path(__file__).with_name("strategies") / f"{family}_{name}.pl"
 
 
 def print_report(report: dict) -> None:

@@ -71,7 +71,7 @@ def test_compare_prints_one_table_of_the_same_levels(neurosym_main, tmp_path: Pa
     proc = neurosym_main(*args, "--compare", "trivial", "--json")
     report = json.loads(proc.stdout)
     trivial = report["compare"]["trivial"]
-    assert trivial["policy"].endswith("neurosym/play/pl/rgw_trivial.pl")
+    assert trivial["policy"].endswith("neurosym/play/strategies/rgw_trivial.pl")
     assert trivial["outcomes"] == {"no_route": 2} and trivial["fallback"] == "none"
     assert report["outcomes"] == {"no_goal": 2}
 
