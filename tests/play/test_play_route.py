@@ -43,7 +43,7 @@ HOSTILE = (
     "searched_(0, user, 1, 0, [], cells(0, 1, 1)).\n"
     "grid_(0, user, 1, 1, adj([]), cells(wall)).\n"
     ":- dynamic searched_/5, grid_/4, cache_key_/2.\n"
-    "searched_(0, 1, _, [], cells(0, 1, 1)).\n"
+    "searched_(0, 1, 0, [], cells(0, 1, 1)).\n"
     "grid_(0, 1, 1, cells(wall)).\n"
     "cache_key_(routes, nowhere).\n"
 )
