@@ -7,7 +7,7 @@ agent's cell and direction, where the key is (on any free cell, or carried) and
 the door's state (open, closed, locked). Every action costs one step and the
 episode pays ``1 - 0.9 * steps / max_steps`` on the goal, so the fewest steps is
 the best return. The search is a vectorised Bellman sweep of shortest distances
-to the goal over all states at once (:class:`Plan`); it covers the states that a
+to the goal over all states at once (:class:`DoorKeyPlan`); it covers the states that a
 learner's own actions reach (a key dropped elsewhere, a door closed again), so
 DAgger can label them too. Plans are cached per level layout.
 """
@@ -42,7 +42,7 @@ def layout_key(cells: np.ndarray) -> bytes:
     return layout.tobytes()
 
 
-class Plan:
+class DoorKeyPlan:
     """Shortest distances to the goal over every state of one DoorKey layout.
 
     A state is (free cell ``p``, direction, key place ``k``, door state): ``k``
@@ -146,11 +146,11 @@ def _value(steps_left: int, steps_taken: int, max_steps: int) -> float:
     return 1.0 - 0.9 * total / max_steps if total <= max_steps else 0.0
 
 
-class Planner:
+class DoorKeyPlanner:
     """An optimal scripted policy for a batched Minigrid DoorKey env: ``planner(obs, venv) -> actions``.
 
     Reads each sub-env's Minigrid grid, agent and carried object and acts by
-    :class:`Plan` (one per layout, cached). It looks at the state, not at the
+    :class:`DoorKeyPlan` (one per layout, cached). It looks at the state, not at the
     network's observation. The same interface as RGW's planner, which the
     DAgger learner calls.
     """
@@ -159,8 +159,8 @@ class Planner:
     """plans kept; the cache starts over when full (a new level every episode)"""
 
     def __init__(self) -> None:
-        self._plans: dict[bytes, Plan] = {}
-        self._levels: dict[int, tuple[Any, Plan, Any]] = {}  # id(env) -> (its grid, plan, door)
+        self._plans: dict[bytes, DoorKeyPlan] = {}
+        self._levels: dict[int, tuple[Any, DoorKeyPlan, Any]] = {}  # id(env) -> (its grid, plan, door)
         self._rng = np.random.default_rng(0)
 
     def __call__(self, obs: np.ndarray, venv: object) -> np.ndarray:
@@ -192,7 +192,7 @@ class Planner:
             np.stack(regrets) if regret else None,
         )
 
-    def _locate(self, inner: Any) -> tuple[Plan, int]:
+    def _locate(self, inner: Any) -> tuple[DoorKeyPlan, int]:
         """The plan of an env's level and the env's state in it.
 
         The level's layout is read once per Minigrid grid (a reset makes a new one); each step
@@ -215,14 +215,14 @@ class Planner:
         col, row = (int(x) for x in inner.agent_pos)
         return plan, plan.state(row, col, int(inner.agent_dir), place, state)
 
-    def _plan(self, cells: np.ndarray) -> Plan:
+    def _plan(self, cells: np.ndarray) -> DoorKeyPlan:
         """The cached plan of a layout, made when first met."""
         key = layout_key(cells)
         plan = self._plans.get(key)
         if plan is None:
             if len(self._plans) >= self.MAX_PLANS:
                 self._plans.clear()
-            plan = self._plans[key] = Plan(cells)
+            plan = self._plans[key] = DoorKeyPlan(cells)
         return plan
 
 

@@ -105,7 +105,7 @@ class _Columns:
         return {name: col[order] for name, col in cols.items()}
 
 
-class _Trace:
+class _SymbolicColumns:
     """The symbolic side of the episodes (positions, holding, events), from decoded infos.
 
     Per state it keeps one reference to the decoded tuples; the columns are
@@ -340,7 +340,7 @@ class _Recorder:
         self.n = venv.num_envs
         self.names = np.asarray(venv.entity_names, dtype=object)
         self.adapter = adapter_class(agent.config.module)
-        self.trace = _Trace()
+        self.trace = _SymbolicColumns()
         self.model = _Columns()  # model outputs per (episode, t)
         self.step_cols = _Columns()  # steps table
         self.ep_rows: list[tuple[int, int, float, str, int]] = []

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from neurosym.envs import make_batched
-from neurosym.envs.minigrid_solver import Planner
+from neurosym.envs.minigrid_solver import DoorKeyPlanner as Planner
 from neurosym.errors import ConfigError
 
 DOORKEY = "MiniGrid-DoorKey-5x5-v0"

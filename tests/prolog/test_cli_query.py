@@ -196,7 +196,7 @@ def test_the_table_shows_data_as_text(neurosym_main, tmp_path: Path) -> None:
 
 
 def test_sword_enemy_link_prints_its_list(neurosym_main, tmp_path: Path) -> None:
-    from conftest import REPO
+    from builders import REPO
 
     facts = tmp_path / "kb.pl"
     facts.write_text(
@@ -292,7 +292,7 @@ def test_a_goal_ending_in_a_full_stop_or_comment_is_one_goal(neurosym_main, tmp_
 
 
 def _popen(tmp_path: Path, *args: object, **kw) -> subprocess.Popen:
-    from conftest import REPO
+    from builders import REPO
 
     path = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH")) if p)
     return subprocess.Popen(

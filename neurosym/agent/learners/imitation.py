@@ -150,7 +150,7 @@ def planner_for(env_name: str) -> Any:
     from neurosym.envs.registration import env_family
 
     if env_family(env_name) == "minigrid":
-        from neurosym.envs.minigrid_solver import Planner as MinigridPlanner
+        from neurosym.envs.minigrid_solver import DoorKeyPlanner as MinigridPlanner
 
         return MinigridPlanner()
     from neurosym.envs.rgw_solver import Planner
