@@ -57,8 +57,10 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
     seed (the network still runs on every state, so its facts are extracted;
     kb_meta(actions, random))"""
-    threshold: str = option("quantile:0.9", metavar="SPEC")
+    threshold: str | None = option(None, metavar="SPEC", shown="quantile:0.9")
     """per-relation threshold for holds/5: quantile:Q, abs:X or z:K"""
+    # an agent with the fact bottleneck (relation_bits=tau) defaults to abs:tau: the bits its
+    # policy read (model_threshold)
     format: str = option("pl", metavar="LIST")
     """comma-separated outputs: pl, parquet"""
     qlf: bool = False
@@ -96,7 +98,8 @@ def run(args: ExtractOptions) -> int:
     from neurosym.export.thresholds import parse_threshold
 
     formats = parse_formats(args.format)
-    threshold = parse_threshold(args.threshold)
+    if args.threshold is not None:
+        parse_threshold(args.threshold)  # a bad spec is refused before the agent is read
     if args.episodes < 1:
         raise ConfigError(f"--episodes must be at least 1, got {args.episodes}")
     check_seed(args.seed, args.episodes)
@@ -112,6 +115,7 @@ def run(args: ExtractOptions) -> int:
     from neurosym.publish import check_out
 
     agent = load_agent(args.checkpoint)
+    threshold = parse_threshold(args.threshold or model_threshold(agent.config))
     adapter = adapter_class(agent.config.module)
     if args.top_keys is not None and not adapter.has("attention"):
         facts = " and ".join(_FACTS[name] for name in adapter.tables if name in _FACTS)
@@ -143,6 +147,17 @@ def run(args: ExtractOptions) -> int:
 
         print_report(rec, facts, written, kb=written.get("kb.pl"), verbose=args.verbose)
     return 0
+
+
+def model_threshold(config: Any) -> str:
+    """The holds/5 threshold an agent's KB is written with by default: ``abs:tau`` for the fact
+    bottleneck (ModelConfig.relation_bits, so the KB's holds/5 are the bits its policy read),
+    else quantile:0.9."""
+    from neurosym.agent.networks.predinet import bits_threshold
+    from neurosym.export.facts import DEFAULT_THRESHOLD
+
+    tau = bits_threshold(getattr(config, "relation_bits", None))
+    return DEFAULT_THRESHOLD if tau is None else f"abs:{tau!r}"
 
 
 def _tty() -> bool:
