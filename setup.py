@@ -24,7 +24,7 @@ setup(
         "neurosym.prolog": ["pl/*.pl"],  # the bridge's Prolog modules (not their .plt tests)
         "neurosym.induce": ["pl/*.pl"],  # the Prolog text learned files carry
         "neurosym.play": ["pl/*.pl"],  # the Prolog half of neurosym play
-        "neurosym.webreport": ["templates/*"],
+        "neurosym.reports.web": ["templates/*"],
         "neurosym.rules": ["*.pl", "lib/*.pl"],
         "neurosym.checkpoints": ["*.pt"],
     },

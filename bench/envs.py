@@ -127,10 +127,10 @@ def level_rates(seconds: float, sizes: tuple[int, ...] = (1, 64, 4096)) -> None:
     first |= {"wall_s": round(time.perf_counter() - t0, 3)}
     print(json.dumps(first | {"cpu_s": round(time.thread_time() - c0, 3)}), flush=True)
     # What uniformly random actions score against the levels' optimal returns.
-    from neurosym.agent.cli_eval import score
+    from neurosym.agent.evaluation import score
 
     rng = np.random.default_rng(0)
-    got = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 500, seed=0)
+    got = score(lambda obs, _venv: rng.integers(0, 4, len(obs)), "rgw-random", 500, seed=0).as_dict()
     keys = ("success_rate", "optimal_rate", "sword_first_guarded", "no_detour_decoy")
     row = {"bench": "random_policy", "env": "rgw-random", "episodes": 500}
     print(json.dumps(row | {k: round(got[k], 4) for k in keys}), flush=True)

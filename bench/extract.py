@@ -49,8 +49,8 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from neurosym.export.facts import PREDICATES, FactSet, extract_facts  # noqa: E402
-from neurosym.export.recorder import record  # noqa: E402
+from neurosym.facts.tables import PREDICATES, FactSet, extract_facts  # noqa: E402
+from neurosym.record.recorder import record  # noqa: E402
 
 TRACE = ("kb_meta", "object", "episode", "step", "event", "holding", "threshold")
 
@@ -60,7 +60,7 @@ def emit(**fields: Any) -> None:
 
 
 def load_or_build_agent(path: Path, env: str) -> tuple[Any, str]:
-    from neurosym.agent.checkpoint import Agent, load_agent
+    from neurosym.agent.agent import Agent, load_agent
 
     if path.is_file():
         return load_agent(path, env=env), str(
@@ -230,7 +230,7 @@ def main() -> None:
 
     import torch
 
-    from neurosym.export.recorder import DEFAULT_BATCH
+    from neurosym.record.recorder import DEFAULT_BATCH
 
     if args.threads:
         torch.set_num_threads(args.threads)

@@ -54,8 +54,8 @@ def emit(**fields: Any) -> None:
 def write_kb(
     agent: Any, env: str, options: dict, episodes: int, seed: int, actions: str, path: Path
 ) -> dict:
-    from neurosym.export.facts import extract_facts
-    from neurosym.export.recorder import record
+    from neurosym.facts.tables import extract_facts
+    from neurosym.record.recorder import record
 
     start = time.perf_counter()
     rec = record(agent, env, episodes, seed=seed, actions=actions, env_kwargs=options)
@@ -109,7 +109,7 @@ def tree_baseline(train: Path, held: Path, templates: list[str]) -> dict[str, li
 
 
 def run_case(name: str, episodes: int, actions: str, folder: Path, baseline: bool) -> None:
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.induce import induce_world
 
     ckpt, env, options = CASES[name]

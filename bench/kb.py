@@ -62,7 +62,7 @@ import pandas as pd
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from neurosym.export.prolog_writer import write_prolog  # noqa: E402
+from neurosym.facts.prolog_writer import write_prolog  # noqa: E402
 from neurosym.prolog.knowledge_base import KnowledgeBase, _janus  # noqa: E402
 from neurosym.prolog.locate import find_swipl  # noqa: E402
 from neurosym.prolog.qlf import qcompile  # noqa: E402

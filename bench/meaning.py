@@ -42,7 +42,7 @@ def main() -> None:
 
     import torch
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.meaning.intervene import intervene
     from neurosym.meaning.probe import probe
 

@@ -5,7 +5,7 @@ Lines, in order:
 * ``machine``: cores, load average (figures are wall times on a machine that
   may be shared: compare with the load average);
 * ``play`` (one line per strategy file and env): episodes played by
-  :func:`neurosym.play.play_policy` (batched env, live facts asserted through
+  :func:`neurosym.play.score_strategy` (batched env, live facts asserted through
   janus, goal/3 and route/4 in SWI-Prolog, scoring as ``neurosym eval``),
   best and median of ``--repeat`` runs of ``steps_per_s`` (env steps per
   second of the whole loop), ``decide_ms`` (mean time of one decision: one

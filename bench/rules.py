@@ -49,7 +49,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from neurosym.export.prolog_writer import write_prolog  # noqa: E402
+from neurosym.facts.prolog_writer import write_prolog  # noqa: E402
 from neurosym.prolog.locate import find_swipl  # noqa: E402
 from neurosym.terms import atom_text  # noqa: E402
 

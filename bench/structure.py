@@ -10,7 +10,7 @@ Measures (from the code's AST, nothing imported):
 * ``module_name_comparisons``: comparisons (``==``, ``!=``, ``in``) against the relational
   modules' names ("predinet", "mhdpa") outside neurosym/agent/networks/ and config.
 * ``kb_predicate_lists``: modules that list three or more KB predicate names (those
-  neurosym/schema.py declares, read from its AST) in one literal (tuple, list, set, dict
+  neurosym/facts/schema.py declares, read from its AST) in one literal (tuple, list, set, dict
   keys) whose strings are mostly such names; a literal of other names that shares a few
   words with the schema (a recording's tables ``holding``, ``terrain``, ``attends``
   beside ``positions``, ``events``, ...) is not a list of predicates, nor is a producer:
@@ -35,7 +35,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "neurosym"
 MODULE_NAMES = {"predinet", "mhdpa"}
 NETWORKS = ("agent/networks/", "agent/config.py")
-SCHEMA = "schema.py"
+SCHEMA = "facts/schema.py"
 
 
 def kb_predicates(schema: ast.Module) -> set[str]:

@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     from sklearn.linear_model import Ridge
     from sklearn.model_selection import cross_val_score
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.agent.diagnostics import gradient_report
     from neurosym.agent.learners.returns import explained_variance
 

@@ -35,7 +35,7 @@ def checkpoints_of(run: Path) -> list[Path]:
 
 def held_out(agent: Any, path: Path, episodes: int, seed: int, env: str | None) -> dict[str, Any]:
     """One checkpoint's success on unseen levels, sampled and greedy."""
-    from neurosym.agent.cli_eval import evaluate
+    from neurosym.agent.evaluation import evaluate
 
     row: dict[str, Any] = {
         "checkpoint": str(path),
@@ -44,7 +44,7 @@ def held_out(agent: Any, path: Path, episodes: int, seed: int, env: str | None) 
     }
     for mode in ("sampled", "greedy"):
         report = evaluate(agent, env, episodes, greedy=mode == "greedy", seed=seed)
-        row[mode] = report["success_rate"]
+        row[mode] = report.scores.success_rate
     return row
 
 
@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(
             f"{args.run} holds no metrics.csv and checkpoint: a `neurosym train --out` folder?"
         )
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
 
     points = []
     for path in paths:

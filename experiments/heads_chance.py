@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 
 from neurosym.envs import make
-from neurosym.export.heads import head_summary
-from neurosym.export.recording import Recording
+from neurosym.record.heads import head_summary
+from neurosym.record.recording import Recording
 
 
 def random_attends(rec: Recording, draws: int, seed: int) -> pd.DataFrame:

@@ -42,7 +42,7 @@ sys.path.insert(
 
 from kb import relation_table  # noqa: E402
 
-from neurosym.export.prolog_writer import write_prolog  # noqa: E402
+from neurosym.facts.prolog_writer import write_prolog  # noqa: E402
 from neurosym.prolog.locate import find_swipl  # noqa: E402
 from neurosym.prolog.qlf import qcompile  # noqa: E402
 from neurosym.terms import atom_text  # noqa: E402

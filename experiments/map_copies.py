@@ -41,12 +41,12 @@ def copies(source: str) -> list[str]:
 
 def play_copies(agent: Any, source: str) -> dict[str, Any]:
     """Greedy return and optimal return of ``agent`` on each copy of ``source`` (one episode each)."""
-    from neurosym.agent.cli_eval import evaluate
+    from neurosym.agent.evaluation import evaluate
     from neurosym.agent.rollout import SUCCESS_OUTCOMES
 
     returns, optimal, counts = [], [], {"at_optimum": 0, "short": 0, "unfinished": 0}
     for text in copies(source):
-        report = evaluate(agent, "rgw2", episodes=1, greedy=True, env_kwargs={"map": text})
+        report = evaluate(agent, "rgw2", episodes=1, greedy=True, env_kwargs={"map": text}).as_dict()
         ret, best = report["mean_return"], report["mean_optimal_return"]
         returns.append(round(ret, 3))
         optimal.append(round(best, 3))
@@ -69,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
 
     import torch
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
 
     torch.set_num_threads(1)
     for path in args.checkpoints:

@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=UNSEEN, help="first reset seed (3e9)")
     args = parser.parse_args(argv)
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
 
     for path in args.checkpoints:
         agent = load_agent(path)

@@ -30,7 +30,7 @@ def profile(path: str, env: str, episodes: int, seed: int) -> dict[str, object]:
     """The figures above for one checkpoint, over ``episodes`` sampled episodes from ``seed``."""
     import torch
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.agent.learners.planner_loss import optimal_set_nll
     from neurosym.envs import make_batched
     from neurosym.envs.rgw_solver import Planner

@@ -9,6 +9,10 @@ The top-level names are imported lazily so that ``import neurosym`` (and the
     >>> facts = neurosym.extract_facts(rec, threshold="quantile:0.9")
     >>> kb = neurosym.KnowledgeBase(facts.to_prolog("kb/rgw2.pl"), rules=["rules/rgw.pl"])
     >>> kb.query("sword_before_enemy(E)")
+
+The commands' pipelines are library functions returning typed results:
+``neurosym.extract(checkpoint, env, ...)`` -> Extraction (recording and fact tables),
+``neurosym.evaluate(agent, env, ...)`` -> Evaluation (``.as_dict()`` is ``eval --json``).
 """
 
 from __future__ import annotations
@@ -20,12 +24,17 @@ __version__ = "0.1.0"
 _LAZY = {
     "make": "neurosym.envs",
     "make_batched": "neurosym.envs",
-    "load_agent": "neurosym.agent.checkpoint",
-    "record": "neurosym.export.recorder",
-    "Recording": "neurosym.export.recording",
-    "extract_facts": "neurosym.export.facts",
-    "FactSet": "neurosym.export.facts",
-    "head_summary": "neurosym.export.heads",
+    "load_agent": "neurosym.agent.agent",
+    "record": "neurosym.record.recorder",
+    "Recording": "neurosym.record.recording",
+    "extract_facts": "neurosym.facts.tables",
+    "FactSet": "neurosym.facts.tables",
+    "head_summary": "neurosym.record.heads",
+    "extract": "neurosym.record.extraction",
+    "Extraction": "neurosym.record.extraction",
+    "evaluate": "neurosym.agent.evaluation",
+    "Evaluation": "neurosym.agent.evaluation",
+    "score_strategy": "neurosym.play.evaluate",
     "KnowledgeBase": "neurosym.prolog.knowledge_base",
     "NeurosymError": "neurosym.errors",
     "PrologError": "neurosym.errors",

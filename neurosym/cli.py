@@ -86,14 +86,14 @@ def parse_env_options(items: list[str], env: str | None = None) -> dict[str, Any
     return out
 
 
-def play_env(
+def agent_env(
     agent: Any, env: str | None, items: list[str], map_file: str | None = None
 ) -> tuple[str, dict[str, Any]]:
     """(env name, options) for intervene and probe: ``--env`` (default: the agent's own)
     with the ``--env-option`` items and ``--map`` on top, typed and checked (family,
     observation shape).
     """
-    from neurosym.agent.checkpoint import env_for
+    from neurosym.agent.agent import env_for
     from neurosym.envs import canonical_name
 
     if map_file is not None:
@@ -106,7 +106,7 @@ def play_env(
     return env_for(agent, name, parse_env_options(items, name))
 
 
-def play_options(args: Any, trained: str) -> tuple[str | None, dict[str, Any] | None]:
+def env_choice(args: Any, trained: str) -> tuple[str | None, dict[str, Any] | None]:
     """(env name or None, the user's env options or None) from ``--env``, ``--map``, ``--env-option``."""
     env, overrides = map_option(args.env, args.map, trained)
     extra = parse_env_options(args.env_option, env or trained)
@@ -155,7 +155,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "Store a checkpoint's weights in half precision: a smaller file to ship.",
     ),
     "extract": (
-        "neurosym.export.cli_extract",
+        "neurosym.record.cli_extract",
         "Record episodes and write the R-vector facts as a Prolog KB.",
     ),
     "probe": (
@@ -183,7 +183,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "neurosym.play.cli_play",
         "Play with a strategy file: goal/3 picks the object, route.pl the action; eval's figures.",
     ),
-    "report": ("neurosym.webreport.cli_report", "One HTML page per agent: card, player, tables."),
+    "report": ("neurosym.reports.web.cli_report", "One HTML page per agent: card, player, tables."),
     "envs": ("neurosym.envs.cli_envs", "List the environments with one line each."),
     "agents": (
         "neurosym.cli_agents",

@@ -4,7 +4,7 @@ Environments describe events and held items with terms such as
 ``picked(sword)`` or ``opened(lock(red))``. They are built as ``Term`` values
 so that nothing downstream has to parse strings; ``str(term)`` gives the
 canonical Prolog text, which is what recordings store in their tables and what
-the fact writer (:mod:`neurosym.export.prolog_writer`) writes.
+the fact writer (:mod:`neurosym.facts.prolog_writer`) writes.
 
 This module is the single authority on how a Python value is spelled in
 Prolog:

@@ -1,10 +1,10 @@
-"""Write docs/design.md's fact tables from the schema (neurosym/schema.py).
+"""Write docs/design.md's fact tables from the schema (neurosym/facts/schema.py).
 
     python scripts/gen_schema_docs.py            # rewrite the tables in docs/design.md
     python scripts/gen_schema_docs.py --check    # exit 1 when a table is not what it would write
 
 Each table sits between ``<!-- schema:GROUP -->`` and ``<!-- /schema:GROUP -->`` lines;
-everything else on the page is left as it is. tests/test_schema.py fails when a table is stale.
+everything else on the page is left as it is. tests/facts/test_schema.py fails when a table is stale.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ BLOCK = re.compile(r"(<!-- schema:(\w+) -->\n)(.*?)(<!-- /schema:\2 -->)", re.S)
 def render(text: str) -> str:
     """``text`` with every schema block replaced by its group's generated table."""
     sys.path.insert(0, str(ROOT))
-    from neurosym.schema import markdown_table
+    from neurosym.facts.schema import markdown_table
 
     return BLOCK.sub(lambda m: f"{m.group(1)}{markdown_table(m.group(2))}\n{m.group(4)}", text)
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The headless browser of the browser tests (tests/webreport/test_webreport_browser.py): Chromium and its
+# The headless browser of the browser tests (tests/reports/test_webreport_browser.py): Chromium and its
 # WebDriver, from the system's packages. Quick when they are there; when they cannot be installed
 # (no apt-get, no root, no network) it says why and exits 0, and those tests skip with that reason.
 set -u

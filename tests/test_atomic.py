@@ -26,8 +26,8 @@ import os, sys
 from pathlib import Path
 import pandas as pd
 from neurosym.atomic import atomic_write, open_atomic, write_bytes_atomic
-from neurosym.export.prolog_writer import write_prolog
-from neurosym.export.recording import Recording
+from neurosym.facts.prolog_writer import write_prolog
+from neurosym.record.recording import Recording
 from neurosym.agent.run.metrics import write_rows as _write_rows
 from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
@@ -80,7 +80,7 @@ import sys
 from pathlib import Path
 import numpy as np, pandas as pd
 from neurosym.errors import NeurosymError
-from neurosym.export.prolog_writer import write_prolog
+from neurosym.facts.prolog_writer import write_prolog
 from neurosym.agent.run.metrics import write_rows as _write_rows
 
 out = Path(sys.argv[1])
@@ -160,8 +160,8 @@ def test_a_folder_that_cannot_be_made_is_one_line(tmp_path: Path) -> None:
     from neurosym.agent.config import ModelConfig
     from neurosym.agent.networks.model import ActorCritic
     from neurosym.errors import OutputError
-    from neurosym.export.prolog_writer import write_prolog
-    from neurosym.export.recording import Recording
+    from neurosym.facts.prolog_writer import write_prolog
+    from neurosym.record.recording import Recording
 
     (tmp_path / "file").write_text("in the way\n")
     below = tmp_path / "file" / "sub"

@@ -136,15 +136,15 @@ def test_play_plays_a_map_file(capsys: pytest.CaptureFixture[str], tmp_path: Pat
 
 
 def test_probe_and_intervene_take_a_map_file(tmp_path: Path) -> None:
-    """play_env, their env: --map puts the user's map on rgw2 under the agent's options."""
-    from neurosym.agent.checkpoint import load_agent
-    from neurosym.cli import play_env
+    """agent_env, their env: --map puts the user's map on rgw2 under the agent's options."""
+    from neurosym.agent.agent import load_agent
+    from neurosym.cli import agent_env
     from neurosym.errors import ConfigError
 
     layout = tmp_path / "map.txt"
     layout.write_text((REPO / "neurosym" / "envs" / "maps" / "rgw1.txt").read_text())
     agent = load_agent(REPO / "checkpoints" / "rgw-random-predinet-cellkeys.pt")
-    name, options = play_env(agent, None, ["max_steps=7"], str(layout))
+    name, options = agent_env(agent, None, ["max_steps=7"], str(layout))
     assert name == "rgw2" and options["map"] == str(layout) and options["max_steps"] == 7
     with pytest.raises(ConfigError, match="give the map once"):
-        play_env(agent, "rgw1", [f"map={layout}"], str(layout))
+        agent_env(agent, "rgw1", [f"map={layout}"], str(layout))

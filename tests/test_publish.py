@@ -17,8 +17,8 @@ import pandas as pd
 import pytest
 
 from neurosym.errors import OutputError
-from neurosym.export.recording import Recording
 from neurosym.publish import STORE, publish
+from neurosym.record.recording import Recording
 
 REPO = Path(__file__).resolve().parents[1]
 OWNED = ("kb.pl", "kb.qlf", "recording")

@@ -1,4 +1,6 @@
-"""Checkpoints: save atomically, read safely, and load a trained :class:`Agent`.
+"""Checkpoints: save atomically, read safely, build the model they hold.
+
+The trained agent made from one is :class:`neurosym.agent.agent.Agent`.
 
 A checkpoint is a dict of tensors and plain values (docs/design.md "Checkpoints"):
 
@@ -31,10 +33,7 @@ observation shape, another model config) is one line of
 
 A checkpoint runs on any environment of its family whose observations have
 its shape (docs/design.md): an agent trained on rgw-random plays rgw1, rgw2 or a
-user's map, and the other way round. :func:`env_for` decides which env and
-which options: on its own env, the options it was trained with; on another,
-that env's own options, except those that shape the observation
-(``CARRIED_OPTIONS``), which carry over.
+user's map, and the other way round (:func:`neurosym.agent.agent.env_for`).
 """
 
 from __future__ import annotations
@@ -44,17 +43,14 @@ import io
 import os
 import pickle
 import shlex
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import torch
 
 from neurosym.agent.config import ModelConfig, TrainConfig
-from neurosym.agent.networks.introspection import Introspection
 from neurosym.agent.networks.model import ActorCritic
-from neurosym.agent.rollout import select_actions
 from neurosym.atomic import make_folder, write_bytes_atomic
 from neurosym.errors import CheckpointError, ConfigError
 from neurosym.shipped import checkpoint_file
@@ -494,67 +490,6 @@ def compact_checkpoint(
     return {"bytes_before": before, "bytes_after": dst.stat().st_size, "max_change": largest}
 
 
-@dataclass(frozen=True)
-class Agent:
-    """A trained model ready to act (docs/interfaces.md)."""
-
-    model: ActorCritic
-    """the network, in eval mode"""
-    config: ModelConfig
-    env_name: str
-    """short name of the env it was trained on"""
-    env_kwargs: dict[str, Any]
-    meta: dict[str, Any] = field(default_factory=dict)
-    """everything else in the checkpoint but the tensors: frames, episodes, metrics, command, ..."""
-    path: str | None = None
-
-    def act(
-        self,
-        obs: np.ndarray,
-        greedy: bool = True,
-        introspect: bool = False,
-        generator: torch.Generator | None = None,
-    ) -> tuple[np.ndarray, Introspection | None]:
-        """Actions (B,) for a batch of observations (B, C, H, W); a single (C, H, W) counts as B = 1.
-
-        ``greedy`` takes the most likely action, otherwise one is sampled from
-        the policy with ``generator``. With ``introspect`` the second value is
-        the module's introspection record with numpy arrays.
-        """
-        x = torch.as_tensor(np.asarray(obs))
-        if x.dim() == 3:
-            x = x.unsqueeze(0)  # (1, C, H, W)
-        with torch.inference_mode():
-            out = self.model(x, introspect=introspect)
-            actions = select_actions(out[0], greedy, generator)
-        return actions.numpy(), (out[2].numpy() if introspect else None)
-
-
-def load_agent(
-    path: str | os.PathLike[str], env: str | None = None, config: ModelConfig | None = None
-) -> Agent:
-    """Load a checkpoint as an :class:`Agent` (CheckpointError, one line, for every bad file).
-
-    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
-    """
-    path = checkpoint_file(path)
-    payload = read_checkpoint(path, env=env, config=config)
-    model = build_model(payload, path)
-    model.eval()
-    meta = {
-        k: v for k, v in payload.items() if k not in ("state_dict", "optimizer", "model_config")
-    }
-    meta["train_config"] = payload.get("train_config")
-    return Agent(
-        model=model,
-        config=payload["model_config"],
-        env_name=payload["env"],
-        env_kwargs=dict(payload["env_kwargs"]),
-        meta=meta,
-        path=str(path),
-    )
-
-
 def env_options(
     payload: dict[str, Any] | Any, env: str, overrides: dict[str, Any] | None = None
 ) -> dict[str, Any]:
@@ -608,22 +543,3 @@ def check_env_fits(
 
 def _options_text(kwargs: dict[str, Any]) -> str:
     return f"({', '.join(f'{k}={v!r}' for k, v in kwargs.items())}) " if kwargs else ""
-
-
-def env_for(
-    agent: Agent | Any, env: str | None = None, overrides: dict[str, Any] | None = None
-) -> tuple[str, dict[str, Any]]:
-    """(short env name, options) to run ``agent`` on: its own env by default, or ``env``.
-
-    ``env`` may be any env of the agent's family whose observations have its
-    shape (checked; CheckpointError otherwise); ``overrides`` are options of
-    the user's (e.g. ``{"map": "my_map.txt"}``) on top of :func:`env_options`.
-    """
-    from neurosym.envs import canonical_name
-
-    name = canonical_name(env if env is not None else agent.env_name)
-    kwargs = env_options(agent, name, overrides)
-    if name != canonical_name(agent.env_name) or overrides:
-        label = getattr(agent, "path", None) or "the agent"
-        check_env_fits(label, agent.env_name, agent.config.obs_shape, name, kwargs)
-    return name, kwargs

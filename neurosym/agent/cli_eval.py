@@ -21,14 +21,10 @@ from __future__ import annotations
 
 import argparse
 import json
-from collections import Counter
 from dataclasses import dataclass
-from typing import Any
 
-from neurosym.cli import play_options
-from neurosym.errors import ConfigError
+from neurosym.cli import env_choice
 from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, add_options, option
-from neurosym.seeds import check_seed
 
 
 @dataclass(kw_only=True)
@@ -45,100 +41,20 @@ def configure(parser: argparse.ArgumentParser) -> None:
     add_options(parser, EvalOptions)
 
 
-def evaluate(
-    agent: Any,
-    env: str | None = None,
-    episodes: int = 100,
-    greedy: bool = True,
-    seed: int = 0,
-    env_kwargs: dict[str, Any] | None = None,
-) -> dict[str, Any]:
-    """Play ``episodes`` episodes of ``agent``; a dict of plain values (what --json prints).
-
-    ``env``: any env of the agent's family with its observation shape
-    (default: its own); ``env_kwargs``: options on top (e.g. ``{"map": path}``).
-    """
-    import torch
-
-    from neurosym.agent.checkpoint import env_for
-
-    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
-        raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
-    check_seed(seed, episodes)
-    env, kwargs = env_for(agent, env, env_kwargs)
-    generator = None if greedy else torch.Generator().manual_seed(seed)
-    report = score(
-        lambda obs, _venv: agent.act(obs, greedy=greedy, generator=generator)[0],
-        env,
-        episodes,
-        seed,
-        kwargs,
-    )
-    return {
-        "checkpoint": agent.path,
-        "env": env,
-        "env_kwargs": kwargs,
-        "module": agent.config.module,
-        "episodes": episodes,
-        "greedy": greedy,
-        "seed": seed,
-        **report,
-        "trained_frames": agent.meta.get("frames"),
-    }
-
-
-def score(
-    act: Any, env: str, episodes: int, seed: int = 0, env_kwargs: dict[str, Any] | None = None
-) -> dict[str, Any]:
-    """Play and score ``episodes`` episodes of a policy ``act(obs, venv) -> actions`` on ``env``.
-
-    The figures of the report (returns, success, lengths, outcomes and, on
-    RGW, the level-aware ones); any policy, e.g. a scripted one in tests.
-    """
-    from neurosym.agent.evaluation import play_scored
-    from neurosym.envs import make_batched
-
-    done = play_scored(
-        act,
-        lambda n: make_batched(env, n, seed=seed, **dict(env_kwargs or {})),
-        episodes,
-        seed,
-    )
-    return report_of(done)
-
-
-def report_of(done: Any) -> dict[str, Any]:
-    """The report's figures of played episodes (a :class:`~neurosym.agent.evaluation.ScoredEpisodes`)."""
-    import numpy as np
-
-    from neurosym.agent.evaluation import level_scores
-    from neurosym.agent.rollout import SUCCESS_OUTCOMES
-
-    returns = np.asarray(done.returns)
-    return {
-        "mean_return": float(returns.mean()),
-        "std_return": float(returns.std()),
-        "min_return": float(returns.min()),
-        "max_return": float(returns.max()),
-        "success_rate": float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes])),
-        **level_scores(done),
-        "mean_length": float(np.mean(done.lengths)),
-        "outcomes": dict(sorted(Counter(done.outcomes).items())),
-    }
-
-
 def run(args: EvalOptions) -> int:
+    """Load, play, print: the figures of :func:`neurosym.agent.evaluation.evaluate`."""
     import torch
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import env_for, load_agent
+    from neurosym.agent.evaluation import evaluate
+    from neurosym.reports.terminal import print_figures
 
     torch.set_num_threads(1)
-    from neurosym.agent.checkpoint import env_for
 
     agent = load_agent(args.checkpoint)
-    env, overrides = play_options(args, agent.env_name)
+    env, overrides = env_choice(args, agent.env_name)
     env, kwargs = env_for(agent, env, overrides)
-    report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs)
+    report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs).as_dict()
     if args.json:
         print(json.dumps(report))
         return 0
@@ -154,30 +70,3 @@ def run(args: EvalOptions) -> int:
     )
     print_figures(report)
     return 0
-
-
-def print_figures(report: dict[str, Any]) -> None:
-    """The report's figure lines, from mean return to outcomes (``neurosym play`` prints the same)."""
-    from neurosym.display import plain
-
-    outcomes = plain(", ".join(f"{k} {v}" for k, v in report["outcomes"].items()))
-    print(f"mean return  {report['mean_return']:.3f} (std {report['std_return']:.3f})")
-    print(f"success      {100 * report['success_rate']:.1f} %")
-    for key, label in (
-        ("optimal_rate", "optimal     "),
-        ("sword_first_guarded", "sword first "),
-        ("no_detour_decoy", "no detour   "),
-    ):
-        if report.get(key) is not None:
-            print(f"{label} {100 * report[key]:.1f} %{_of(report, key)}")
-    print(f"mean length  {report['mean_length']:.1f} steps")
-    print(f"outcomes     {outcomes}")
-
-
-def _of(report: dict[str, Any], key: str) -> str:
-    """' (of N guarded levels)' for the shares that count only some episodes."""
-    if key == "sword_first_guarded":
-        return f" (of {report['guarded_episodes']} guarded levels)"
-    if key == "no_detour_decoy":
-        return f" (of {report['decoy_episodes']} decoy levels)"
-    return f" (mean optimal return {report['mean_optimal_return']:.3f})"

@@ -1,6 +1,6 @@
 """Evaluation episodes scored against their levels: optimal return, sword first, no detour.
 
-:func:`play_scored` plays whole episodes with :func:`neurosym.agent.play.play_waves`
+:func:`play_scored` plays whole episodes with :func:`neurosym.agent.waves.run_waves`
 (episode k from ``reset(seed=seed + k)``, in waves of at most ``batch`` sub-envs;
 :func:`play_episodes` is the same without scores)
 and keeps, per episode, what the level was and what the agent did about it.
@@ -29,14 +29,15 @@ used are unseen levels of rgw-random.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 
-from neurosym.agent.play import play_waves
 from neurosym.agent.rollout import Finished, outcome_of
+from neurosym.agent.waves import run_waves
 
 TOLERANCE = 1e-6
 """returns this close to the optimal return count as optimal (float sums of -0.1 steps)"""
@@ -72,13 +73,13 @@ def play_scored(
 
     ``act`` gets the batched env as well, so that a scripted policy (such as
     rgw_solver's planner in the tests) can read the state; it sees the whole
-    batch every step (``act_on="all"`` of :func:`play_waves`). ``levels=False``
+    batch every step (``act_on="all"`` of :func:`run_waves`). ``levels=False``
     skips the level-aware scoring (its no-sword search costs time at every
     reset): returns, lengths and outcomes only, as the trainer's evaluation wants.
     """
     out = ScoredEpisodes()
     venvs: dict[int, Any] = {}
-    waves = play_waves(
+    waves = run_waves(
         act, lambda n: venvs.setdefault(n, make_venv(n)), episodes, seed, batch,
         act_on="all", max_steps=max_steps,
     )  # fmt: skip
@@ -187,8 +188,69 @@ def _share(mask: np.ndarray, of: np.ndarray) -> float | None:
     return float(mask[of].mean()) if of.any() else None
 
 
+@dataclass(frozen=True)
+class LevelScores:
+    """The level-aware figures (module docstring); on envs whose levels report their optimum."""
+
+    optimal_rate: float | None
+    mean_optimal_return: float
+    guarded_episodes: int
+    sword_first_guarded: float | None
+    decoy_episodes: int
+    no_detour_decoy: float | None
+    sword_taken_decoy: float | None
+
+
+@dataclass(frozen=True)
+class Scores:
+    """The figures of played episodes: what ``neurosym eval`` and ``neurosym play`` report."""
+
+    mean_return: float
+    std_return: float
+    min_return: float
+    max_return: float
+    success_rate: float
+    mean_length: float
+    outcomes: dict[str, int]
+    """episodes per outcome, by outcome name"""
+    levels: LevelScores | None = None
+    """None on envs whose levels do not report their optimum (Box-World)"""
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain values under ``--json``'s names, in its order (level figures flattened in)."""
+        return {
+            "mean_return": self.mean_return,
+            "std_return": self.std_return,
+            "min_return": self.min_return,
+            "max_return": self.max_return,
+            "success_rate": self.success_rate,
+            **(asdict(self.levels) if self.levels is not None else {}),
+            "mean_length": self.mean_length,
+            "outcomes": dict(self.outcomes),
+        }
+
+
+def scores_of(done: ScoredEpisodes) -> Scores:
+    """The :class:`Scores` of :func:`play_scored`'s episodes."""
+    from neurosym.agent.rollout import SUCCESS_OUTCOMES
+
+    returns = np.asarray(done.returns, dtype=float)
+    levels = level_scores(done)
+    return Scores(
+        mean_return=float(returns.mean()),
+        std_return=float(returns.std()),
+        min_return=float(returns.min()),
+        max_return=float(returns.max()),
+        success_rate=float(np.mean([o in SUCCESS_OUTCOMES for o in done.outcomes])),
+        mean_length=float(np.mean(done.lengths)),
+        outcomes=dict(sorted(Counter(done.outcomes).items())),
+        levels=LevelScores(**levels) if levels else None,
+    )
+
+
 def level_scores(done: ScoredEpisodes) -> dict[str, Any]:
-    """The level-aware figures of :func:`play_scored`'s episodes (module docstring)."""
+    """The level-aware figures of :func:`play_scored`'s episodes (module docstring); {} where
+    no level reports its optimum."""
     returns = np.asarray(done.returns, dtype=float)
     optimal = np.asarray(done.optimal_return, dtype=float)
     known = ~np.isnan(optimal)
@@ -208,3 +270,96 @@ def level_scores(done: ScoredEpisodes) -> dict[str, Any]:
         "no_detour_decoy": _share(no_detour, decoy),
         "sword_taken_decoy": _share(np.asarray(done.took_sword, dtype=bool), decoy),
     }
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """An agent's :func:`evaluate`: what was played, and its :class:`Scores`."""
+
+    checkpoint: str | None
+    env: str
+    env_kwargs: dict[str, Any]
+    module: str
+    episodes: int
+    greedy: bool
+    seed: int
+    scores: Scores
+    trained_frames: int | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain values: what ``neurosym eval --json`` prints, in its order."""
+        return {
+            "checkpoint": self.checkpoint,
+            "env": self.env,
+            "env_kwargs": self.env_kwargs,
+            "module": self.module,
+            "episodes": self.episodes,
+            "greedy": self.greedy,
+            "seed": self.seed,
+            **self.scores.as_dict(),
+            "trained_frames": self.trained_frames,
+        }
+
+
+def evaluate(
+    agent: Any,
+    env: str | None = None,
+    episodes: int = 100,
+    greedy: bool = True,
+    seed: int = 0,
+    env_kwargs: dict[str, Any] | None = None,
+) -> Evaluation:
+    """Play ``episodes`` episodes of ``agent`` (episode k from ``reset(seed=seed + k)``).
+
+    ``env``: any env of the agent's family with its observation shape
+    (default: its own); ``env_kwargs``: options on top (e.g. ``{"map": path}``).
+    ``greedy=False`` samples actions with a torch generator seeded with ``seed``.
+    """
+    import torch
+
+    from neurosym.agent.agent import env_for
+    from neurosym.errors import ConfigError
+    from neurosym.seeds import check_seed
+
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ConfigError(f"--episodes must be a positive integer, got {episodes!r}")
+    check_seed(seed, episodes)
+    env, kwargs = env_for(agent, env, env_kwargs)
+    generator = None if greedy else torch.Generator().manual_seed(seed)
+    scores = score(
+        lambda obs, _venv: agent.act(obs, greedy=greedy, generator=generator)[0],
+        env,
+        episodes,
+        seed,
+        kwargs,
+    )
+    return Evaluation(
+        checkpoint=agent.path,
+        env=env,
+        env_kwargs=kwargs,
+        module=agent.config.module,
+        episodes=episodes,
+        greedy=greedy,
+        seed=seed,
+        scores=scores,
+        trained_frames=agent.meta.get("frames"),
+    )
+
+
+def score(
+    act: Any, env: str, episodes: int, seed: int = 0, env_kwargs: dict[str, Any] | None = None
+) -> Scores:
+    """Play and score ``episodes`` episodes of a policy ``act(obs, venv) -> actions`` on ``env``.
+
+    Any policy, e.g. a scripted one in tests; the env is made batched with ``env_kwargs``.
+    """
+    from neurosym.envs import make_batched
+
+    done = play_scored(
+        act,
+        lambda n: make_batched(env, n, seed=seed, **dict(env_kwargs or {})),
+        episodes,
+        seed,
+    )
+    return scores_of(done)
+

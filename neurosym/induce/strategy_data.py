@@ -19,7 +19,7 @@ import pandas as pd
 
 from neurosym.display import plain
 from neurosym.errors import ConfigError
-from neurosym.schema import SCHEMA
+from neurosym.facts.schema import SCHEMA
 from neurosym.terms import format_value
 
 CONTACTS = frozenset(

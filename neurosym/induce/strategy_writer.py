@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from neurosym.errors import ConfigError
+from neurosym.facts.schema import indicators
 from neurosym.induce.readback import Code, Part, comment
 from neurosym.induce.strategy_features import (
     BACKGROUND,
@@ -18,7 +19,6 @@ from neurosym.induce.strategy_features import (
 )
 from neurosym.induce.strategy_route import PROLOG as ROUTE
 from neurosym.induce.strategy_tree import Clause, simplify
-from neurosym.schema import indicators
 from neurosym.terms import Term, Var, format_value
 
 if TYPE_CHECKING:

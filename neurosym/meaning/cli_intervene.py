@@ -26,7 +26,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from neurosym.cli import play_env
+from neurosym.cli import agent_env
 from neurosym.errors import ConfigError
 from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, Out, add_options, option
 
@@ -67,13 +67,13 @@ def run(args: InterveneOptions) -> int:
     check_seed(args.seed, args.episodes)
     out = check_out(Path(args.out))
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.envs import canonical_name
     from neurosym.meaning.intervene import intervene
 
     env = canonical_name(args.env) if args.env else None
     agent = load_agent(args.checkpoint, env=env)
-    env, env_kwargs = play_env(agent, env, args.env_option, args.map)
+    env, env_kwargs = agent_env(agent, env, args.env_option, args.map)
     if env_kwargs.get("edit") is not None:
         raise ConfigError(
             f"--env-option edit={env_kwargs['edit']}: intervene makes the level edits itself "
@@ -109,7 +109,7 @@ def run(args: InterveneOptions) -> int:
 
 
 def _causal_rules() -> Path | None:
-    from neurosym.export.report import rules_dir
+    from neurosym.reports.terminal import rules_dir
 
     folder = rules_dir()
     return folder / "causal.pl" if folder and (folder / "causal.pl").is_file() else None

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from neurosym.cli import play_env
+from neurosym.cli import agent_env
 from neurosym.errors import ConfigError
 from neurosym.flags import ActionMode, EnvChoice, Episodes, Json, Out, add_options, option
 
@@ -69,13 +69,13 @@ def run(args: ProbeOptions) -> int:
     check_seed(args.seed, args.episodes)
     out = check_out(Path(args.out))
 
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.envs import canonical_name
     from neurosym.meaning.probe import probe
 
     env = canonical_name(args.env) if args.env else None
     agent = load_agent(args.checkpoint, env=env)
-    env, env_kwargs = play_env(agent, env, args.env_option, args.map)
+    env, env_kwargs = agent_env(agent, env, args.env_option, args.map)
     report = probe(
         agent,
         env,

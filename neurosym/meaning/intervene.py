@@ -60,7 +60,7 @@ import pandas as pd
 
 from neurosym.agent.networks.adapters import adapter_class
 from neurosym.errors import ConfigError
-from neurosym.schema import TRACE, group
+from neurosym.facts.schema import TRACE, group
 from neurosym.terms import Term
 
 DEFAULT_EPISODES = 100
@@ -69,7 +69,7 @@ DEFAULT_EPISODES = 100
 TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
 
 NETWORK_FACTS = tuple(p.name for p in group(TRACE) if "intervene" not in p.writers)
-"""the trace predicates an experiment KB leaves out (:mod:`neurosym.schema`: those intervene does
+"""the trace predicates an experiment KB leaves out (:mod:`neurosym.facts.schema`: those intervene does
 not write): what the network computed, per state"""
 
 
@@ -112,8 +112,8 @@ class InterventionReport:
 
     def facts(self) -> dict[str, pd.DataFrame]:
         """Tables for the Prolog writer (see :meth:`to_prolog`)."""
-        from neurosym.export.facts import extract_facts
-        from neurosym.export.recording import Recording
+        from neurosym.facts.tables import extract_facts
+        from neurosym.record.recording import Recording
 
         merged = Recording(
             **{
@@ -169,8 +169,8 @@ class InterventionReport:
 
     def to_prolog(self, path: str | os.PathLike[str]) -> Path:
         """Write the KB: trace facts of every experiment's episodes plus the experiment facts."""
-        from neurosym.export.prolog_writer import write_prolog
-        from neurosym.schema import indicators, term_columns, written_by
+        from neurosym.facts.prolog_writer import write_prolog
+        from neurosym.facts.schema import indicators, term_columns, written_by
 
         tables = self.facts()
         header = (
@@ -465,9 +465,9 @@ def intervene(
     plays them, with its own change on top). ``progress``: bars on stderr.
     """
     from neurosym.envs import env_family
-    from neurosym.export.recorder import _resolve_env
     from neurosym.meaning.features import head_means, head_vectors, replay_observations
     from neurosym.progress import Stages
+    from neurosym.record.recorder import _resolve_env
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"episodes must be a positive integer, got {episodes!r}")
@@ -553,8 +553,8 @@ class _Run:
     def play(self, exp: Experiment, index: int, base_means: dict | None) -> Any:
         """Record ``exp``: its level change goes in as an option of the env played (not as the
         agent's own options, which another env than the agent's would not carry over)."""
-        from neurosym.export.recorder import record
         from neurosym.meaning.features import ablate_heads
+        from neurosym.record.recorder import record
 
         kwargs = self.env_kwargs
         if exp.map_text is not None:

@@ -120,8 +120,8 @@ class ProbeReport:
 
     def to_prolog(self, path: str | os.PathLike[str]) -> Path:
         """Write the facts as a plain Prolog file (atomically, full-precision floats)."""
-        from neurosym.export.prolog_writer import write_prolog
-        from neurosym.schema import PROBE, group, indicators, term_columns
+        from neurosym.facts.prolog_writer import write_prolog
+        from neurosym.facts.schema import PROBE, group, indicators, term_columns
 
         names = [p.name for p in group(PROBE)]
         header = (
@@ -519,7 +519,7 @@ def probe(
     ``env``: any env of the agent's family with its observation shape (default:
     its own); ``env_kwargs``: options on top of the agent's.
     """
-    from neurosym.export.recorder import record
+    from neurosym.record.recorder import record
 
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 2:
         raise ConfigError(f"probes need at least 2 episodes, got {episodes!r}")

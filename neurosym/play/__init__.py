@@ -1,7 +1,7 @@
 """A Prolog agent that plays: a strategy's goal/3 and rules/route.pl's route/4 choose the actions.
 
 * :mod:`~neurosym.play.agent` -- :class:`PrologAgent`, live facts in, actions out
-* :mod:`~neurosym.play.evaluate` -- :func:`play_policy`: the figures of ``neurosym eval``
+* :mod:`~neurosym.play.evaluate` -- :func:`score_strategy`: the figures of ``neurosym eval``
 * :mod:`~neurosym.play.live` -- the live state's facts under the KB schema
 * :mod:`~neurosym.play.policy` -- :func:`read_policy`: a strategy file and its features line
 * :mod:`~neurosym.play.relations` -- the network's relation facts of live states
@@ -17,7 +17,7 @@ from neurosym.lazy import lazy_attributes
 
 _API = {
     "PrologAgent": "neurosym.play.agent",
-    "play_policy": "neurosym.play.evaluate",
+    "score_strategy": "neurosym.play.evaluate",
     "read_policy": "neurosym.play.policy",
     "Policy": "neurosym.play.policy",
     "episode_facts": "neurosym.play.live",

@@ -34,18 +34,18 @@ import numpy as np
 
 from neurosym.envs.actions import ACTION_NAMES
 from neurosym.errors import ConfigError, PrologError
+from neurosym.facts.schema import TRACE, group
 from neurosym.play import live
 from neurosym.play import prolog as play_prolog
 from neurosym.play.policy import Policy, read_policy
 from neurosym.prolog.interrupt import interruptible
-from neurosym.schema import TRACE, group
 from neurosym.terms import Term
 
 INFERENCE_LIMIT = 10_000_000
 """inferences a strategy may take to choose one object (then the run stops with one line)"""
 
 SCHEMA = tuple(group(TRACE))
-"""every predicate of the KB schema (:mod:`neurosym.schema`), declared dynamic in the agent's module"""
+"""every predicate of the KB schema (:mod:`neurosym.facts.schema`), declared dynamic in the agent's module"""
 
 _ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
 
@@ -65,7 +65,7 @@ class PrologAgent:
     """Plays with a strategy file's ``goal/3`` and route.pl; ``act(obs, venv)`` as evaluation wants.
 
     ``policy``: the strategy file (or a :class:`Policy`). ``network``: the
-    loaded checkpoint (:class:`~neurosym.agent.checkpoint.Agent`) whose
+    loaded checkpoint (:class:`~neurosym.agent.agent.Agent`) whose
     relation facts a strategy with ``features: relations`` or ``both`` reads
     (:mod:`neurosym.play.relations`), with ``thresholds`` (relation j ->
     threshold of holds/5) when the strategy file has no threshold/2. Play

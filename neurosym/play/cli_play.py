@@ -62,7 +62,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: PlayOptions) -> int:
     from neurosym.errors import ConfigError
-    from neurosym.play.evaluate import play_policy
+    from neurosym.play.evaluate import score_strategy
 
     env, overrides = map_option(args.env, args.map, args.env or "rgw2")
     if env is None and args.checkpoint is None:
@@ -81,7 +81,7 @@ def run(args: PlayOptions) -> int:
         import torch
 
         torch.set_num_threads(1)
-    report = play_policy(
+    report = score_strategy(
         args.policy, env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb
     )
     if args.json:
@@ -93,8 +93,8 @@ def run(args: PlayOptions) -> int:
 
 def print_report(report: dict) -> None:
     """The report for people: eval's figure lines, then fallbacks and speed."""
-    from neurosym.agent.cli_eval import print_figures
     from neurosym.display import plain
+    from neurosym.reports.terminal import print_figures
 
     print(
         f"policy       {plain(report['policy'])} ({plain(report['env'])}, features {report['features']})"

@@ -1,10 +1,10 @@
 """Play and score a strategy file: the figures of ``neurosym eval``, plus fallbacks and speed.
 
-:func:`play_policy` plays ``episodes`` episodes (episode k from
+:func:`score_strategy` plays ``episodes`` episodes (episode k from
 ``reset(seed=seed + k)``, as ``neurosym eval`` does) with a
 :class:`~neurosym.play.agent.PrologAgent` and scores them with the same code
 (:func:`neurosym.agent.evaluation.play_scored`,
-:func:`neurosym.agent.cli_eval.report_of`), so the two reports compare line by
+:func:`neurosym.agent.evaluation.scores_of`), so the two reports compare line by
 line under the same names.
 """
 
@@ -21,7 +21,7 @@ BATCH = 64
 """episodes played side by side (sub-envs of one batched env)"""
 
 
-def play_policy(
+def score_strategy(
     policy: str | os.PathLike[str],
     env: str | None = None,
     episodes: int = 100,
@@ -43,8 +43,7 @@ def play_policy(
     object chosen), ``steps`` and ``steps_per_s`` (env steps per second of the
     whole loop: facts, Prolog, env).
     """
-    from neurosym.agent.cli_eval import report_of
-    from neurosym.agent.evaluation import play_scored
+    from neurosym.agent.evaluation import play_scored, scores_of
     from neurosym.envs import canonical_name
     from neurosym.play.agent import PrologAgent
     from neurosym.play.policy import read_policy
@@ -58,7 +57,7 @@ def play_policy(
     network = None
     if checkpoint is not None:
         check_file_name(checkpoint, "--checkpoint")
-        from neurosym.agent.checkpoint import env_for, load_agent
+        from neurosym.agent.agent import env_for, load_agent
 
         network = load_agent(checkpoint)
         env, env_kwargs = env_for(network, env, env_kwargs)
@@ -88,7 +87,7 @@ def play_policy(
             "env_kwargs": kwargs,
             "episodes": episodes,
             "seed": seed,
-            **report_of(done),
+            **scores_of(done).as_dict(),
             "fallbacks": dict(sorted(agent.fallbacks.items())),
             "fallback_steps": int(sum(agent.fallbacks.values())),
             "goals": dict(sorted(agent.goals.items())),

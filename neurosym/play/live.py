@@ -11,7 +11,7 @@ writes for the state being played: for episode E and state T
 * per step: ``step(E, T, Action, Reward)`` and ``event(E, T, Event)`` for
   the transition from T to T + 1.
 
-The recorder (:mod:`neurosym.export.recorder`) builds a recording's world tables
+The recorder (:mod:`neurosym.record.recorder`) builds a recording's world tables
 with these same functions. The rows come from the env's decoded info (``decode_info``, the same dicts
 the recorder reads) and its entity grid, as plain Python values: ids and
 names as text, entity and event texts as :class:`~neurosym.terms.Term` once

@@ -32,7 +32,7 @@ from neurosym.play.policy import Policy
 
 
 class RelationFacts:
-    """Relation facts of live states from a loaded network (:class:`~neurosym.agent.checkpoint.Agent`).
+    """Relation facts of live states from a loaded network (:class:`~neurosym.agent.agent.Agent`).
 
     The rows are the recorder's: the module's adapter keeps and tabulates the live
     states' introspection exactly as it does for a recording (top key 1); here they

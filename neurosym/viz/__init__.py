@@ -1,7 +1,7 @@
 """Pictures of what the agent relates: attention maps, R vectors, relation values, episodes.
 
-Each function takes a :class:`~neurosym.export.recording.Recording`, an
-:class:`~neurosym.agent.checkpoint.Agent` (played greedily on ``env`` from
+Each function takes a :class:`~neurosym.record.recording.Recording`, an
+:class:`~neurosym.agent.agent.Agent` (played greedily on ``env`` from
 ``reset(seed)``) or an :class:`EpisodeTrace`, and returns a matplotlib Figure
 (headless, no pyplot); :func:`save_figure` writes PNG or SVG reproducibly.
 

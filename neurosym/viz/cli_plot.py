@@ -201,14 +201,14 @@ def _load_source(args: Any) -> Any:
         for flag, value in played:
             if value is not None:
                 raise ConfigError(f"{flag} goes with --checkpoint; a recording already fixes it")
-        from neurosym.export.recording import Recording
+        from neurosym.record.recording import Recording
 
         return Recording.load(args.recording)
     if args.episode is not None:
         raise ConfigError(
             "--episode goes with --recording; with --checkpoint pick the episode by --seed"
         )
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
 
     return load_agent(args.checkpoint)
 

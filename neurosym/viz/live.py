@@ -17,14 +17,14 @@ import numpy as np
 import pandas as pd
 
 from neurosym.agent.networks.adapters import adapter_class
-from neurosym.agent.play import SingleAsBatch, play_waves
+from neurosym.agent.waves import SingleAsBatch, run_waves
 from neurosym.errors import ConfigError
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
 if TYPE_CHECKING:
     import gymnasium
 
-    from neurosym.agent.checkpoint import Agent
+    from neurosym.agent.agent import Agent
 
 
 def trace_from_agent(
@@ -93,7 +93,7 @@ class _Play:
 
     def run(self, limit: int) -> None:
         """Play the episode (at most ``limit`` steps) with the shared play loop, as a batch of one."""
-        waves = play_waves(
+        waves = run_waves(
             self._act, lambda _count: SingleAsBatch(self.env), 1, self.seed, 1,
             act_on="live", max_steps=limit, stop_at_limit=True,
         )  # fmt: skip
@@ -213,7 +213,7 @@ def _open_env(
     shape (``checkpoint.env_for`` checks and picks its options); an env object
     passed in is checked for its shape when the episode starts.
     """
-    from neurosym.agent.checkpoint import env_for
+    from neurosym.agent.agent import env_for
     from neurosym.envs import canonical_name
 
     if env is None or isinstance(env, str):

@@ -1,4 +1,4 @@
-"""An :class:`EpisodeTrace` from a saved :class:`~neurosym.export.recording.Recording`.
+"""An :class:`EpisodeTrace` from a saved :class:`~neurosym.record.recording.Recording`.
 
 The recording's attention tables keep only the strongest cells (PrediNet: the
 argmax of a1 and a2; MHDPA: the top keys of each non-background query), so the
@@ -20,7 +20,7 @@ import pandas as pd
 
 from neurosym.agent.networks.adapters import adapter_class, module_names
 from neurosym.errors import ConfigError
-from neurosym.export.recording import Recording
+from neurosym.record.recording import Recording
 from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
 

@@ -1,7 +1,7 @@
 """Distributions of PrediNet relation values, with the threshold that makes them facts.
 
 ``neurosym extract`` keeps a relation row as a ``holds/5`` fact when |D_j|
-exceeds relation j's threshold (:mod:`neurosym.export.thresholds`, computed
+exceeds relation j's threshold (:mod:`neurosym.facts.thresholds`, computed
 from the recorded values of all heads, since W_S is shared). This figure shows
 each relation's values per head and pooled, with the threshold at +/- its value
 and how many values it keeps, so a threshold spec can be chosen by eye.
@@ -19,8 +19,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from neurosym.errors import ConfigError
-from neurosym.export.facts import DEFAULT_THRESHOLD
-from neurosym.export.recording import Recording
+from neurosym.facts.tables import DEFAULT_THRESHOLD
+from neurosym.record.recording import Recording
 from neurosym.viz.live import trace_from_agent
 from neurosym.viz.panels import widen_for_text
 from neurosym.viz.sources import EnvLike, Source, require_source_module
@@ -108,7 +108,7 @@ def relations_figure(
 
     Size: (2.6 * columns + 0.4) x (2.2 * rows + 1.0) inches, 4 relations per row.
     """
-    from neurosym.export.thresholds import parse_threshold
+    from neurosym.facts.thresholds import parse_threshold
 
     rule = parse_threshold(threshold)
     table, where = relation_values(source, env, episodes=episodes, seed=seed)

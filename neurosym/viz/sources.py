@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, TypeAlias
 
 from neurosym.errors import ConfigError
-from neurosym.export.recording import Recording
+from neurosym.record.recording import Recording
 from neurosym.viz.live import trace_from_agent
 from neurosym.viz.recorded import trace_from_recording
 from neurosym.viz.trace import EpisodeTrace, require_module
@@ -19,7 +19,7 @@ from neurosym.viz.trace import EpisodeTrace, require_module
 if TYPE_CHECKING:
     import gymnasium
 
-    from neurosym.agent.checkpoint import Agent
+    from neurosym.agent.agent import Agent
 
 Source: TypeAlias = "Recording | Agent | EpisodeTrace"
 """what every plotting function draws from"""

@@ -2,7 +2,7 @@
 
 Every picture needs the same few things: what occupies each cell at each state,
 where the agent went, and what the relational module computed at each step.
-A saved :class:`~neurosym.export.recording.Recording` keeps only the strongest
+A saved :class:`~neurosym.record.recording.Recording` keeps only the strongest
 cells of each attention map, while a checkpoint played live gives the full
 maps; :class:`EpisodeTrace` holds both kinds, with ``NaN`` marking the weights
 that were not recorded (``complete`` says which kind it is), so one set of

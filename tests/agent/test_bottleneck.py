@@ -15,7 +15,8 @@ import pandas as pd
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent, save_checkpoint
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.networks.hooks import hooked
 from neurosym.agent.networks.model import ActorCritic

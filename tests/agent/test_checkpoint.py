@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import FORMAT, load_agent, read_checkpoint, save_checkpoint
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import FORMAT, read_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.networks.introspection import PrediNetIntrospection
 from neurosym.agent.networks.model import ActorCritic

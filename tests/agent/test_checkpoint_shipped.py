@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent
+from neurosym.agent.agent import load_agent
 
 CHECKPOINTS = Path(__file__).resolve().parents[2] / "checkpoints"
 # rgw2: the lower part is reachable only through the teleport; rgw1 (no mountains, no pits)
@@ -96,7 +96,7 @@ def test_all_shipped_agents_are_there() -> None:
 @pytest.mark.expensive
 @pytest.mark.parametrize("name", BOXWORLD + RANDOM)
 def test_shipped_agent_solves_unseen_levels(name: str) -> None:
-    from neurosym.agent.cli_eval import evaluate
+    from neurosym.agent.evaluation import evaluate
 
     path = CHECKPOINTS / f"{name}.pt"
     agent = load_agent(path)
@@ -116,7 +116,7 @@ def test_shipped_agent_solves_unseen_levels(name: str) -> None:
         assert commands[-1].startswith(f"neurosym compact checkpoints/{name}.pt --out ")
     for mode, floor in UNSEEN_FLOOR[name].items():
         report = evaluate(agent, episodes=UNSEEN_EPISODES, greedy=mode == "greedy", seed=UNSEEN,
-                          env_kwargs=default_levels(agent))  # fmt: skip
+                          env_kwargs=default_levels(agent)).as_dict()  # fmt: skip
         assert report["success_rate"] >= floor, (mode, report)
 
 
@@ -134,8 +134,8 @@ def default_levels(agent: Any) -> dict[str, Any] | None:
 def test_the_cell_keys_predinet_relates_two_objects_on_rgw_random() -> None:
     """Unlike the fixed-map agents (agent-agent, agent-wall), one head compares two objects on
     the rgw-random levels it was made for (the default ones), the agent and another."""
-    from neurosym.export.heads import head_summary
-    from neurosym.export.recorder import record
+    from neurosym.record.heads import head_summary
+    from neurosym.record.recorder import record
 
     agent = load_agent(CHECKPOINTS / "rgw-random-predinet-cellkeys.pt")
     rec = record(agent, episodes=20, seed=UNSEEN, greedy=False, env_kwargs=default_levels(agent))
@@ -149,10 +149,10 @@ def test_the_rgw_random_mhdpa_plays_rgw2_zero_shot_sampled() -> None:
     """Never trained on rgw2, its sampled policy reaches the terminal (all 20 episodes, mean
     10.48 of the optimal 10.7, when shipped); greedily it takes the sword and then loops (a
     timeout since the --safe-coef fine-tune; the 9.56 M agent before it played 10.4)."""
-    from neurosym.agent.cli_eval import evaluate
+    from neurosym.agent.evaluation import evaluate
 
     report = evaluate(load_agent(CHECKPOINTS / "rgw-random-mhdpa.pt"), env="rgw2",
-                      episodes=20, greedy=False, seed=0)  # fmt: skip
+                      episodes=20, greedy=False, seed=0).as_dict()  # fmt: skip
     assert report["success_rate"] >= 0.9 and report["mean_return"] >= 10.0, report
 
 
@@ -163,11 +163,11 @@ def test_the_cell_keys_predinet_plays_rgw2_and_relates_objects(tmp_path: Path) -
     field of mountains, since its last 10 minutes on 12-mountain levels), one head relating
     the agent to the sword and then the enemy on most states, another the teleport and the
     agent, and sword_enemy_link through the agent in real SWI-Prolog."""
-    from neurosym.export.facts import extract_facts
-    from neurosym.export.heads import head_summary
-    from neurosym.export.recorder import record
-    from neurosym.export.report import RULE_FILES, rules_dir
+    from neurosym.facts.tables import extract_facts
     from neurosym.prolog.knowledge_base import KnowledgeBase
+    from neurosym.record.heads import head_summary
+    from neurosym.record.recorder import record
+    from neurosym.reports.terminal import RULE_FILES, rules_dir
     from neurosym.terms import Term
 
     path = CHECKPOINTS / "rgw-random-predinet-cellkeys.pt"

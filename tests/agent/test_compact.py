@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import compact_checkpoint, load_agent, save_checkpoint
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import compact_checkpoint, save_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.errors import CheckpointError, ConfigError

@@ -24,7 +24,8 @@ from pathlib import Path
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent, read_checkpoint
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import read_checkpoint
 from neurosym.agent.learners import distributed
 from neurosym.errors import ConfigError
 

@@ -12,9 +12,10 @@ from pathlib import Path
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent, save_checkpoint
-from neurosym.agent.cli_eval import evaluate
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
+from neurosym.agent.evaluation import evaluate
 from neurosym.agent.networks.model import ActorCritic
 
 RGW1_MAP = Path(__file__).resolve().parents[2] / "neurosym" / "envs" / "maps" / "rgw1.txt"
@@ -48,7 +49,7 @@ def test_eval_json(neurosym, untrained: Path) -> None:
     assert sum(report["outcomes"].values()) == 6
     assert 0.0 <= report["success_rate"] <= 1.0 and report["mean_length"] > 0
     # greedy on a fixed map is deterministic: the library function gives the same numbers
-    again = evaluate(load_agent(untrained), "rgw2", 6)
+    again = evaluate(load_agent(untrained), "rgw2", 6).as_dict()
     assert again["mean_return"] == report["mean_return"] and again["outcomes"] == report["outcomes"]
 
 
@@ -61,8 +62,8 @@ def test_eval_text_and_sample(neurosym, untrained: Path) -> None:
     assert (
         "mean return" in out and "success" in out and "outcomes" in out and "sampled, seed 3" in out
     )
-    a = evaluate(load_agent(untrained), "rgw2", 4, greedy=False, seed=3)
-    b = evaluate(load_agent(untrained), "rgw2", 4, greedy=False, seed=3)
+    a = evaluate(load_agent(untrained), "rgw2", 4, greedy=False, seed=3).as_dict()
+    b = evaluate(load_agent(untrained), "rgw2", 4, greedy=False, seed=3).as_dict()
     assert a == b  # sampling is seeded
 
 

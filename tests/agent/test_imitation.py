@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent, read_checkpoint
-from neurosym.agent.cli_eval import score
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import read_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig
+from neurosym.agent.evaluation import score
 from neurosym.agent.learners.imitation import (
     LabelBuffer,
     expert_share,
@@ -40,7 +41,7 @@ class SetSampler:
 
 
 def test_any_action_of_the_optimal_sets_earns_the_optimal_return() -> None:
-    report = score(SetSampler(0), "rgw-random", 48, seed=2000)
+    report = score(SetSampler(0), "rgw-random", 48, seed=2000).as_dict()
     assert report["optimal_rate"] == 1.0 and report["success_rate"] == 1.0
 
 

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from neurosym.agent.play import EpisodeTooLong, SingleAsBatch, play_waves
+from neurosym.agent.waves import EpisodeTooLong, SingleAsBatch, run_waves
 from neurosym.errors import ConfigError
 
 
@@ -44,7 +44,7 @@ def _play(venv: CountdownVenv, act_on: str, episodes: int, batch: int) -> tuple[
         return np.ones(len(obs), dtype=np.int64)
 
     result: dict[int, tuple[float, int]] = {}
-    for wave in play_waves(act, lambda _n: venv, episodes, 100, batch, act_on=act_on):
+    for wave in run_waves(act, lambda _n: venv, episodes, 100, batch, act_on=act_on):
         for step in wave.steps():
             assert (step.episodes == wave.first + step.live).all()
         for i in range(wave.count):
@@ -73,12 +73,12 @@ def test_act_on_all_shows_the_policy_the_whole_batch() -> None:
 
 def test_an_endless_episode_is_an_error_unless_the_caller_stops_at_the_limit() -> None:
     act = lambda obs, _venv: np.zeros(len(obs), dtype=np.int64)  # noqa: E731
-    waves = play_waves(act, lambda n: CountdownVenv(n, forever=True), 2, 0, 2, max_steps=4)
+    waves = run_waves(act, lambda n: CountdownVenv(n, forever=True), 2, 0, 2, max_steps=4)
     with pytest.raises(ConfigError, match="episode 0 ran 4 steps without ending"):
         for wave in waves:
             list(wave.steps())
     assert issubclass(EpisodeTooLong, ConfigError)
-    stopped = play_waves(
+    stopped = run_waves(
         act, lambda n: CountdownVenv(n, forever=True), 2, 0, 2, max_steps=4, stop_at_limit=True
     )
     assert [len(list(wave.steps())) for wave in stopped] == [4]
@@ -92,7 +92,7 @@ def test_a_single_env_plays_as_the_same_episode_as_in_a_batch() -> None:
 
     def lengths(venv_for: Any, episodes: int) -> list[tuple[float, int]]:
         out = []
-        for wave in play_waves(act, venv_for, episodes, 7, 1, act_on="live"):
+        for wave in run_waves(act, venv_for, episodes, 7, 1, act_on="live"):
             list(wave.steps())
             out.append((float(wave.returns[0]), int(wave.lengths[0])))
         return out
@@ -104,4 +104,4 @@ def test_a_single_env_plays_as_the_same_episode_as_in_a_batch() -> None:
 
 def test_act_on_must_be_live_or_all() -> None:
     with pytest.raises(ValueError, match="act_on must be 'live' or 'all', got 'some'"):
-        next(play_waves(lambda o, v: o, lambda n: CountdownVenv(n), 1, 0, 1, act_on="some"))
+        next(run_waves(lambda o, v: o, lambda n: CountdownVenv(n), 1, 0, 1, act_on="some"))

@@ -94,12 +94,12 @@ def _checkpoint(path: Path) -> Path:
 def test_a_registered_module_goes_through_extract_query_ablation_and_report(
     registered: None, tmp_path: Path
 ) -> None:
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.cli import main
     from neurosym.envs import make
-    from neurosym.export.recording import Recording
     from neurosym.meaning.features import ablate_heads, head_vectors
     from neurosym.prolog.knowledge_base import KnowledgeBase
+    from neurosym.record.recording import Recording
 
     path = _checkpoint(tmp_path / "attention.pt")
     out = tmp_path / "extract"

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent
+from neurosym.agent.agent import load_agent
 
 ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONHASHSEED": "0"}

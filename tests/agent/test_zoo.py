@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import torch
 
-from neurosym.agent.checkpoint import load_agent
+from neurosym.agent.agent import load_agent
 from neurosym.errors import CheckpointError, ConfigError
 
 REPO = Path(__file__).resolve().parents[2]

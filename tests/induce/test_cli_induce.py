@@ -64,8 +64,8 @@ def test_without_holdout_only_train_scores(neurosym_main, kbs, tmp_path: Path) -
 def test_bad_input_is_one_line(
     neurosym_main, kbs, tmp_path: Path, args: list[str], message: str
 ) -> None:
-    from neurosym.export.facts import extract_facts
-    from neurosym.export.recording import Recording
+    from neurosym.facts.tables import extract_facts
+    from neurosym.record.recording import Recording
 
     empty = extract_facts(Recording()).to_prolog(tmp_path / "empty.pl")
     args = [{"KB": str(kbs[0]), "EMPTY": str(empty)}.get(a, a) for a in args]

@@ -67,8 +67,8 @@ def strategy_kb(path: Path, meta: tuple[str, str] = ("", ""), type_: str = "") -
 @pytest.fixture(scope="module")
 def world_kb(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A small real Relational-Grid-World KB of random-action episodes."""
-    from neurosym.export.facts import extract_facts
-    from neurosym.export.recorder import record
+    from neurosym.facts.tables import extract_facts
+    from neurosym.record.recorder import record
 
     rec = record(
         small_agent("rgw-random"), "rgw-random", 8, seed=0, actions="random",

@@ -10,11 +10,11 @@ import pytest
 from test_recorder import small_agent
 
 from neurosym.errors import ConfigError
-from neurosym.export.facts import extract_facts
-from neurosym.export.recorder import record
-from neurosym.export.recording import Recording
+from neurosym.facts.tables import extract_facts
 from neurosym.induce import induce_world
 from neurosym.induce.background import VOCABULARY
+from neurosym.record.recorder import record
+from neurosym.record.recording import Recording
 
 CASES = {  # env -> (env options, episodes)
     "rgw-random": ({"max_steps": 60, "enemy": "pass"}, 60),

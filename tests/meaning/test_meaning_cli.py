@@ -131,26 +131,26 @@ def test_bad_input_is_one_line(run_neurosym, tmp_path: Path, args: list[str], me
 
 def test_env_options_reach_the_played_env() -> None:
     """intervene and probe play --env (default: the agent's own) with --env-option on top, checked."""
-    from neurosym.agent.checkpoint import load_agent
-    from neurosym.cli import play_env
+    from neurosym.agent.agent import load_agent
+    from neurosym.cli import agent_env
     from neurosym.errors import ConfigError
-    from neurosym.export.recorder import record
+    from neurosym.record.recorder import record
 
     agent = load_agent(REPO / "checkpoints" / "rgw2-predinet.pt")
-    assert play_env(agent, None, []) == ("rgw2", agent.env_kwargs)
-    name, capped = play_env(agent, None, ["max_steps=3"])
+    assert agent_env(agent, None, []) == ("rgw2", agent.env_kwargs)
+    name, capped = agent_env(agent, None, ["max_steps=3"])
     assert capped == {**agent.env_kwargs, "max_steps": 3}
     assert agent.env_kwargs.get("max_steps") != 3  # the loaded agent is left as it was
     rec = record(agent, name, episodes=2, seed=0, greedy=True, env_kwargs=capped)
     assert rec.meta["env_kwargs"]["max_steps"] == 3
     assert int(rec.episodes["steps"].max()) <= 3  # its episodes end at 3 steps
     with pytest.raises(ConfigError, match="num_mountains"):
-        play_env(agent, None, ["num_mountains=12"])  # rgw2 takes no level parameters
+        agent_env(agent, None, ["num_mountains=12"])  # rgw2 takes no level parameters
     cellkeys = load_agent(REPO / "checkpoints" / "rgw-random-predinet-cellkeys.pt")
     # another env of the family: its options, not the agent's own (num_mountains=12) nor lost
-    assert play_env(cellkeys, "rgw2", ["max_steps=3"]) == ("rgw2", {"max_steps": 3})
+    assert agent_env(cellkeys, "rgw2", ["max_steps=3"]) == ("rgw2", {"max_steps": 3})
     with pytest.raises(ConfigError, match="unknown option 'num_mountains' for rgw2"):
-        play_env(cellkeys, "rgw2", ["num_mountains=12"])
+        agent_env(cellkeys, "rgw2", ["num_mountains=12"])
 
 
 @pytest.mark.parametrize(
@@ -160,7 +160,7 @@ def test_env_options_reach_the_played_env() -> None:
 def test_intervene_changes_the_level_of_the_env_asked_for(checkpoint: str, env: str) -> None:
     """On another env than the agent's, every level change is played (the sword removed is
     never picked up), not the unchanged level under the change's name."""
-    from neurosym.agent.checkpoint import load_agent
+    from neurosym.agent.agent import load_agent
     from neurosym.meaning.intervene import intervene
 
     agent = load_agent(REPO / "checkpoints" / checkpoint)

@@ -1,4 +1,4 @@
-"""PrologAgent and play_policy: fallbacks counted, strategy errors, eval's figures under eval's names."""
+"""PrologAgent and score_strategy: fallbacks counted, strategy errors, eval's figures under eval's names."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from neurosym.agent.cli_eval import score
+from neurosym.agent.evaluation import score
 from neurosym.envs.rgw_solver import Planner
 from neurosym.errors import ConfigError, PrologError
-from neurosym.play import PrologAgent, play_policy, read_policy
+from neurosym.play import PrologAgent, read_policy, score_strategy
 
 ROOT = Path(__file__).resolve().parents[2]
 RGW = ROOT / "examples" / "play" / "rgw_strategy.pl"
@@ -23,8 +23,8 @@ def _policy(tmp_path: Path, text: str) -> Path:
 
 
 def test_the_report_has_evals_names_and_figures() -> None:
-    report = play_policy(RGW, "rgw2", 2)
-    planner = score(Planner(), "rgw2", 2)
+    report = score_strategy(RGW, "rgw2", 2)
+    planner = score(Planner(), "rgw2", 2).as_dict()
     assert set(planner) <= set(report)
     assert report["mean_return"] == pytest.approx(10.7) and report["optimal_rate"] == 1.0
     assert report["outcomes"] == {"terminal": 2} and report["fallback_steps"] == 0
@@ -33,7 +33,7 @@ def test_the_report_has_evals_names_and_figures() -> None:
 
 def test_the_hand_written_strategy_is_optimal_where_the_planner_is() -> None:
     """rgw-random seed 1000: the planner earns every optimal return (tests/agent/test_evaluation.py)."""
-    report = play_policy(RGW, "rgw-random", 12, seed=1000)
+    report = score_strategy(RGW, "rgw-random", 12, seed=1000)
     assert report["success_rate"] == 1.0 and report["sword_first_guarded"] == 1.0
     assert report["optimal_rate"] >= 0.9
 
@@ -41,7 +41,7 @@ def test_the_hand_written_strategy_is_optimal_where_the_planner_is() -> None:
 def test_no_answer_of_goal_falls_back_to_the_default_goal(tmp_path: Path) -> None:
     """route.pl's default_goal/3 plays instead: the sword, the enemy, the terminal."""
     policy = _policy(tmp_path, "goal(_, 0, sword).\n")
-    report = play_policy(policy, "rgw2", 1)
+    report = score_strategy(policy, "rgw2", 1)
     assert report["fallbacks"] == {"no_goal": report["steps"] - 1}
     assert list(report["goals"]) == ["enemy", "sword", "terminal"]
     assert report["mean_return"] == pytest.approx(10.7) and report["outcomes"] == {"terminal": 1}
@@ -54,14 +54,14 @@ def test_a_state_seen_before_goes_to_the_default_goal(tmp_path: Path) -> None:
         tmp_path,
         "goal(E, T, O) :- at(E, T, agent, R, C), ( 0 is (R + C) mod 2 -> O = sword ; O = terminal ).\n",
     )
-    report = play_policy(flip, "rgw-random", 1, seed=12)
+    report = score_strategy(flip, "rgw-random", 1, seed=12)
     assert report["fallbacks"].get("loop", 0) > 0
     assert report["outcomes"] == {"terminal": 1}
 
 
 def test_a_goal_off_the_map_counts_as_no_route(tmp_path: Path) -> None:
     policy = _policy(tmp_path, "goal(_, T, unicorn) :- T > 0.\ngoal(_, 0, sword).\n")
-    report = play_policy(policy, "rgw1", 1)
+    report = score_strategy(policy, "rgw1", 1)
     assert report["fallbacks"] == {"no_route": report["steps"] - 1}
 
 
@@ -78,7 +78,7 @@ def test_a_strategy_that_never_chose_is_refused(
     """Every step a fallback: the figures would be route.pl's default strategy's, not its own."""
     policy = policy or _policy(tmp_path, "goal(_, _, _) :- fail.\n")
     with pytest.raises(ConfigError) as info:
-        play_policy(policy, env, 2)
+        score_strategy(policy, env, 2)
     assert str(info.value) == (
         f"{policy} chose no object it could reach in any of the {causes.split()[1]} steps on "
         f"{env} (fallbacks: {causes}); is it a strategy for another env (its goal/3 names "
@@ -89,7 +89,7 @@ def test_a_strategy_that_never_chose_is_refused(
 def test_a_strategy_that_raises_stops_with_one_line(tmp_path: Path) -> None:
     policy = _policy(tmp_path, "goal(E, T, O) :- O is E / T.\n")
     with pytest.raises(PrologError, match=r"strategy\.pl: .*(evaluable|zero|Arithmetic)") as info:
-        play_policy(policy, "rgw2", 1)
+        score_strategy(policy, "rgw2", 1)
     assert "\n" not in str(info.value)
 
 
@@ -242,7 +242,7 @@ def test_a_file_name_that_is_not_utf8_is_refused(tmp_path: Path) -> None:
     name = os.fsdecode(os.fsencode(str(tmp_path)) + b"/bad\xff.pl")
     Path(name).write_text("goal(_, _, terminal).\n")
     with pytest.raises(ConfigError) as info:
-        play_policy(name, "rgw2", 1)
+        score_strategy(name, "rgw2", 1)
     assert str(info.value) == (
         f"--policy {name!r}: the file name is not UTF-8, which SWI-Prolog needs; rename the file"
     )
@@ -257,5 +257,5 @@ def test_a_strategy_may_define_library_predicate_names(tmp_path: Path) -> None:
         "reachable(E, T, O) :- route_exists(E, T, O).\n"
         "goal(E, T, O) :- member(O, [sword, terminal]), reachable(E, T, O).\n",
     )
-    report = play_policy(policy, "rgw2", 1)
+    report = score_strategy(policy, "rgw2", 1)
     assert report["fallback_steps"] == 0 and report["outcomes"] == {"terminal": 1}

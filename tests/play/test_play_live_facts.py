@@ -14,12 +14,12 @@ from typing import Any
 import numpy as np
 import pytest
 
-from neurosym.agent.checkpoint import load_agent
+from neurosym.agent.agent import load_agent
 from neurosym.agent.evaluation import play_scored
 from neurosym.envs.actions import ACTION_NAMES
-from neurosym.export.facts import extract_facts
-from neurosym.export.recorder import record
+from neurosym.facts.tables import extract_facts
 from neurosym.play import PrologAgent
+from neurosym.record.recorder import record
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = 40

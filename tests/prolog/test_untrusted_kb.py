@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 
 from neurosym.errors import ConfigError, NeurosymError, PrologError
-from neurosym.export.prolog_writer import write_prolog
+from neurosym.facts.prolog_writer import write_prolog
 from neurosym.prolog.knowledge_base import KnowledgeBase
 from neurosym.prolog.signature import signature_path
 from neurosym.terms import atom_text

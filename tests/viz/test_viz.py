@@ -12,8 +12,8 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from neurosym.errors import ConfigError
-from neurosym.export.recording import Recording
-from neurosym.export.thresholds import parse_threshold
+from neurosym.facts.thresholds import parse_threshold
+from neurosym.record.recording import Recording
 from neurosym.viz import episode as ep_mod
 from neurosym.viz.attention import mhdpa_figure
 from neurosym.viz.output import figure_bytes, gif_bytes, save_figure

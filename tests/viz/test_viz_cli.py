@@ -18,12 +18,13 @@ import pytest
 import torch
 from PIL import Image
 
-from neurosym.agent.checkpoint import load_agent, save_checkpoint
+from neurosym.agent.agent import load_agent
+from neurosym.agent.checkpoint import save_checkpoint
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.cli import main
 from neurosym.envs import env_family, make
-from neurosym.export.recorder import record
+from neurosym.record.recorder import record
 
 ROOT = Path(__file__).resolve().parents[2]
 DPI = "40"
@@ -281,7 +282,7 @@ def test_a_recording_and_a_live_run_of_the_same_seed_draw_the_same_episode(
 def test_the_default_threshold_is_extracts() -> None:
     import argparse
 
-    from neurosym.export.facts import DEFAULT_THRESHOLD
+    from neurosym.facts.tables import DEFAULT_THRESHOLD
     from neurosym.viz.cli_plot import configure
 
     parser = argparse.ArgumentParser()
