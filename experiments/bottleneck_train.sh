@@ -3,7 +3,7 @@
 # env's planner, starting from the cell-keyed agent's encoder, attention and MLP
 # (experiments/bottleneck_init.py); niced, snapshots every 8 minutes for the learning curve.
 #   sh experiments/bottleneck_train.sh RUN MINUTES            # a new run in runs/RUN
-#   sh experiments/bottleneck_train.sh RUN MINUTES --resume   # continue it
+#   sh experiments/bottleneck_train.sh RUN MINUTES --resume   # continue it (LR=1e-4: its lr)
 # Then, per snapshot: neurosym eval --checkpoint FILE --episodes 300 --seed 3000000000 --sample
 set -eu
 RUN=${1:-bn1}
@@ -11,7 +11,7 @@ MINUTES=${2:-55}
 PY=${PY:-python}
 if [ "${3:-}" = "--resume" ]; then
     exec nice -n 10 $PY -m neurosym train --out "runs/$RUN" --resume --minutes "$MINUTES" \
-        --snapshot-every 8 --quiet
+        --snapshot-every 4 --quiet ${LR:+--lr $LR}
 fi
 $PY experiments/bottleneck_init.py checkpoints/rgw-random-predinet-cellkeys.pt \
     "runs/$RUN-init.pt" --tau 0.25 --env-option num_mountains=6
