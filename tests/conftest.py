@@ -7,6 +7,7 @@ import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -133,3 +134,49 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             getattr(item, "fixturenames", ())
         ):
             item.add_marker(pytest.mark.subprocess)
+
+
+# Builders the tests share (tests/builders.py), as fixtures: a test asks for one by name and
+# calls it, e.g. ``def test_x(scripted_recording): rec = scripted_recording()``.
+
+
+@pytest.fixture(scope="session")
+def small_agent() -> Callable[..., Any]:
+    """``small_agent(env, module="predinet")``: a small untrained agent (torch seed 0)."""
+    from builders import small_agent
+
+    return small_agent
+
+
+@pytest.fixture(scope="session")
+def scripted_recording() -> Callable[..., Any]:
+    """``scripted_recording(module="predinet")``: rgw2 episodes along fixed plans (builders.PLANS)."""
+    from builders import scripted_recording
+
+    return scripted_recording
+
+
+@pytest.fixture(scope="session")
+def explorer_recording() -> Callable[..., Any]:
+    """``explorer_recording(env="bw2", episodes=8)``: Box-World episodes of a scripted explorer."""
+    from builders import explorer_recording
+
+    return explorer_recording
+
+
+@pytest.fixture(scope="session")
+def small_checkpoint() -> Callable[..., Any]:
+    """``small_checkpoint(path, module, max_steps, **sizes)``: a small untrained rgw2 checkpoint."""
+    from builders import small_checkpoint
+
+    return small_checkpoint
+
+
+@pytest.fixture(scope="session")
+def play_one_episode() -> Callable[..., Any]:
+    """``play_one_episode(path, route, env_name=None)``: one greedy episode of a checkpoint,
+    (return, the route's events met in order, steps)."""
+    from builders import play_one_episode
+
+    return play_one_episode
+

@@ -187,3 +187,16 @@ def test_the_link_check_finds_what_it_must(tmp_path: Path) -> None:
         ["query", "--kb", "kb.pl", "x(A)"],
     ]
     assert links(page) == [(8, "docs/images/episode.png"), (8, "docs/nowhere.md")]
+
+
+def test_design_md_shows_every_package() -> None:
+    """design.md's layout names every package of neurosym/ (a folder with __init__.py)."""
+    text = (REPO / "docs" / "design.md").read_text()
+    layout = text[text.index("## Layout") :]
+    layout = layout[: layout.index("\n## ", 1)]
+    packages = sorted(
+        p.parent.relative_to(REPO / "neurosym").as_posix()
+        for p in (REPO / "neurosym").glob("*/__init__.py")
+    )
+    missing = [name for name in packages if f"  {name}/" not in layout]
+    assert packages and not missing, f"docs/design.md's layout lacks {missing}"

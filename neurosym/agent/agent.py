@@ -61,12 +61,22 @@ class Agent:
 
 
 def load_agent(
-    path: str | os.PathLike[str], env: str | None = None, config: ModelConfig | None = None
+    path: str | os.PathLike[str],
+    env: str | None = None,
+    config: ModelConfig | None = None,
+    play_env: str | None = None,
 ) -> Agent:
     """Load a checkpoint as an :class:`Agent` (CheckpointError, one line, for every bad file).
 
-    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`.
+    ``env`` and ``config`` are optional expectations, see :func:`read_checkpoint`. An agent
+    trained elsewhere (``FILE.py:FUNCTION``, an SB3 ``.zip``) loads through
+    :func:`neurosym.outside.load_outside`; ``play_env`` (a command's ``--env``) is the env an
+    SB3 model plays, whose file does not say which (ignored for a checkpoint).
     """
+    from neurosym.outside.load import load_outside, outside_spec
+
+    if config is None and outside_spec(path) is not None:
+        return load_outside(str(path), env or play_env)
     path = checkpoint_file(path)
     payload = read_checkpoint(path, env=env, config=config)
     model = build_model(payload, path)

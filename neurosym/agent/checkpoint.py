@@ -518,13 +518,14 @@ def check_env_fits(
     env_kwargs: dict[str, Any],
 ) -> None:
     """Refuse, in one line naming both, an env of another family or observation shape."""
-    from neurosym.envs import ENVS, canonical_name, env_family, make
+    from neurosym.envs import canonical_name, env_family, make
+    from neurosym.envs.registration import family_members
 
     name, trained = canonical_name(env), canonical_name(trained)
     family, theirs = env_family(trained), env_family(name)
     shape = tuple(int(v) for v in obs_shape)
     if family != theirs:
-        same = ", ".join(n for n in ENVS if env_family(n) == family)
+        same = family_members(family)
         raise CheckpointError(
             f"{label} was trained on {trained} ({family} family, observations {shape}); "
             f"{name} is a {theirs} environment: pick one of {same}"

@@ -32,7 +32,7 @@ class EvalOptions(EnvChoice, Episodes, ActionMode, Json):
     """``neurosym eval``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """checkpoint file (.pt) written by neurosym train, or a shipped agent's name"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     json: bool = False
     """print one JSON object"""
 
@@ -51,7 +51,7 @@ def run(args: EvalOptions) -> int:
 
     torch.set_num_threads(1)
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
     env, kwargs = env_for(agent, env, overrides)
     report = evaluate(agent, env, args.episodes, args.greedy, args.seed, kwargs).as_dict()

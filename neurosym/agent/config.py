@@ -46,7 +46,7 @@ from neurosym.errors import ConfigError
 from neurosym.flags import field_docs, option_name  # noqa: F401 (the train command's too)
 
 MODULES = ("predinet", "mhdpa")
-FAMILIES = ("rgw", "boxworld")
+FAMILIES = ("rgw", "boxworld", "minigrid")
 PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
 OPTIMIZERS = ("adam", "rmsprop")
@@ -162,11 +162,14 @@ def check_ranges(config: Any) -> None:
 _MODEL_FAMILY: dict[str, dict[str, Any]] = {
     "rgw": {"key_size": 32},
     "boxworld": {"key_size": 64},
+    # Minigrid: not in the thesis; RGW's key size, and Minigrid's seven actions
+    "minigrid": {"key_size": 32, "n_actions": 7},
 }
 # Table 4 exactly (preset "thesis"): classic A3C, RMSprop with epsilon 0.1.
 _THESIS_TRAIN: dict[str, dict[str, Any]] = {
     "rgw": {"lr": 2e-3, "entropy": 0.02},
     "boxworld": {"lr": 2e-4, "entropy": 0.01},
+    "minigrid": {"lr": 2e-4, "entropy": 0.01},
 }
 _THESIS_COMMON: dict[str, Any] = {
     "optimizer": "rmsprop",
@@ -199,6 +202,8 @@ _DEFAULT_TRAIN: dict[str, dict[str, Any]] = {
     # critic's loss (and its pull on the shared layers) far larger than the actor's;
     # self-imitation, without which A3C on bw1 stays far from solving it.
     "boxworld": {"lr": 5e-4, "entropy": 0.01, "reward_scale": 0.1, "sil": 1.0},
+    # Minigrid: Box-World's learner without the reward scale (Minigrid pays at most 1)
+    "minigrid": {"lr": 5e-4, "entropy": 0.01, "sil": 1.0},
 }
 # PPO: no exploration aids, the plain comparison point.
 _PPO_TRAIN: dict[str, Any] = {
@@ -230,6 +235,7 @@ _DEFAULT_MODEL: dict[str, dict[str, Any]] = {
     # entities, so key size 64 makes that one layer nearly all of the weights and most of
     # a forward-backward; 32 halves both
     "boxworld": {**_SEEING_MODEL, "key_size": 32},
+    "minigrid": {**_SEEING_MODEL, "key_size": 32},
 }
 _DEFAULT_PREDINET: dict[str, dict[str, Any]] = {
     # Box-World: learned queries. Scene queries (Q = flat(L) W_Q) let one update fix every

@@ -18,8 +18,9 @@ from typing import Any, NamedTuple
 import numpy as np
 import torch
 
-SUCCESS_OUTCOMES = ("terminal", "gem")
-"""Outcomes that count as solving an episode (RGW terminal, Box-World gem)."""
+SUCCESS_OUTCOMES = ("terminal", "gem", "goal", "mission")
+"""Outcomes that count as solving an episode (RGW terminal, Box-World gem, Minigrid goal or
+mission)."""
 
 
 def select_actions(

@@ -1,5 +1,7 @@
 """``neurosym envs``: list the environments (short name, gymnasium id, one line each).
 
+The Minigrid family lists every id Farama's Minigrid registers (``MiniGrid-*``, ``BabyAI-*``).
+
 ``--json`` prints one JSON object per line instead of a table; ``--show NAME``
 prints the first state of one environment as text.
 """
@@ -11,7 +13,7 @@ import json
 import sys
 from dataclasses import dataclass
 
-from neurosym.envs.registration import ENTRIES, canonical_name
+from neurosym.envs.registration import all_entries, canonical_name
 from neurosym.flags import Json, add_options, option
 
 
@@ -32,8 +34,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: EnvsOptions) -> int:
     if args.show:
         return _show(args.show)
+    entries = all_entries()  # neurosym's own, then every Minigrid and BabyAI id
     if args.json:
-        for e in ENTRIES:
+        for e in entries:
             row = {"name": e.short, "id": e.id, "family": e.family, "description": e.description}
             print(json.dumps(row))
         return 0
@@ -46,11 +49,11 @@ def run(args: EnvsOptions) -> int:
     for column in ("name", "id", "family"):  # names never wrap; the description does, at spaces
         table.add_column(column, no_wrap=True)
     table.add_column("description")
-    for e in ENTRIES:
+    for e in entries:
         table.add_row(show(e.short), show(e.id), show(e.family), show(e.description))
     console = Console()
     if not console.is_terminal:  # piped: never wrap, whatever width rich guesses
-        rows = [(e.short, e.id, e.family, e.description) for e in ENTRIES]
+        rows = [(e.short, e.id, e.family, e.description) for e in entries]
         natural = sum(max(len(r[i]) for r in rows) + 3 for i in range(4)) + 1
         console = Console(width=max(natural, console.width))
     console.print(table)

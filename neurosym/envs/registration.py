@@ -37,6 +37,10 @@ _RGW = "neurosym.envs.rgw:RGWEnv"
 _RGW_VEC = "neurosym.envs.rgw_vector:RGWVectorEnv"
 _BW = "neurosym.envs.boxworld:BoxWorldEnv"
 _BW_VEC = "neurosym.envs.boxworld:BoxWorldVectorEnv"
+_MG = "neurosym.envs.minigrid_env:MinigridEnv"
+_MG_VEC = "neurosym.envs.minigrid_env:MinigridVectorEnv"
+MINIGRID_PREFIXES = ("MiniGrid-", "BabyAI-")
+"""the ids of Farama's Minigrid package: every one is a neurosym env of family ``minigrid``"""
 
 ENTRIES: tuple[EnvEntry, ...] = (
     EnvEntry(
@@ -111,29 +115,113 @@ _BY_NAME: dict[str, EnvEntry] = {**{e.short: e for e in ENTRIES}, **{e.id: e for
 
 
 def register_envs() -> None:
-    """Register every id with gymnasium (idempotent; done on import of neurosym.envs)."""
+    """Register every neurosym id with gymnasium (idempotent; done on import of neurosym.envs).
+
+    The Minigrid family's ids (``neurosym/MiniGrid-DoorKey-5x5-v0``) are registered
+    when one is first named, so that importing neurosym does not import Minigrid.
+    """
+    for e in ENTRIES:
+        _register(e)
+
+
+def _register(e: EnvEntry) -> None:
     import gymnasium
 
-    for e in ENTRIES:
-        if e.id not in gymnasium.registry:
-            gymnasium.register(
-                id=e.id,
-                entry_point=e.entry_point,
-                vector_entry_point=e.vector_entry_point,
-                kwargs=dict(e.kwargs),
-                nondeterministic=False,
-            )
+    if e.id not in gymnasium.registry:
+        gymnasium.register(
+            id=e.id,
+            entry_point=e.entry_point,
+            vector_entry_point=e.vector_entry_point,
+            kwargs=dict(e.kwargs),
+            nondeterministic=False,
+        )
+
+
+MINIGRID_UNSUPPORTED: dict[str, str] = {
+    "minigrid.envs:DynamicObstaclesEnv": "its env takes 3 actions (left, right, forward), "
+    "not Minigrid's 7",
+    "minigrid.envs.wfc": "its env needs Minigrid's wfc extra (imageio, networkx), which neurosym "
+    "does not install",
+}
+"""Minigrid env classes (``module:Class``) or modules left out of the family, and why"""
+
+
+def _minigrid_class(spec: Any) -> str:
+    return str(spec.entry_point).rpartition(":")[2] if isinstance(spec.entry_point, str) else ""
+
+
+def _unsupported(spec: Any) -> str | None:
+    """Why neurosym does not play the env of a Minigrid spec, or None when it does."""
+    point = str(spec.entry_point) if isinstance(spec.entry_point, str) else ""
+    return MINIGRID_UNSUPPORTED.get(point) or MINIGRID_UNSUPPORTED.get(point.partition(":")[0])
+
+
+@functools.cache
+def minigrid_entries() -> tuple[EnvEntry, ...]:
+    """One EnvEntry per id Farama's Minigrid registers (``MiniGrid-*``, ``BabyAI-*``).
+
+    The short name is Minigrid's own id (``--env MiniGrid-DoorKey-5x5-v0``); the
+    gymnasium id neurosym registers for it is ``neurosym/`` + that id, whose
+    env is :class:`~neurosym.envs.minigrid_env.MinigridEnv` over Minigrid's.
+    """
+    import gymnasium
+    import minigrid  # noqa: F401  (registers its ids with gymnasium)
+
+    out = []
+    for name, spec in gymnasium.registry.items():
+        if not name.startswith(MINIGRID_PREFIXES):
+            continue
+        if _unsupported(spec) is not None:
+            continue
+        cls = _minigrid_class(spec)
+        options = ", ".join(f"{k}={v!r}" for k, v in sorted(spec.kwargs.items()))
+        package = "BabyAI" if name.startswith("BabyAI-") else "Minigrid"
+        description = f"{package} {cls}{f' ({options})' if options else ''}"
+        out.append(EnvEntry(name, f"neurosym/{name}", "minigrid", _MG, _MG_VEC, description,
+                            {"env_id": name}))  # fmt: skip
+    return tuple(out)
+
+
+def all_entries() -> tuple[EnvEntry, ...]:
+    """Every environment: neurosym's own (:data:`ENTRIES`), then the Minigrid family's."""
+    return ENTRIES + minigrid_entries()
 
 
 def entry(name_or_id: str) -> EnvEntry:
     """The EnvEntry of a short name or id, or ConfigError listing the known names."""
     found = _BY_NAME.get(name_or_id)
-    if found is None:
-        raise ConfigError(
-            f"unknown environment {name_or_id!r}; expected one of {', '.join(ENVS)} "
-            f"or an id such as {ENVS['rgw2']}"
-        )
-    return found
+    if found is not None:
+        return found
+    name = str(name_or_id).removeprefix("neurosym/")
+    if name.startswith(MINIGRID_PREFIXES):
+        return _minigrid_entry(name)
+    raise ConfigError(
+        f"unknown environment {name_or_id!r}; expected one of {', '.join(ENVS)}, "
+        f"an id such as {ENVS['rgw2']}, or a Minigrid id such as MiniGrid-DoorKey-5x5-v0"
+    )
+
+
+def _minigrid_entry(name: str) -> EnvEntry:
+    """The Minigrid family's entry of an id, or one line naming the nearest ids."""
+    import difflib
+
+    import gymnasium
+
+    entries = {e.short: e for e in minigrid_entries()}
+    found = entries.get(name)
+    if found is not None:
+        _register(found)
+        return found
+    spec = gymnasium.registry.get(name)
+    why = _unsupported(spec) if spec is not None else None
+    if why is not None:
+        raise ConfigError(f"Minigrid environment {name!r} is not one neurosym plays: {why}")
+    near = difflib.get_close_matches(name, list(entries), n=3, cutoff=0.75)
+    hint = f"did you mean {', '.join(near[:-1]) + ' or ' if near[1:] else ''}{near[-1]}? " if near else ""
+    raise ConfigError(
+        f"unknown Minigrid environment {name!r}; {hint}`neurosym envs` lists the "
+        f"{len(entries)} Minigrid and BabyAI ids"
+    )
 
 
 def canonical_name(name_or_id: str) -> str:
@@ -142,8 +230,16 @@ def canonical_name(name_or_id: str) -> str:
 
 
 def env_family(name_or_id: str) -> str:
-    """``"rgw"`` or ``"boxworld"``."""
+    """``"rgw"``, ``"boxworld"`` or ``"minigrid"``."""
     return entry(name_or_id).family
+
+
+def family_members(family: str) -> str:
+    """The envs of a family as error messages name them: ``rgw1, rgw2, rgw-random``, or for
+    Minigrid's 166 ids a pointer to ``neurosym envs``."""
+    if family == "minigrid":
+        return "the MiniGrid-* and BabyAI-* ids (`neurosym envs` lists them)"
+    return ", ".join(e.short for e in ENTRIES if e.family == family)
 
 
 RENDER_ONLY_OPTIONS = ("render_mode", "tile_size")
@@ -220,6 +316,7 @@ def make(name: str, **kwargs: Any) -> Any:
     e = entry(name)
     check_options(name, kwargs)
     register_envs()
+    _register(e)
     return gymnasium.make(e.id, **kwargs)
 
 
@@ -235,6 +332,7 @@ def make_batched(name: str, n: int, seed: int | None = None, **kwargs: Any) -> A
         raise ConfigError(f"number of environments must be a positive integer, got {n!r}")
     check_options(name, kwargs, batched=True)
     register_envs()
+    _register(e)
     return gymnasium.make_vec(
         e.id, num_envs=n, vectorization_mode="vector_entry_point", seed=seed, **kwargs
     )

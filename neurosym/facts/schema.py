@@ -129,16 +129,18 @@ SCHEMA: dict[str, Predicate] = {
         _p("object", "id:Id:atom type:term", "every named object of the recorded maps",
            TRACE, "extract intervene"),
         _p("episode", "episode:E:int steps:int return:float outcome:atom",
-           "Outcome: `terminal`, `pit`, `enemy`, `timeout`, `gem`, `distractor`",
+           "Outcome: `terminal`, `pit`, `enemy`, `timeout`, `gem`, `distractor`; Minigrid `goal`, "
+           "`mission`, `lava`, `failure`",
            TRACE, "extract intervene"),
         _p("grid", "episode:E:int rows:int cols:int",
            "the size of episode E's map (the entity grid's shape)", TRACE, "extract intervene"),
         _p("terrain", "episode:E:int type:term row:int col:int",
            "every non-empty cell of E's map after the reset that holds no object and is not "
-           "the agent (RGW `wall`, `mountain`; Box-World `wall`); terrain never changes within "
-           "an episode", TRACE, "extract intervene"),
+           "the agent (RGW `wall`, `mountain`; Box-World `wall`; Minigrid `wall`, `lava`, "
+           "`floor`); terrain never changes within an episode", TRACE, "extract intervene"),
         _p("step", "episode:E:int t:T:int action:atom reward:float",
-           "the action taken in state T (`up, right, down, left`) and its reward",
+           "the action taken in state T (`up, right, down, left`; Minigrid `left, right, forward, "
+           "pickup, drop, toggle, done`) and its reward",
            TRACE, "extract intervene"),
         _p("at", "episode:E:int t:T:int id:Id:atom row:int col:int",
            "where object Id is in state T (T in 0..S)", TRACE, "extract intervene"),
@@ -147,6 +149,15 @@ SCHEMA: dict[str, Predicate] = {
         _p("event", "episode:E:int t:T:int event:term",
            "an event of the step from state T to T+1 (`picked(sword)`, `defeated(enemy)`, "
            "`opened(lock(red))`, ...)", TRACE, "extract intervene"),
+        _p("facing", "episode:E:int t:T:int direction:Dir:atom",
+           "the agent's direction in state T (Minigrid: `east`, `south`, `west`, `north`)",
+           TRACE, "extract"),
+        _p("door_state", "episode:E:int t:T:int id:Id:atom state:atom",
+           "the state of door Id in state T (Minigrid: `open`, `closed`, `locked`)",
+           TRACE, "extract"),
+        _p("mission", "episode:E:int text:atom",
+           "episode E's mission as the env words it (Minigrid, BabyAI: `go to the red ball`)",
+           TRACE, "extract"),
         _p("attends",
            "episode:E:int t:T:int head:int arg:int entity:term row:int col:int weight:float",
            "PrediNet: Arg 1 or 2, the argmax cell of a1 or a2, the entity there and its weight",

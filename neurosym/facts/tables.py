@@ -8,6 +8,7 @@
     grid(E, Rows, Cols)            terrain(E, Type, Row, Col)
     step(E, T, Action, Reward)     at(E, T, Id, Row, Col)
     holding(E, T, Item)            event(E, T, Event)
+    facing(E, T, Dir)              door_state(E, T, Id, State)     mission(E, Text)
     attends(E, T, Head, Arg, Entity, Row, Col, Weight)
     relation(E, T, Head, J, A, B, Value)
     holds(E, T, r(J), A, B)        threshold(J, Value)
@@ -326,6 +327,9 @@ def extract_facts(
         ),
         "holding": _frame("holding", rec.holding),
         "event": _frame("event", rec.events),
+        "facing": _frame("facing", rec.facing),
+        "door_state": _frame("door_state", rec.doors),
+        "mission": _frame("mission", rec.missions),
         "attends": _frame("attends", rec.attends),
         "relation": _frame("relation", rec.relations),
         "holds": holds_table(rec.relations, thr, per_j),

@@ -1,9 +1,11 @@
 """A KB's acted states grounded on the background predicates: the learner's examples.
 
-:func:`ground` loads a KB with :data:`~neurosym.induce.background.BACKGROUND`
-as its rule file and asks Prolog for every answer of ``ahead/3``,
-``left_of_ahead/3``, ``right_of_ahead/3``, ``holding/3`` and ``on_map/3`` at
-the states with a ``step/4`` fact, plus the events. The learner then works on
+:func:`ground` loads a KB, tells its env family, loads the family's background
+(:data:`~neurosym.induce.background.FAMILIES`) as its rule file and asks Prolog
+for every answer of the family's body predicates (RGW and Box-World
+``ahead/3``, ``left_of_ahead/3``, ``right_of_ahead/3``, ``holding/3``,
+``on_map/3``; Minigrid ``action/3``, ``ahead/3``, ``ahead_door/3``,
+``carrying/3``) at the states with a ``step/4`` fact, plus the events. The learner then works on
 these answers as dense boolean matrices (state x value), so what it learns
 from is exactly what Prolog derives from the same facts.
 """
@@ -20,10 +22,11 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError
-from neurosym.induce.background import BACKGROUND, CELL_PREDICATES, COLOURED, STATE_PREDICATES
+from neurosym.induce.background import COLOURED, FAMILIES
 from neurosym.terms import format_value
 
-PREDICATES = CELL_PREDICATES + STATE_PREDICATES
+PREDICATES = FAMILIES["rgw"].predicates
+"""RGW's and Box-World's body predicates (the default bias's)"""
 _COLOURED = re.compile(r"(" + "|".join(COLOURED) + r")\(([a-z][A-Za-z0-9_]*)\)")
 
 
@@ -100,8 +103,15 @@ def _canonical(column: pd.Series) -> pd.Series:
     return column.map(text)
 
 
+_MINIGRID_TYPE = re.compile(r"(door|ball|box)\(.*\)|goal")
+
+
 def env_family(types: list[str], env: str) -> str:
-    """The env family (``rgw`` or ``boxworld``) of a KB with these object types and this env."""
+    """The env family (``rgw``, ``boxworld`` or ``minigrid``) of a KB with these object types
+    and this env."""
+    env = env.strip("'")
+    if env.startswith(("MiniGrid-", "BabyAI-")) or any(_MINIGRID_TYPE.fullmatch(t) for t in types):
+        return "minigrid"
     if env.startswith(("bw", "boxworld")) or any(
         _COLOURED.fullmatch(t) or t == "gem" for t in types
     ):
@@ -122,14 +132,23 @@ def ground(kb_path: str | os.PathLike[str]) -> Grounded:
         raise ConfigError(
             f"KB {path} does not exist (give a knowledge base written by neurosym extract)"
         )
-    with tempfile.TemporaryDirectory(prefix="neurosym-induce-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="neurosym-induce-") as tmp, KnowledgeBase(path) as kb:
+        family = _family(kb)
         rules = Path(tmp) / "background.pl"
-        rules.write_text(BACKGROUND)
-        with KnowledgeBase(path, rules=[rules]) as kb:
-            return _ground(kb, path)
+        rules.write_text(FAMILIES[family].background)
+        kb.load_rules(rules)
+        return _ground(kb, path, family)
 
 
-def _ground(kb: object, path: Path) -> Grounded:
+def _family(kb: object) -> str:
+    """The KB's env family, from its ``kb_meta(env, _)`` and its objects' types."""
+    meta = kb.query_df("kb_meta(env, V)")  # type: ignore[attr-defined]
+    env = str(meta["V"].iloc[0]) if len(meta) else ""
+    types = [str(t) for t in kb.query_df("object(_, Ty)")["Ty"]]  # type: ignore[attr-defined]
+    return env_family(types, env)
+
+
+def _ground(kb: object, path: Path, family: str) -> Grounded:
     steps = kb.query_df("step(E, T, _, _)")  # type: ignore[attr-defined]
     if steps.empty:
         raise ConfigError(f"KB {path} has no step/4 facts: nothing to learn world rules from")
@@ -146,7 +165,7 @@ def _ground(kb: object, path: Path) -> Grounded:
     keys = steps[["E", "T"]].drop_duplicates().sort_values(["E", "T"]).to_numpy(dtype=np.int64)
     index = pd.DataFrame({"E": keys[:, 0], "T": keys[:, 1], "s": np.arange(len(keys))})
     answers = {}
-    for pred in PREDICATES:
+    for pred in FAMILIES[family].predicates:
         df = kb.query_df(f"{pred}(E, T, W), step(E, T, _, _)")  # type: ignore[attr-defined]
         df = df.assign(W=_canonical(df["W"])).merge(index, on=["E", "T"])
         answers[pred] = df[["s", "W"]].drop_duplicates()
@@ -159,11 +178,10 @@ def _ground(kb: object, path: Path) -> Grounded:
         m = np.zeros((len(keys), len(values)), dtype=bool)
         m[df["s"].to_numpy(), df["W"].map(vindex).to_numpy()] = True
         matrix[pred] = m
-    types = [str(t) for t in kb.query_df("object(_, Ty)")["Ty"]]  # type: ignore[attr-defined]
     return Grounded(
         source=str(path),
         env=env,
-        family=env_family(types, env),
+        family=family,
         keys=keys,
         values=values,
         matrix=matrix,

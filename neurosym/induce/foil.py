@@ -4,10 +4,12 @@ Head: ``predicts(E, T, Event)`` for one event template of the vocabulary
 (``picked(sword)``, ``opened(lock(C))``). Body literals (the bias), each
 about state T of episode E:
 
-* ``P(E, T, Value)`` and ``\\+ P(E, T, Value)`` for P in ahead/3,
-  left_of_ahead/3, right_of_ahead/3, holding/3, on_map/3, Value an uncoloured
-  constant the data shows (``sword``, ``wall``, ``border``, ``empty``);
-* ``P(E, T, F(V))`` for F a coloured type (``key``, ``lock``) and V the
+* ``P(E, T, Value)`` and ``\\+ P(E, T, Value)`` for P a body predicate of the
+  bias (the env family's: RGW and Box-World ahead/3, left_of_ahead/3,
+  right_of_ahead/3, holding/3, on_map/3; Minigrid action/3, ahead/3,
+  ahead_door/3, carrying/3), Value an uncoloured constant the data shows
+  (``sword``, ``wall``, ``border``, ``empty``, ``toggle``, ``nothing``);
+* ``P(E, T, F(V))`` for F a coloured type (``key``, ``lock``, ``door``) and V the
   head's colour variable, a variable already in the clause, a new variable
   (at most :attr:`Bias.max_new_vars` in a clause) or ``_``; negated only with
   a bound variable or ``_`` (so negation is always safe).
@@ -32,7 +34,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from neurosym.induce.background import CELL_PREDICATES
+from neurosym.induce.background import FAMILIES, STEP_BOUND
 from neurosym.induce.examples import PREDICATES, Grounded
 from neurosym.terms import Term, Var, parse_term
 
@@ -108,9 +110,9 @@ class Clause:
         ]
         positive = [lit for lit in body if not lit.negated]
         negative = [lit for lit in body if lit.negated]
-        positive.sort(key=lambda lit: lit.pred not in CELL_PREDICATES)  # bind E, T through step/4
+        positive.sort(key=lambda lit: lit.pred not in STEP_BOUND)  # bind E, T through step/4
         goals: list[Literal | str] = [*positive, *negative]
-        if not any(lit.pred in CELL_PREDICATES for lit in positive):
+        if not any(lit.pred in STEP_BOUND for lit in positive):
             goals.insert(0, "step(E, T, _, _)")
         return goals
 
@@ -216,6 +218,9 @@ def _candidates(
             out += [Literal(pred, f, f, var, negated=True) for var in [*bound, "_"]]
     if has_var and HEAD_VAR not in bound:  # the first literal binds the head's colour
         out = [lit for lit in out if lit.var == HEAD_VAR]
+    family = FAMILIES.get(g.family)
+    if family is not None and family.links_first:  # ties go to the first candidate
+        out.sort(key=lambda lit: lit.negated or lit.var not in bound)
     return [lit for lit in out if lit not in body]
 
 

@@ -15,14 +15,15 @@ not guessed.
 from __future__ import annotations
 
 import os
+import textwrap
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from neurosym.errors import ConfigError
-from neurosym.induce.background import BACKGROUND, VOCABULARY
+from neurosym.induce.background import BACKGROUND, FAMILIES  # noqa: F401 (BACKGROUND: re-exported)
 from neurosym.induce.examples import Grounded, ground
 from neurosym.induce.foil import Bias, Clause, evaluate, head_var, learn, positives
 from neurosym.induce.readback import Code, Part, check_reads_back, comment
@@ -114,12 +115,12 @@ def induce_world(
     recall, "solved perfectly"). Learning time (``seconds``) counts grounding
     the training KB and the search, not the held-out scoring.
     """
-    bias = bias or Bias()
     start = time.perf_counter()
     g = ground(kb)
     grounded = time.perf_counter() - start
+    bias = _bias(bias, g)
     scores: dict[str, EventScore] = {}
-    for template in VOCABULARY[g.family]:
+    for template in FAMILIES[g.family].vocabulary:
         n_pos = len(positives(g, template))
         if n_pos == 0:
             scores[template] = EventScore(
@@ -155,19 +156,39 @@ def induce_world(
     return rules
 
 
+def _bias(bias: Bias | None, g: Grounded) -> Bias:
+    """``bias``, or the default one over the KB's env family's body predicates; a bias naming a
+    predicate the family has no background for is a one-line :class:`ConfigError`."""
+    family = FAMILIES[g.family]
+    if bias is None:
+        return replace(Bias(), predicates=family.predicates)
+    unknown = [p for p in bias.predicates if p not in g.matrix]
+    if unknown:
+        raise ConfigError(
+            f"the bias names {', '.join(unknown)}, which {g.family} KBs have no background for: "
+            f"use {', '.join(family.predicates)}"
+        )
+    return bias
+
+
 def _fmt(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f}"
 
 
-HEADER = """/** <module> World rules learned from recorded facts (neurosym induce world)
+def header(facts: tuple[str, ...]) -> str:
+    """The file's PlDoc header: fixed text only (data goes in one-line ``%`` comments);
+    ``facts`` are the KB predicates the background reads (the env family's)."""
+    load = (
+        f"Load beside a KB of the same schema ({', '.join(facts)}): `swipl kb.pl world.pl`. "
+        "Where and how the rules were learned, and their scores, follow in the % lines below."
+    )
+    wrapped = textwrap.fill(load, 84, break_long_words=False, break_on_hyphens=False)
+    return (
+        "/** <module> World rules learned from recorded facts (neurosym induce world)\n\n"
+        "predicts(E, T, Event) holds when the step of state T of episode E has event Event.\n"
+        f"{wrapped}\n*/\n"
+    )
 
-predicts(E, T, Event) holds when the step of state T of episode E has event Event.
-Load beside a KB of the same schema (step/4, at/5, object/2, holding/3, terrain/4,
-grid/3): `swipl kb.pl world.pl`. Where and how the rules were learned, and their
-scores, follow in the % lines below.
-*/
-"""
-"""The file's PlDoc header: fixed text only (data goes in one-line ``%`` comments)."""
 
 DISCONTIGUOUS = ":- discontiguous predicts/3."
 
@@ -180,6 +201,7 @@ def render(rules: WorldRules) -> str:
 def render_parts(rules: WorldRules) -> tuple[str, list[Part]]:
     """The learned file's text and what it must read back as (:mod:`neurosym.induce.readback`)."""
     b = rules.bias
+    family = FAMILIES[rules.family]
     notes = [
         f"Learned from: {rules.kb} (env {rules.env or '?'}, {rules.episodes} episodes, "
         f"{rules.states} acted states) in {rules.seconds:.1f} s.",
@@ -191,7 +213,7 @@ def render_parts(rules: WorldRules) -> tuple[str, list[Part]]:
         notes.append(f"Held out: {rules.holdout} ({rules.holdout_episodes} episodes).")
     notes += ["", "Scores (train precision/recall; held-out precision/recall):"]
     notes += [f"  - {sc.event}: {_describe(sc)}" for sc in rules.scores.values()]
-    lines = [HEADER, *(comment(n) for n in notes), "", DISCONTIGUOUS, ""]
+    lines = [header(family.facts), *(comment(n) for n in notes), "", DISCONTIGUOUS, ""]
     parts: list[Part] = [Code(DISCONTIGUOUS)]
     for sc in rules.scores.values():
         if sc.status == "determined":
@@ -203,8 +225,8 @@ def render_parts(rules: WorldRules) -> tuple[str, list[Part]]:
             lines += [comment("  " + line) for c in sc.clauses for line in c.text().splitlines()]
         lines.append("")
     lines.append("% ---- background predicates (neurosym.induce.background) ----")
-    lines.append(BACKGROUND.strip())
-    parts.append(Code(BACKGROUND))
+    lines.append(family.background.strip())
+    parts.append(Code(family.background))
     return "\n".join(lines) + "\n", parts
 
 

@@ -36,7 +36,7 @@ class InterveneOptions(EnvChoice, Episodes, ActionMode, Out, Json):
     """``neurosym intervene``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """trained agent (.pt)"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     levels: bool = True
     """run the level changes (remove the sword, the enemy; swap them)"""
     ablations: bool = True

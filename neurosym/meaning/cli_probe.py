@@ -36,7 +36,7 @@ class ProbeOptions(EnvChoice, Episodes, ActionMode, Out, Json):
     """``neurosym probe``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """trained agent (.pt)"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     untrained: bool = True
     """also probe the untrained network (the baseline of each probe)"""
     solver: Literal["batched", "sklearn"] = "batched"

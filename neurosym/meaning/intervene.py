@@ -294,7 +294,10 @@ def _count(grid_map: Any, obj: str) -> int:
 
 
 def ablation_experiments(heads: int, module: str) -> list[Experiment]:
-    """Each head ablated in turn, then all of them."""
+    """Each head ablated in turn, then all of them; none for a network without heads (an
+    outside agent whose attention nobody named)."""
+    if heads < 1:
+        return []
     what = adapter_class(module).head_term
     detail = Term("replaced", (what, Term("mean_over", ("baseline",))))
     out = [

@@ -459,7 +459,9 @@ def _probe_recording(
         feats, _ = head_vectors(agent.model, obs)
         base = None
         if untrained:
-            base, _ = head_vectors(untrained_like(agent.config, seed), obs)
+            untrained_of = getattr(agent, "untrained", None)  # an outside agent's own re-init
+            fresh = untrained_of(seed) if untrained_of else untrained_like(agent.config, seed)
+            base, _ = head_vectors(fresh, obs)
     finally:
         torch.set_num_threads(saved)
     module = agent.config.module

@@ -40,7 +40,7 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """``neurosym extract``'s options."""
 
     checkpoint: str = option(metavar="FILE")
-    """trained agent (.pt)"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip"""
     actions: Literal["agent", "random"] = "agent"
     """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
     seed (the network still runs on every state, so its facts are extracted;
@@ -92,7 +92,7 @@ def run(args: ExtractOptions) -> int:
     if args.threshold is not None:
         parse_threshold(args.threshold)  # a bad spec is refused before the agent is read
     check_extract_options(args.episodes, args.seed, args.batch, args.top_keys)
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     threshold = args.threshold or model_threshold(agent.config)
     env, overrides = env_choice(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)

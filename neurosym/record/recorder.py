@@ -55,6 +55,11 @@ def random_actions(episode_seeds: np.ndarray, t: int, count: int = 4) -> np.ndar
     return (x % np.uint64(count)).astype(np.int64)
 
 
+def _action_count(venv: Any) -> int:
+    """The batched env's number of actions (4 in RGW and Box-World, 7 in Minigrid)."""
+    return int(getattr(getattr(venv, "single_action_space", None), "n", 4))
+
+
 def _meta(
     agent: Any, env_name: str, seed: int, greedy: bool, env_kwargs: dict[str, Any]
 ) -> dict[str, Any]:
@@ -115,6 +120,9 @@ class _Trace:
         self.events: list[tuple] = []  # event texts of each transition
         self.terrain: list[tuple[int, str, int, int]] = []  # (episode, type, row, col)
         self.grids: list[tuple[int, int, int]] = []  # (episode, rows, cols)
+        self.facing: list[tuple[int, int, str]] = []  # (episode, t, direction): Minigrid
+        self.doors: list[tuple[int, int, str, str]] = []  # (episode, t, id, state): Minigrid
+        self.missions: list[tuple[int, str]] = []  # (episode, text): Minigrid
 
     def map(self, episode: int, grid: np.ndarray, names: np.ndarray, info: dict[str, Any]) -> None:
         """Episode's map size and terrain: its (H, W) entity codes after the reset
@@ -127,12 +135,17 @@ class _Trace:
         facts = live.episode_facts(info, grid, names)
         self.grids.append((episode, facts.rows, facts.cols))
         self.terrain.extend((episode, *row) for row in facts.terrain)
+        if "mission" in info:
+            self.missions.append((episode, str(info["mission"])))
 
     def state(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Positions and held items of state t (the agent first, then the map's objects)."""
         self.keys.append((episode, t))
         self.objects.append(live.state_objects(info))
         self.held.append(tuple(info["holding"]))
+        if "direction" in info:  # Minigrid's agent direction and door states
+            self.facing.append((episode, t, str(info["direction"])))
+            self.doors.extend((episode, t, str(i), str(s)) for i, s in info["doors"])
 
     def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Events of the step taken in state t."""
@@ -151,6 +164,16 @@ class _Trace:
             np.repeat(key[:, 1], lens),
             list(chain.from_iterable(groups)),
         )
+
+    def minigrid_tables(self) -> dict[str, pd.DataFrame]:
+        """facing, doors (ordered by episode, then t) and missions (by episode): Minigrid's state."""
+        return {
+            "facing": _by_episode(pd.DataFrame(self.facing, columns=["episode", "t", "direction"])),
+            "doors": _by_episode(
+                pd.DataFrame(self.doors, columns=["episode", "t", "id", "state"])
+            ),
+            "missions": _by_episode(pd.DataFrame(self.missions, columns=["episode", "text"])),
+        }
 
     def map_tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
         """terrain (row-major per episode) and grids, ordered by episode."""
@@ -340,15 +363,15 @@ class _Recorder:
             obs, greedy=self.greedy, introspect=True, generator=self.generator
         )
         if self.random:
-            return random_actions(self._live_seeds, self._t)
+            return random_actions(self._live_seeds, self._t, _action_count(venv))
         return np.asarray(acted)
 
     def _wave(self, wave: Wave) -> None:
         """Record one wave: the reset states, then each live sub-env's steps and states."""
         from neurosym.envs import ACTION_NAMES
 
-        action_names = np.asarray(ACTION_NAMES, dtype=object)
         venv = self.venv
+        action_names = np.asarray(getattr(venv, "action_names", ACTION_NAMES), dtype=object)
         grid = venv.entity_grid()  # (n, H, W) entity codes after the reset
         for i in range(wave.count):
             decoded = venv.decode_info(wave.info, i)
@@ -398,6 +421,7 @@ class _Recorder:
         positions, holding, events = self.trace.tables()
         terrain, grids = self.trace.map_tables()
         tables: dict[str, pd.DataFrame] = {"terrain": terrain, "grids": grids}
+        tables.update(self.trace.minigrid_tables())
         m = self.model.sorted_by("ep")  # states in episode order
         rows = self.adapter.rows(m, m["ep"], m["t"], self.names, W)
         tables.update({name: pd.DataFrame(cols) for name, cols in rows.items()})

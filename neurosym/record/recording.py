@@ -62,6 +62,9 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
         ("key_row", "int64"),
         ("key_col", "int64"),
     ),
+    "facing": _arguments("facing"),
+    "doors": _arguments("door_state"),
+    "missions": _arguments("mission"),
     "r_vectors": (
         ("episode", "int64"),
         ("t", "int64"),
@@ -75,8 +78,9 @@ META_KEYS = (
     "checkpoint", "env", "module", "heads", "relations", "seed", "actions", "created", "version",
 )  # fmt: skip
 
-OPTIONAL_TABLES = ("terrain", "grids")
-"""tables that recordings of older versions lack: they load as empty tables"""
+OPTIONAL_TABLES = ("terrain", "grids", "facing", "doors", "missions")
+"""tables that recordings of older versions lack: they load as empty tables (RGW and Box-World
+recordings have no rows in Minigrid's facing, doors and missions)"""
 
 MAX_COUNT = 1024
 """the most heads or relations a recording's meta may give (they size the tables readers draw)"""
@@ -140,6 +144,9 @@ class Recording:
     attends: pd.DataFrame = field(default_factory=lambda: empty_table("attends"))
     relations: pd.DataFrame = field(default_factory=lambda: empty_table("relations"))
     attention: pd.DataFrame = field(default_factory=lambda: empty_table("attention"))
+    facing: pd.DataFrame = field(default_factory=lambda: empty_table("facing"))
+    doors: pd.DataFrame = field(default_factory=lambda: empty_table("doors"))
+    missions: pd.DataFrame = field(default_factory=lambda: empty_table("missions"))
     r_vectors: pd.DataFrame = field(default_factory=lambda: empty_table("r_vectors"))
     meta: dict[str, Any] = field(default_factory=dict)
 

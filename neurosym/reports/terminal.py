@@ -33,10 +33,17 @@ QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("key opens lock", "key_opens(K, L), X = K-L", "X"),
         ("key-lock links in the network", "key_lock_link(C, L), X = C-L", "X"),
     ),
+    "minigrid": (
+        ("key before door", "key_before_door(E)", "E"),
+        ("key opens door", "opens(K, D), X = K-D", "X"),
+        ("mission done", "mission_done(E)", "E"),
+        ("key-door links in the network", "key_door_link(C, L), X = C-L", "X"),
+    ),
 }
 RULE_FILES: dict[str, tuple[str, ...]] = {
     "rgw": ("rgw.pl", "relations.pl"),
     "boxworld": ("boxworld.pl", "relations.pl"),
+    "minigrid": ("minigrid.pl", "relations.pl"),
 }
 
 

@@ -27,6 +27,8 @@ from neurosym.viz.grid import (
     head_arrow,
     label_size,
     mark_agent,
+    mark_direction,
+    mark_doors,
 )
 from neurosym.viz.output import save_gif
 from neurosym.viz.panels import widen_for_text
@@ -114,7 +116,12 @@ def draw_state(
     w = trace.shape[1]
     fontsize = label_size(panel_inches, w)
     draw_entities(ax, trace.grids[t], fontsize=fontsize)
+    mark_doors(ax, trace.grids[t], trace.door_states(t), fontsize=fontsize)
     draw_route(ax, trace.agent_path[: t + 1])
+    row, col = trace.agent_path[t]
+    direction = trace.direction(t)
+    if row >= 0 and direction is not None:
+        mark_direction(ax, int(row), int(col), direction)
     for i, a, b in head_pairs(trace, t, heads):
         head_arrow(
             ax,
@@ -259,12 +266,14 @@ class _Film:
     def _terrain(self, t: int) -> None:
         grid = self.trace.grids[t]
         terrain = np.where(grid == "agent", "empty", grid)  # the agent is drawn per frame
-        key = tuple(terrain.ravel().tolist())
+        doors = self.trace.door_states(t)
+        key = (*terrain.ravel().tolist(), *map(str, doors))
         if key == self.terrain_key:
             self.canvas.restore_region(self.background)
             return
         self.ax.clear()
         draw_entities(self.ax, terrain, fontsize=self.fontsize)
+        mark_doors(self.ax, terrain, doors, fontsize=self.fontsize)
         self.canvas.draw()
         self.background = self.canvas.copy_from_bbox(self.fig.bbox)
         self.terrain_key = key
@@ -276,6 +285,7 @@ class _Film:
         moving: list[Any] = [draw_route(ax, trace.agent_path[: t + 1])]
         if row >= 0:
             moving += mark_agent(ax, int(row), int(col), fontsize=self.fontsize)
+            moving += mark_direction(ax, int(row), int(col), trace.direction(t) or "")
         for i, a, b in head_pairs(trace, t, self.heads):
             moving += head_arrow(
                 ax,

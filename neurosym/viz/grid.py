@@ -15,7 +15,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Colormap, Normalize, to_rgb
 from matplotlib.image import AxesImage
-from matplotlib.patches import FancyArrowPatch, Patch, Rectangle
+from matplotlib.patches import FancyArrowPatch, Patch, Polygon, Rectangle
 from matplotlib.text import Text
 
 from neurosym.viz.style import entity_colour, entity_label, split_entity, text_colour_on
@@ -196,6 +196,47 @@ def mark_agent(ax: Axes, row: int, col: int, *, fontsize: float) -> list[Artist]
         fontweight="bold",
     )
     return [_patch(ax, cell), label]
+
+
+_POINTS = {"east": (1, 0), "south": (0, 1), "west": (-1, 0), "north": (0, -1)}
+"""(dx, dy) in data coordinates (row 0 at the top) of each Minigrid direction"""
+
+
+def mark_direction(ax: Axes, row: int, col: int, direction: str) -> list[Artist]:
+    """A triangle in the agent's cell pointing where it faces (Minigrid's agent turns)."""
+    if direction not in _POINTS:
+        return []
+    dx, dy = _POINTS[direction]
+    tip = (col + 0.42 * dx, row + 0.42 * dy)
+    back = (col + 0.12 * dx, row + 0.12 * dy)
+    side = (0.2 * -dy, 0.2 * dx)
+    corners = [tip, (back[0] + side[0], back[1] + side[1]), (back[0] - side[0], back[1] - side[1])]
+    fill = text_colour_on(entity_colour("agent"))
+    return [_patch(ax, Polygon(corners, closed=True, facecolor=fill, edgecolor="none"))]
+
+
+def mark_doors(
+    ax: Axes, names: np.ndarray, doors: list[tuple[int, int, str]], *, fontsize: float
+) -> list[Artist]:
+    """Each Minigrid door's state: an open door is an outline in its colour, a closed one the
+    filled cell drawn already, a locked one that cell with a black keyhole."""
+    out: list[Artist] = []
+    for row, col, state in doors:
+        name = str(names[row, col])
+        if split_entity(name)[0] != "door":
+            continue  # the agent stands in the doorway
+        colour = entity_colour(name)
+        if state == "open":
+            inner = Rectangle(
+                (col - 0.5, row - 0.5), 1, 1, facecolor=entity_colour("empty"),
+                edgecolor=colour, linewidth=2.5,
+            )  # fmt: skip
+            out += [_patch(ax, inner)]
+            out += [_cell_text(ax, col, row, "D", fontsize=fontsize, color=colour, fontweight="bold")]
+        elif state == "locked":
+            hole = Rectangle((col + 0.12, row + 0.12), 0.22, 0.26, facecolor="black", edgecolor="none")
+            out += [_patch(ax, hole)]
+    return out
 
 
 def draw_route(ax: Axes, path: np.ndarray, *, colour: str = "#1f77b4") -> LineCollection:

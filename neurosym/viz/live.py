@@ -19,7 +19,7 @@ import pandas as pd
 from neurosym.agent.networks.adapters import adapter_class
 from neurosym.agent.waves import SingleAsBatch, run_waves
 from neurosym.errors import ConfigError
-from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
+from neurosym.viz.trace import DOOR_COLUMNS, OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
 if TYPE_CHECKING:
     import gymnasium
@@ -86,6 +86,8 @@ class _Play:
         self.attention: dict[int, np.ndarray] = {}  # MHDPA, kept steps only
         self.focus: list[np.ndarray] = []  # MHDPA, per step (heads,)
         self.object_rows: list[tuple[int, str, str, int, int]] = []
+        self.facing: list[str] = []  # Minigrid: the agent's direction per state
+        self.door_rows: list[tuple[int, int, int, str]] = []  # Minigrid: t, row, col, state
         self._intro: Any = None  # the model's introspection of the state being acted in
 
     def _grid(self) -> np.ndarray:
@@ -132,8 +134,13 @@ class _Play:
             )
 
     def _objects(self, t: int, info: dict[str, Any]) -> None:
-        self.object_rows.extend(
-            (t, str(i), str(k), int(r), int(c)) for i, k, r, c in info.get("objects", ())
+        objects = info.get("objects", ())
+        self.object_rows.extend((t, str(i), str(k), int(r), int(c)) for i, k, r, c in objects)
+        if "direction" in info:
+            self.facing.append(str(info["direction"]))
+        cell = {str(i): (int(r), int(c)) for i, _, r, c in objects}
+        self.door_rows.extend(
+            (t, *cell[str(i)], str(state)) for i, state in info.get("doors", ()) if str(i) in cell
         )
 
     def _keep(self, t: int, intro: Any) -> None:
@@ -169,6 +176,8 @@ class _Play:
             heads=heads,
             complete=True,
             objects=pd.DataFrame(self.object_rows, columns=OBJECT_COLUMNS),
+            facing=tuple(self.facing) if len(self.facing) == n_steps + 1 else (),
+            doors=pd.DataFrame(self.door_rows, columns=DOOR_COLUMNS),
         )
         if self.pairs:
             n, h, j = config.n_entities, len(heads), int(config.relations)

@@ -21,7 +21,7 @@ import pandas as pd
 from neurosym.agent.networks.adapters import adapter_class, module_names
 from neurosym.errors import ConfigError
 from neurosym.record.recording import Recording
-from neurosym.viz.trace import OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
+from neurosym.viz.trace import DOOR_COLUMNS, OBJECT_COLUMNS, POSITION_COMPONENTS, EpisodeTrace
 
 
 def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeTrace:
@@ -78,6 +78,7 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
         relations=relations,
         complete=False,
         objects=positions[OBJECT_COLUMNS].reset_index(drop=True),
+        **_minigrid_state(rec, episode, positions, n_steps),
     )
     if adapter.has("attends"):
         a1, a2 = _sparse_argument_maps(attends, n_steps, heads, shape)
@@ -86,6 +87,23 @@ def trace_from_recording(rec: Recording, episode: int | None = None) -> EpisodeT
     lazy = _RecordedAttention(attention, n_steps, heads, shape)
     focus = _recorded_focus(attention, grids, heads, shape, n_steps)
     return EpisodeTrace(**common, mhdpa=lazy, mhdpa_focus=focus)
+
+
+def _minigrid_state(
+    rec: Recording, episode: int, positions: pd.DataFrame, n_steps: int
+) -> dict[str, Any]:
+    """Minigrid's agent direction per state and its doors' states with their cells (nothing for
+    the other envs, whose recordings have no facing or door rows)."""
+    facing = _episode_rows(rec.facing, episode).sort_values("t")
+    out: dict[str, Any] = {}
+    if len(facing) == n_steps + 1:
+        out["facing"] = tuple(str(d) for d in facing["direction"])
+    doors = _episode_rows(rec.doors, episode)
+    if not doors.empty:
+        cells = positions[["t", "object", "row", "col"]].rename(columns={"object": "id"})
+        placed = doors[["t", "id", "state"]].merge(cells, on=["t", "id"])
+        out["doors"] = placed[DOOR_COLUMNS].astype({"state": str}).reset_index(drop=True)
+    return out
 
 
 def _episode_rows(table: pd.DataFrame, episode: int) -> pd.DataFrame:

@@ -1,4 +1,4 @@
-"""Colours and short labels for the entities of Relational-Grid-World and Box-World.
+"""Colours and short labels for the entities of Relational-Grid-World, Box-World and Minigrid.
 
 A grid cell is too small for a full name, so every entity gets a label of one
 or two characters and the figure carries a legend line spelling them out.
@@ -59,6 +59,9 @@ ENTITY_COLOURS: dict[str, str] = {
     "pit": "#1a1a1a",
     "empty": "#f4f4f4",
     "gem": "#ffffff",
+    "goal": "#2ca02c",  # Minigrid
+    "lava": "#ff7f0e",
+    "floor": "#e6e6e6",
 }
 
 ENTITY_LABELS: dict[str, str] = {
@@ -75,9 +78,15 @@ ENTITY_LABELS: dict[str, str] = {
     "key": "k",
     "lock": "L",
     "held": "h",
+    "door": "D",  # Minigrid: door(C), ball(C), box(C) take their colour as keys do
+    "ball": "b",
+    "box": "x",
+    "goal": "G",
+    "lava": "~",
+    "floor": "f",
 }
 
-_COLOURED = re.compile(r"^(key|lock|held)\((.+)\)$")
+_COLOURED = re.compile(r"^(key|lock|held|door|ball|box)\((.+)\)$")
 _FALLBACK_PALETTE = (
     "#e6194b",
     "#3cb44b",

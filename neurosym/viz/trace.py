@@ -26,6 +26,9 @@ from neurosym.errors import ConfigError
 OBJECT_COLUMNS = ["t", "object", "type", "row", "col"]
 """columns of :attr:`EpisodeTrace.objects` (the recording's ``positions`` without ``episode``)"""
 
+DOOR_COLUMNS = ["t", "row", "col", "state"]
+"""columns of :attr:`EpisodeTrace.doors` (Minigrid)"""
+
 POSITION_COMPONENTS = 4
 """R^h ends with the (row, col) of E1 and of E2"""
 
@@ -72,6 +75,11 @@ class EpisodeTrace:
     """MHDPA (S, heads) cell the agent's cell attends to most; -1 where unknown"""
     objects: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=OBJECT_COLUMNS))
     """columns t, object, type, row, col: the named objects (ids such as lock_red_2) per state"""
+    facing: tuple[str, ...] = ()
+    """Minigrid: (S+1,) the agent's direction at each state (``east``, ``south``, ``west``,
+    ``north``); empty for the envs whose agent has none"""
+    doors: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=DOOR_COLUMNS))
+    """Minigrid: columns t, row, col, state (``open``, ``closed``, ``locked``) of each door"""
 
     @property
     def steps(self) -> int:
@@ -100,6 +108,15 @@ class EpisodeTrace:
         path = np.stack([cell // w, cell % w], axis=1)
         path[~flat.any(axis=1)] = -1
         return path
+
+    def direction(self, t: int) -> str | None:
+        """The agent's direction in state t (Minigrid), else None."""
+        return self.facing[t] if 0 <= t < len(self.facing) else None
+
+    def door_states(self, t: int) -> list[tuple[int, int, str]]:
+        """(row, col, state) of every door in state t (Minigrid; [] elsewhere)."""
+        rows = self.doors[self.doors["t"] == t]
+        return [(int(r), int(c), str(s)) for r, c, s in rows[["row", "col", "state"]].to_numpy()]
 
     def head_index(self, head: int) -> int:
         """Position of head number ``head`` in the arrays, or a one-line error."""

@@ -11,37 +11,14 @@ from typing import Any
 
 import pytest
 import torch
+from builders import OPTIMAL, ROUTES
+from builders import play_one_episode as play
 
 from neurosym.agent.agent import load_agent
 
 CHECKPOINTS = Path(__file__).resolve().parents[2] / "checkpoints"
 # rgw2: the lower part is reachable only through the teleport; rgw1 (no mountains, no pits)
 # also opens the way down the right edge, so the teleport is optional there.
-ROUTES = {
-    "rgw1": ["picked(sword)", "defeated(enemy)", "reached(terminal)"],
-    "rgw2": ["picked(sword)", "teleported", "defeated(enemy)", "reached(terminal)"],
-}
-OPTIMAL = {"rgw1": 11.0, "rgw2": 10.7}
-
-
-def play(path: Path, route: list[str], env_name: str | None = None) -> tuple[float, list[str], int]:
-    """Greedy play of one episode (reset seed 0) on the agent's own env, or on ENV_NAME."""
-    from neurosym.envs import make
-
-    agent = load_agent(path)
-    env = make(env_name) if env_name else make(agent.env_name, **agent.env_kwargs)
-    obs, info = env.reset(seed=0)
-    total, events = 0.0, []
-    for t in range(1000):
-        actions, _ = agent.act(obs[None])
-        obs, reward, terminated, truncated, info = env.step(int(actions[0]))
-        total += float(reward)
-        events += [e for e in info["events"] if e in route]
-        if terminated or truncated:
-            return total, events, t + 1
-    raise AssertionError("episode did not end")
-
-
 # The agents the project ships (checkpoints/README.md).
 EXPECTED = {
     "rgw1-predinet",

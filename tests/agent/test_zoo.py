@@ -21,13 +21,13 @@ def test_rule_files_and_agents_by_bare_name(tmp_path: Path, monkeypatch) -> None
     from neurosym.shipped import checkpoint_file, rule_file, rules_dir, shipped_rule_names
 
     assert rules_dir() == REPO / "rules"
-    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "relations", "rgw", "route"]
+    assert shipped_rule_names() == ["boxworld", "causal", "meaning", "minigrid", "relations", "rgw", "route"]
     monkeypatch.chdir(tmp_path)
     assert rule_file("rgw") == REPO / "rules" / "rgw.pl"
     assert rule_file("boxworld.pl") == REPO / "rules" / "boxworld.pl"
     assert rule_file("mine.pl") == Path("mine.pl")  # not there: the loader says so
     with pytest.raises(
-        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, relations, rgw, route\)"
+        ConfigError, match=r"no rule file 'rgx'.*\(boxworld, causal, meaning, minigrid, relations, rgw, route\)"
     ):
         rule_file("rgx")
     (tmp_path / "rgw").write_text("my_rule.\n")  # a file of the user's wins over the shipped name
@@ -64,11 +64,9 @@ def test_query_takes_a_shipped_rule_file_by_name(run_neurosym, tmp_path: Path) -
     assert proc.stderr.startswith("neurosym query: error: no rule file 'rgx': give a .pl file")
 
 
-def test_write_card_keeps_the_weights_and_the_agent_replays(tmp_path: Path) -> None:
+def test_write_card_keeps_the_weights_and_the_agent_replays(tmp_path: Path, play_one_episode) -> None:
     """A card written into a copy of a shipped agent: every other entry and every weight as they
     were, and the agent still plays rgw2 by the optimal route."""
-    from test_checkpoint_shipped import OPTIMAL, ROUTES, play
-
     from neurosym.cards import write_card
 
     path = tmp_path / "agent.pt"
@@ -89,8 +87,9 @@ def test_write_card_keeps_the_weights_and_the_agent_replays(tmp_path: Path) -> N
         k: v for k, v in after.items() if k != "state_dict"
     }
     assert load_agent(path).meta["card"] == card
-    total, events, _ = play(path, ROUTES["rgw2"])
-    assert events == ROUTES["rgw2"] and total == pytest.approx(OPTIMAL["rgw2"])
+    route = ["picked(sword)", "teleported", "defeated(enemy)", "reached(terminal)"]
+    total, events, _ = play_one_episode(path, route)
+    assert events == route and total == pytest.approx(10.7)
     with pytest.raises(CheckpointError, match="held_out.greedy.success_rate must be in"):
         write_card(
             path, {**card, "held_out": {**card["held_out"], "greedy": {"success_rate": 2.0}}}

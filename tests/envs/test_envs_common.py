@@ -195,8 +195,10 @@ def test_cli_lists_every_environment() -> None:
         )
         assert cells[1] == env_id and cells[3]
     rows = [json.loads(ln) for ln in run_cli("--json").stdout.splitlines()]
-    assert [r["name"] for r in rows] == NAMES
-    assert all(r["id"] == ENVS[r["name"]] and r["description"] for r in rows)
+    own, minigrid = rows[: len(NAMES)], rows[len(NAMES) :]  # then the Minigrid family's ids
+    assert [r["name"] for r in own] == NAMES
+    assert all(r["id"] == ENVS[r["name"]] and r["description"] for r in own)
+    assert minigrid and all(r["family"] == "minigrid" for r in minigrid)
 
 
 def test_cli_show_and_errors() -> None:

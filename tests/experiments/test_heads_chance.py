@@ -12,8 +12,7 @@ heads_chance = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(heads_chance)
 
 
-def test_random_arguments_are_named_by_their_cell() -> None:
-    from test_recorder_scripted import scripted_recording
+def test_random_arguments_are_named_by_their_cell(scripted_recording) -> None:
 
     rec = scripted_recording()
     states = rec.attends[["episode", "t"]].drop_duplicates()

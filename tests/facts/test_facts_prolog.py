@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from test_recorder_scripted import explorer_recording, scripted_recording
 
 from neurosym.facts.tables import FactSet, extract_facts
 from neurosym.prolog.knowledge_base import KnowledgeBase
@@ -26,7 +25,7 @@ ENEMY = ("defeated(enemy)", "hurt_by(enemy)")
 
 
 @pytest.fixture(scope="module")
-def rgw(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[FactSet, Path, KnowledgeBase]]:
+def rgw(scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[FactSet, Path, KnowledgeBase]]:
     facts = extract_facts(scripted_recording(), threshold="abs:0")  # every non-zero value holds
     path = facts.to_prolog(tmp_path_factory.mktemp("kb") / "kb.pl")
     with KnowledgeBase(path, rules=[RULES / "rgw.pl", RULES / "relations.pl"]) as kb:
@@ -35,6 +34,7 @@ def rgw(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[FactSet, Pat
 
 @pytest.fixture(scope="module")
 def boxworld(
+    explorer_recording,
     tmp_path_factory: pytest.TempPathFactory,
 ) -> Iterator[tuple[FactSet, Path, KnowledgeBase]]:
     facts = extract_facts(explorer_recording(), threshold="quantile:0.9")
@@ -208,7 +208,7 @@ def test_boxworld_solution_chain_is_consistent_with_the_gem_episodes(boxworld: t
         assert kb.once("gem_chain(E, C), solution_chain(E, C)", E=row["E"]) is not None
 
 
-def test_kb_meta_names_the_env_options(tmp_path: Path, run_neurosym) -> None:  # noqa: ANN001
+def test_kb_meta_names_the_env_options(scripted_recording, tmp_path: Path, run_neurosym) -> None:  # noqa: ANN001
     """The options the env was made with (the checkpoint's and --env-option's) are in kb_meta,
     after the other keys, and read back through the fact reader and `neurosym query`."""
     rec = scripted_recording()

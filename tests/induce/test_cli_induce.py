@@ -7,14 +7,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_extract import small_checkpoint
-from test_world import write_kb
 
 
 @pytest.fixture(scope="module")
-def kbs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+def kbs(tmp_path_factory: pytest.TempPathFactory, write_world_kb) -> tuple[Path, Path]:
     folder = tmp_path_factory.mktemp("kbs")
-    return write_kb(folder / "train.pl", "rgw-random", 0), write_kb(
+    return write_world_kb(folder / "train.pl", "rgw-random", 0), write_world_kb(
         folder / "held.pl", "rgw-random", 50_000
     )
 
@@ -88,7 +86,7 @@ def test_induce_imports_no_torch(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
 
 
-def test_extract_random_actions_records_it(neurosym_main, tmp_path: Path) -> None:
+def test_extract_random_actions_records_it(small_checkpoint, neurosym_main, tmp_path: Path) -> None:
     ckpt = small_checkpoint(tmp_path / "small.pt", "predinet", 12, relations=3)
     outs = []
     for batch in ("3", "1"):

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import pytest
 from strategy_kbs import nearest_key_kb
-from test_recorder import small_agent
 
 from neurosym.cli import main
 from neurosym.induce.strategy import induce_strategy
@@ -60,30 +59,6 @@ def strategy_kb(path: Path, meta: tuple[str, str] = ("", ""), type_: str = "") -
     if type_:  # keys of another type; the contact event is then `opened` (a contact by name)
         text = re.sub(r"object\(key_(\w+),key\(\w+\)\)", lambda m: f"object(key_{m[1]},{type_}({m[1]}))", text)
         text = re.sub(r"event\((\d+),(\d+),got\(key\(\w+\)\)\)", r"event(\1,\2,opened)", text)
-    path.write_text(text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def world_kb(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A small real Relational-Grid-World KB of random-action episodes."""
-    from neurosym.facts.tables import extract_facts
-    from neurosym.record.recorder import record
-
-    rec = record(
-        small_agent("rgw-random"), "rgw-random", 8, seed=0, actions="random",
-        env_kwargs={"max_steps": 60, "enemy": "pass"},
-    )  # fmt: skip
-    return extract_facts(rec).to_prolog(tmp_path_factory.mktemp("world") / "kb.pl")
-
-
-def hostile_world_kb(source: Path, path: Path, meta: str = "", wall: str = "") -> Path:
-    text = source.read_text()
-    if meta:
-        text = text.replace("kb_meta(env,'rgw-random').", meta)
-    if wall:
-        text = re.sub(r"^terrain\((\d+),wall,", lambda m: f"terrain({m[1]},{wall},", text, flags=re.M)
-    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
     return path
 
@@ -141,6 +116,7 @@ WORLD_CASES = {
 
 @pytest.mark.parametrize("case", sorted(WORLD_CASES))
 def test_a_hostile_kb_learns_world_rules_that_run_nothing(
+    hostile_world_kb,
     case: str, world_kb: Path, swipl: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.chdir(tmp_path)

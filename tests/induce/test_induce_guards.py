@@ -8,7 +8,6 @@ from pathlib import Path
 
 import pytest
 from strategy_kbs import nearest_key_kb
-from test_hostile_kb import hostile_world_kb, world_kb  # noqa: F401 (a fixture)
 
 from neurosym.atomic import refuse_overwrite
 from neurosym.cli import main
@@ -32,7 +31,8 @@ def bw_kb(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_an_atom_is_written_as_an_atom_and_escapes_are_shown(
-    world_kb: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]  # noqa: F811
+    hostile_world_kb,
+    world_kb: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """'Wall' stays an atom (as a variable it predicted every state); ESC never reaches the terminal."""
     kb = hostile_world_kb(world_kb, tmp_path / "wall.pl", wall="'Wall'")
@@ -86,7 +86,7 @@ def test_values_read_from_the_kb_are_bounded_before_the_work(bw_kb: Path, tmp_pa
 
 
 def test_a_held_out_kb_of_another_family_is_refused(
-    bw_kb: Path, world_kb: Path, capsys: pytest.CaptureFixture[str], tmp_path: Path  # noqa: F811
+    bw_kb: Path, world_kb: Path, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     out = tmp_path / "s.pl"
     for what in ("strategy", "world"):
@@ -188,7 +188,7 @@ def test_a_strategy_flag_is_refused_by_induce_world(
 
 
 def test_both_kinds_make_the_folders_of_out(
-    bw_kb: Path, world_kb: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]  # noqa: F811
+    bw_kb: Path, world_kb: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     for what, kb in (("strategy", bw_kb), ("world", world_kb)):
         out = tmp_path / what / "missing" / "dir" / "x.pl"

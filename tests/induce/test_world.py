@@ -7,7 +7,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_recorder import small_agent
+from builders import WORLD_CASES as CASES
 
 from neurosym.errors import ConfigError
 from neurosym.facts.tables import extract_facts
@@ -16,27 +16,14 @@ from neurosym.induce.background import VOCABULARY
 from neurosym.record.recorder import record
 from neurosym.record.recording import Recording
 
-CASES = {  # env -> (env options, episodes)
-    "rgw-random": ({"max_steps": 60, "enemy": "pass"}, 60),
-    # 15 random episodes open a lock 7 times (seed 0) and 5 times held out (seed 50000), with
-    # steps ahead of a lock without its key among them: enough for the exact two-literal rule
-    "bw2": ({"max_steps": 300}, 15),
-}
-
-
-def write_kb(path: Path, env: str, seed: int) -> Path:
-    options, episodes = CASES[env]
-    rec = record(small_agent(env), env, episodes, seed=seed, actions="random", env_kwargs=options)
-    return extract_facts(rec).to_prolog(path)
-
 
 @pytest.fixture(scope="module", params=sorted(CASES))
 def kbs(
-    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory, write_world_kb
 ) -> tuple[str, Path, Path]:
     folder = tmp_path_factory.mktemp(request.param)
     env = request.param
-    return env, write_kb(folder / "train.pl", env, 0), write_kb(folder / "held.pl", env, 50_000)
+    return env, write_world_kb(folder / "train.pl", env, 0), write_world_kb(folder / "held.pl", env, 50_000)
 
 
 @pytest.fixture(scope="module")
@@ -120,7 +107,7 @@ def test_world_pl_predicts_exactly_the_held_out_events_in_plain_swipl(
     assert _facts(swipl, [world, held], "predicts(E, T, X)") == predicted
 
 
-def test_a_kb_without_steps_or_events_is_one_line_error(tmp_path: Path) -> None:
+def test_a_kb_without_steps_or_events_is_one_line_error(small_agent, tmp_path: Path) -> None:
     empty = extract_facts(Recording()).to_prolog(tmp_path / "empty.pl")
     with pytest.raises(ConfigError, match=r"has no step/4 facts"):
         induce_world(empty)
@@ -133,7 +120,7 @@ def test_a_kb_without_steps_or_events_is_one_line_error(tmp_path: Path) -> None:
         induce_world(tmp_path / "missing.pl")
 
 
-def test_a_held_out_kb_of_another_env_family_is_refused(kbs: tuple, tmp_path: Path) -> None:
+def test_a_held_out_kb_of_another_env_family_is_refused(small_agent, kbs: tuple, tmp_path: Path) -> None:
     env, train, _ = kbs
     other = "bw2" if env == "rgw-random" else "rgw-random"
     rec = record(small_agent(other), other, 8, actions="random", env_kwargs={"max_steps": 300})

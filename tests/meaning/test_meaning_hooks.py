@@ -20,10 +20,13 @@ from neurosym.meaning.features import (
 )
 
 
-def agent(module: str):  # noqa: ANN201
-    from test_recorder import small_agent
+@pytest.fixture(scope="session")
+def agent(small_agent):  # noqa: ANN201
+    """``agent(...)``, built from the shared builders."""
+    def agent(module: str):  # noqa: ANN201
 
-    return small_agent("rgw2", module)
+        return small_agent("rgw2", module)
+    return agent
 
 
 def observations(n: int = 6) -> np.ndarray:
@@ -36,7 +39,7 @@ def observations(n: int = 6) -> np.ndarray:
     return np.concatenate([obs, venv.reset(seed=0)[0]])
 
 
-def test_predinet_ablation_replaces_only_that_heads_slice() -> None:
+def test_predinet_ablation_replaces_only_that_heads_slice(agent) -> None:
     model = agent("predinet").model
     obs = torch.from_numpy(observations())
     with torch.inference_mode(), capture_heads(model) as got:
@@ -66,7 +69,7 @@ def _mhdpa_values(model, obs: torch.Tensor) -> tuple[torch.Tensor, dict[str, tor
     return seen["x"], values
 
 
-def test_mhdpa_head_outputs_are_what_enters_norm1() -> None:
+def test_mhdpa_head_outputs_are_what_enters_norm1(agent) -> None:
     model = agent("mhdpa").model
     x, values = _mhdpa_values(model, torch.from_numpy(observations()))
     heads = values["head_out"]  # (B, H, N, F)
@@ -76,7 +79,7 @@ def test_mhdpa_head_outputs_are_what_enters_norm1() -> None:
     )
 
 
-def test_mhdpa_ablation_swaps_only_that_heads_output() -> None:
+def test_mhdpa_ablation_swaps_only_that_heads_output(agent) -> None:
     model = agent("mhdpa").model
     rel = model.relational
     obs = torch.from_numpy(observations())
@@ -101,7 +104,7 @@ def test_mhdpa_ablation_swaps_only_that_heads_output() -> None:
         assert not rel.hook_head_out.active
 
 
-def test_ablation_with_the_heads_own_output_changes_nothing() -> None:
+def test_ablation_with_the_heads_own_output_changes_nothing(agent) -> None:
     model = agent("predinet").model
     obs = observations(1)[:1]  # one state: its R vectors are their own mean
     means = head_means(model, obs)
@@ -111,15 +114,14 @@ def test_ablation_with_the_heads_own_output_changes_nothing() -> None:
     np.testing.assert_allclose(p, q, atol=1e-6)
 
 
-def test_unknown_head_is_refused() -> None:
+def test_unknown_head_is_refused(agent) -> None:
     model = agent("predinet").model
     with pytest.raises(ConfigError, match="head 7 does not exist"):
         with ablate_heads(model, {7: torch.zeros(7)}):
             pass
 
 
-def test_replay_gives_back_the_recorded_r_vectors() -> None:
-    from test_recorder_scripted import scripted_recording
+def test_replay_gives_back_the_recorded_r_vectors(agent, scripted_recording) -> None:
 
     rec = scripted_recording("predinet")
     a = agent("predinet")
@@ -129,8 +131,7 @@ def test_replay_gives_back_the_recorded_r_vectors() -> None:
     np.testing.assert_allclose(vecs.reshape(-1), recorded, atol=1e-6)
 
 
-def test_replay_with_another_time_limit_or_map_is_refused() -> None:
-    from test_recorder_scripted import scripted_recording
+def test_replay_with_another_time_limit_or_map_is_refused(scripted_recording) -> None:
 
     rec = scripted_recording("predinet")
     from neurosym.envs.rgw_maps import load_map

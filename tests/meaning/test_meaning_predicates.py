@@ -5,18 +5,22 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
+import pytest
 
 from neurosym.meaning.intervene import behaviour, relates_table
 from neurosym.meaning.predicates import acted_states, state_labels
 
 
-@cache
-def recording():  # noqa: ANN201
-    from test_recorder_scripted import scripted_recording
+@pytest.fixture(scope="session")
+def recording(scripted_recording):  # noqa: ANN201
+    """``recording(...)``, built from the shared builders."""
+    @cache
+    def recording():  # noqa: ANN201
 
-    return scripted_recording(
-        "predinet"
-    )  # 0 optimal, 1 no_sword, 2 pit, 3 back_for_sword, 4 timeout
+        return scripted_recording(
+            "predinet"
+        )  # 0 optimal, 1 no_sword, 2 pit, 3 back_for_sword, 4 timeout
+    return recording
 
 
 def at(labels, name: str, episode: int) -> np.ndarray:  # noqa: ANN001
@@ -24,14 +28,14 @@ def at(labels, name: str, episode: int) -> np.ndarray:  # noqa: ANN001
     return labels.column(name)[rows]
 
 
-def test_one_row_per_acted_state() -> None:
+def test_one_row_per_acted_state(recording) -> None:
     rec = recording()
     states = acted_states(rec.episodes)
     assert len(states) == int(rec.episodes["steps"].sum())
     assert states[states.episode == 0]["t"].tolist() == list(range(int(rec.episodes.steps[0])))
 
 
-def test_holding_visited_and_next_target_follow_the_events() -> None:
+def test_holding_visited_and_next_target_follow_the_events(recording) -> None:
     labels = state_labels(recording(), "rgw")
     # optimal route: picked(sword) at t=5, teleported at 11, enemy beaten at 19, terminal at 20
     holding = at(labels, "holding(sword)", 0)
@@ -49,7 +53,7 @@ def test_holding_visited_and_next_target_follow_the_events() -> None:
     assert not at(labels, "next_target(sword)", 4).any()
 
 
-def test_geometry_of_agent_and_objects() -> None:
+def test_geometry_of_agent_and_objects(recording) -> None:
     labels = state_labels(recording(), "rgw")
     # optimal route starts with 6 steps right along row 0 towards the sword at (0, 6)
     left = at(labels, "left_of(agent,sword)", 0)
@@ -60,7 +64,7 @@ def test_geometry_of_agent_and_objects() -> None:
     assert at(labels, "above(agent,enemy)", 0)[:6].all()
 
 
-def test_behaviour_measures() -> None:
+def test_behaviour_measures(recording) -> None:
     m = behaviour(recording(), "rgw")
     # optimal and back_for_sword beat the enemy with the sword; no_sword meets it unarmed,
     # back_for_sword too (before going back); pit and timeout never meet it
@@ -72,7 +76,7 @@ def test_behaviour_measures() -> None:
     assert m["success"] == 3 / 5
 
 
-def test_relates_shares_are_shares_of_states() -> None:
+def test_relates_shares_are_shares_of_states(recording) -> None:
     table = relates_table(recording(), "predinet")
     assert ((table["share"] > 0) & (table["share"] <= 1)).all()
     assert (table["a"] < table["b"]).all()

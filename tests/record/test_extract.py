@@ -8,27 +8,9 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-import torch
+from builders import small_checkpoint
 
-from neurosym.agent.checkpoint import save_checkpoint
-from neurosym.agent.config import ModelConfig
-from neurosym.agent.networks.model import ActorCritic
-from neurosym.envs import make
 from neurosym.record.recording import Recording
-
-
-def small_checkpoint(path: Path, module: str, max_steps: int, **sizes: object) -> Path:
-    """A small untrained rgw2 checkpoint (seed 0) whose episodes stop after ``max_steps``."""
-    env = make("rgw2")
-    torch.manual_seed(0)
-    cfg = ModelConfig.for_family(
-        "rgw", module, env.observation_space.shape, env.unwrapped.obs_scale,
-        heads=2, key_size=8, conv_channels=(4, 8), hidden_sizes=(16,), **sizes,
-    )  # fmt: skip
-    return save_checkpoint(
-        path, model=ActorCritic(cfg), config=cfg, env_name="rgw2",
-        env_kwargs={"max_steps": max_steps},
-    )  # fmt: skip
 
 
 @pytest.fixture(scope="module")

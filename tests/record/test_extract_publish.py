@@ -6,7 +6,6 @@ import os
 from pathlib import Path
 
 import pytest
-from test_recorder_scripted import scripted_recording
 
 import neurosym.publish
 from neurosym.cli import main
@@ -15,13 +14,18 @@ from neurosym.record.extraction import write_outputs
 from neurosym.record.recording import Recording
 
 
-def extract(out: Path, seed: int) -> None:
-    rec = scripted_recording()
-    rec = Recording(**rec.tables, meta={**rec.meta, "seed": seed})
-    write_outputs(out, rec, extract_facts(rec), ("pl",))
+@pytest.fixture(scope="session")
+def extract(scripted_recording):  # noqa: ANN201
+    """``extract(...)``, built from the shared builders."""
+    def extract(out: Path, seed: int) -> None:
+        rec = scripted_recording()
+        rec = Recording(**rec.tables, meta={**rec.meta, "seed": seed})
+        write_outputs(out, rec, extract_facts(rec), ("pl",))
+    return extract
 
 
 def test_a_new_run_removes_the_report_page_in_the_rename_that_publishes_it(
+    extract,
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     out = tmp_path / "kb"

@@ -7,7 +7,6 @@ import re
 from pathlib import Path
 
 import pytest
-from test_recorder_scripted import explorer_recording, scripted_recording
 
 from neurosym.facts.tables import extract_facts
 from neurosym.record.extraction import write_outputs
@@ -29,6 +28,7 @@ def report(
 
 
 def test_boxworld_report_answers_every_question(
+    explorer_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     rec = explorer_recording()
@@ -46,6 +46,7 @@ def test_boxworld_report_answers_every_question(
 
 
 def test_levels_without_a_distractor_say_so(
+    explorer_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """bw1 has no distractor box: its distractor questions say so instead of "0 of 4 episodes"."""
@@ -56,7 +57,7 @@ def test_levels_without_a_distractor_say_so(
             assert re.search(rf"\n {title} +│ no distractor on these levels +\n", text), text
 
 
-def test_counts_say_what_they_count(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_counts_say_what_they_count(explorer_recording, scripted_recording, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Visit orders: the three most common, of how many distinct orders; other lists: answers."""
     rec = scripted_recording()
     text = report(rec, tmp_path, capsys, verbose=True)
@@ -69,13 +70,13 @@ def test_counts_say_what_they_count(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert re.search(r"key opens lock (key\(\w+\)-lock\(\w+\), ){3}\.\.\.  \(\d+ answers\)", flat)
 
 
-def test_mhdpa_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_mhdpa_report(scripted_recording, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     text = report(scripted_recording("mhdpa"), tmp_path, capsys)
     assert "MHDPA: attention/6 holds the strongest key of every query cell" in text
     assert "sword before enemy" in text and "0  (1 of 5 episodes)" in text
 
 
-def test_report_without_a_prolog_kb(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_report_without_a_prolog_kb(scripted_recording, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     text = report(scripted_recording(), tmp_path, capsys, formats=("parquet",))
     assert "rule answers: none (they need the Prolog KB: --format pl)" in text
     assert not (tmp_path / "out" / "kb.pl").exists()
@@ -83,6 +84,7 @@ def test_report_without_a_prolog_kb(tmp_path: Path, capsys: pytest.CaptureFixtur
 
 
 def test_report_shows_data_as_text(
+    scripted_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Markup, hyperlinks and escape codes from a recording print as the characters they are."""
@@ -98,6 +100,7 @@ def test_report_shows_data_as_text(
 
 
 def test_report_columns_of_values_never_wrap(
+    scripted_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """In a narrow terminal a value such as "29 %" stays whole; text columns and headers wrap."""
@@ -121,6 +124,7 @@ def test_report_columns_of_values_never_wrap(
 
 
 def test_report_lines_break_between_phrases(
+    scripted_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Output to a file or pipe is 80 columns wide: the header and the counts break between

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from test_recorder_scripted import scripted_recording
 
 from neurosym.facts.tables import extract_facts
 from neurosym.record.extraction import write_outputs
@@ -14,15 +13,20 @@ from neurosym.reports.terminal import print_report
 REPO = Path(__file__).resolve().parents[2]
 
 
-def report(tmp_path: Path, capsys: pytest.CaptureFixture[str], verbose: bool) -> str:
-    rec = scripted_recording()
-    facts = extract_facts(rec, threshold="quantile:0.9")
-    written = write_outputs(tmp_path / "out", rec, facts, ("pl",))
-    print_report(rec, facts, written, kb=written.get("kb.pl"), verbose=verbose)
-    return capsys.readouterr().out
+@pytest.fixture(scope="session")
+def report(scripted_recording):  # noqa: ANN201
+    """``report(...)``, built from the shared builders."""
+    def report(tmp_path: Path, capsys: pytest.CaptureFixture[str], verbose: bool) -> str:
+        rec = scripted_recording()
+        facts = extract_facts(rec, threshold="quantile:0.9")
+        written = write_outputs(tmp_path / "out", rec, facts, ("pl",))
+        print_report(rec, facts, written, kb=written.get("kb.pl"), verbose=verbose)
+        return capsys.readouterr().out
+    return report
 
 
 def test_the_short_report_leaves_out_the_tables_the_verbose_one_has(
+    report,
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     short, full = report(tmp_path, capsys, False), report(tmp_path, capsys, True)
@@ -52,6 +56,7 @@ def test_extract_verbose_flag(run_neurosym, tmp_path: Path) -> None:
 
 
 def test_missing_rule_files_are_said_in_one_line(
+    report,
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import neurosym.shipped

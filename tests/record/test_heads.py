@@ -109,9 +109,9 @@ def test_an_mhdpa_recording_has_no_argument_pairs() -> None:
 
 
 def test_on_a_recording_and_in_the_extract_report(
+    scripted_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from test_recorder_scripted import scripted_recording
 
     from neurosym.facts.tables import extract_facts
     from neurosym.record.extraction import write_outputs

@@ -8,42 +8,13 @@ import numpy as np
 import pandas as pd
 import pytest
 import torch
+from builders import SMALL_MAX_STEPS as MAX_STEPS
+from builders import small_agent
 
-from neurosym.agent.agent import Agent
-from neurosym.agent.config import ModelConfig
-from neurosym.agent.networks.model import ActorCritic
-from neurosym.envs import ACTION_NAMES, env_family, make
+from neurosym.envs import ACTION_NAMES, make
 from neurosym.errors import CheckpointError, ConfigError
 from neurosym.record.recorder import record
 from neurosym.record.recording import Recording
-
-MAX_STEPS = 25
-
-
-@cache
-def small_agent(env: str, module: str = "predinet") -> Agent:
-    """A small random agent (fixed torch seed): it wanders, so episodes differ and events happen."""
-    probe = make(env)
-    torch.manual_seed(0)
-    cfg = ModelConfig.for_family(
-        env_family(env),
-        module,
-        probe.observation_space.shape,
-        probe.unwrapped.obs_scale,
-        heads=2,
-        relations=3,
-        key_size=8,
-        value_size=8,
-        conv_channels=(4, 8),
-        hidden_sizes=(16,),
-    )
-    return Agent(
-        model=ActorCritic(cfg).eval(),
-        config=cfg,
-        env_name=env,
-        env_kwargs={"max_steps": MAX_STEPS},
-        path="random.pt",
-    )
 
 
 @cache

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_recorder import small_agent
 
 from neurosym.envs import make
 from neurosym.errors import ConfigError
@@ -16,7 +15,7 @@ from neurosym.record.recording import Recording
 
 
 @pytest.mark.parametrize("env", ["rgw-random", "bw2"])
-def test_terrain_is_the_reset_grid_less_objects_agent_and_empty(env: str) -> None:
+def test_terrain_is_the_reset_grid_less_objects_agent_and_empty(small_agent, env: str) -> None:
     rec = record(small_agent(env), env, episodes=3, seed=5, batch=2, env_kwargs={"max_steps": 5})
     for ep in rec.episodes.itertuples(index=False):
         single = make(env, max_steps=5)
@@ -38,7 +37,7 @@ def test_terrain_is_the_reset_grid_less_objects_agent_and_empty(env: str) -> Non
         assert grid[["rows", "cols"]].values.tolist() == [list(names.shape)]
 
 
-def test_a_recording_saved_without_terrain_or_grids_still_loads(tmp_path: Path) -> None:
+def test_a_recording_saved_without_terrain_or_grids_still_loads(small_agent, tmp_path: Path) -> None:
     rec = record(small_agent("rgw2"), "rgw2", episodes=2, seed=0, env_kwargs={"max_steps": 5})
     rec.save(tmp_path / "rec")
     (tmp_path / "rec" / "terrain.parquet").unlink()
@@ -49,7 +48,7 @@ def test_a_recording_saved_without_terrain_or_grids_still_loads(tmp_path: Path) 
     assert old.steps.equals(rec.steps)
 
 
-def test_grid_and_terrain_facts_load_in_prolog(tmp_path: Path) -> None:
+def test_grid_and_terrain_facts_load_in_prolog(small_agent, tmp_path: Path) -> None:
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
     rec = record(small_agent("rgw2"), "rgw2", episodes=2, seed=0, env_kwargs={"max_steps": 5})
@@ -65,7 +64,7 @@ def test_grid_and_terrain_facts_load_in_prolog(tmp_path: Path) -> None:
         assert kb.query("kb_meta(actions, A)") == [{"A": "agent"}]
 
 
-def test_random_actions_are_reproducible_uniform_and_batch_independent() -> None:
+def test_random_actions_are_reproducible_uniform_and_batch_independent(small_agent) -> None:
     seeds = np.arange(1000)
     draws = np.stack([random_actions(seeds, t) for t in range(40)])
     counts = np.bincount(draws.ravel(), minlength=4) / draws.size
@@ -85,6 +84,6 @@ def test_random_actions_are_reproducible_uniform_and_batch_independent() -> None
     assert not greedy.steps["action"].equals(a.steps["action"])
 
 
-def test_unknown_action_source_is_refused() -> None:
+def test_unknown_action_source_is_refused(small_agent) -> None:
     with pytest.raises(ConfigError, match="actions must be one of agent, random"):
         record(small_agent("rgw2"), "rgw2", 1, actions="greedy")

@@ -13,75 +13,21 @@ skip, saying so, only where they are not installed.
 from __future__ import annotations
 
 import io
-import shutil
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from test_recorder_scripted import scripted_recording
-from test_webreport_data import (
-    SCRIPT,
-    TAG,
-    extract_folder,
-    hostile_recording,
-    report,
-)
+from pages import SCRIPT, TAG, errors, extract_folder, open_page, report
 
 from neurosym.record.recording import Recording
 
-BROWSERS = ("chromium", "chromium-browser", "google-chrome")
-INSTALL = "scripts/setup_browser.sh installs it (apt-get install chromium chromium-driver)"
-
-
-def _browser() -> tuple[str, str]:
-    binary = next((p for p in map(shutil.which, BROWSERS) if p), None)
-    driver = shutil.which("chromedriver")
-    if binary is None or driver is None:
-        missing = "chromium" if binary is None else "chromedriver"
-        pytest.skip(f"no headless browser: {missing} is not installed; {INSTALL}")
-    return binary, driver
-
 
 @pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    """A headless Chromium with its console log kept (selenium's WebDriver)."""
-    binary, driver_path = _browser()
-    webdriver = pytest.importorskip(
-        "selenium.webdriver", reason="selenium: pip install -e '.[dev]'"
-    )
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    options.binary_location = binary
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1280,900", "--force-device-scale-factor=1"):  # fmt: skip
-        options.add_argument(arg)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(driver_path), options=options)
-    try:
-        yield driver
-    finally:
-        driver.quit()
-
-
-def errors(driver: Any) -> list[str]:
-    """Console messages of level SEVERE since the last call (CSP violations included)."""
-    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
-
-
-@pytest.fixture(scope="module")
-def predinet_page(tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path]:
+def predinet_page(scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path]:
     rec = scripted_recording("predinet")
     folder = extract_folder(rec, tmp_path_factory.mktemp("browser") / "out")
     report(folder)
     return rec, folder / "index.html"
-
-
-def open_page(driver: Any, page: Path, fragment: str = "") -> None:
-    """Load ``page`` afresh (not a fragment change of the page already open)."""
-    driver.get("about:blank")
-    driver.get(page.resolve().as_uri() + fragment)
 
 
 def markers(driver: Any) -> list[dict[str, Any]]:
@@ -186,7 +132,7 @@ def test_screenshot_is_not_blank(browser: Any, predinet_page: tuple) -> None:
     assert (0x1F, 0x77, 0xB4) in found and (0x2C, 0xA0, 0x2C) in found
 
 
-def test_hostile_kb_text_runs_nothing(browser: Any, tmp_path: Path) -> None:
+def test_hostile_kb_text_runs_nothing(hostile_recording, browser: Any, tmp_path: Path) -> None:
     from selenium.common.exceptions import NoAlertPresentException
 
     folder = extract_folder(hostile_recording(), tmp_path / "out")
@@ -203,9 +149,8 @@ def test_hostile_kb_text_runs_nothing(browser: Any, tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def other_pages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Recording, Path]]:
+def other_pages(explorer_recording, scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Recording, Path]]:
     """An MHDPA page and a Box-World page."""
-    from test_recorder_scripted import explorer_recording
 
     pages = {}
     for name, rec in (

@@ -10,36 +10,15 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from test_recorder_scripted import explorer_recording, scripted_recording
+from pages import HOSTILE, HOSTILE_EVENT, SCRIPT, TAG, embedded, extract_folder, report
 
 from neurosym.cli import main
 from neurosym.facts.tables import extract_facts
-from neurosym.record.extraction import write_outputs
 from neurosym.record.heads import head_summary
 from neurosym.record.recording import SCHEMA, Recording, conform
 from neurosym.reports.terminal import rule_answers
 from neurosym.reports.web.build import identity, stale_page
 from neurosym.reports.web.player import PLAYER_TABLES, player_data
-
-DATA = re.compile(r'<script type="application/json" id="report-data">(.*?)</script>', re.S)
-
-
-def embedded(html: str) -> dict:
-    """The page's JSON data block, parsed."""
-    blocks = DATA.findall(html)
-    assert len(blocks) == 1
-    return json.loads(blocks[0])
-
-
-def extract_folder(rec: Recording, out: Path) -> Path:
-    """What ``neurosym extract --out out`` writes for ``rec`` (kb.pl, recording/)."""
-    write_outputs(out, rec, extract_facts(rec, threshold="quantile:0.9"), ("pl",))
-    return out
-
-
-def report(folder: Path, *extra: str) -> str:
-    assert main(["report", "--recording", str(folder), "--quiet", *extra]) == 0
-    return (folder / "index.html").read_text(encoding="utf-8")
 
 
 def tables_back(data: dict, name: str) -> pd.DataFrame:
@@ -54,7 +33,7 @@ def tables_back(data: dict, name: str) -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def predinet_page(tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path, str]:
+def predinet_page(scripted_recording, tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, Path, str]:
     rec = scripted_recording("predinet")
     folder = extract_folder(rec, tmp_path_factory.mktemp("predinet") / "out")
     return rec, folder, report(folder)
@@ -62,6 +41,7 @@ def predinet_page(tmp_path_factory: pytest.TempPathFactory) -> tuple[Recording, 
 
 @pytest.mark.parametrize("module", ["predinet", "mhdpa"])
 def test_embedded_tables_equal_the_recording(
+    scripted_recording,
     module: str, predinet_page: tuple[Recording, Path, str], tmp_path: Path
 ) -> None:
     if module == "predinet":
@@ -173,7 +153,7 @@ def test_report_from_a_checkpoint_writes_extracts_products(run_neurosym, tmp_pat
     )
 
 
-def test_boxworld_page(tmp_path: Path) -> None:
+def test_boxworld_page(explorer_recording, tmp_path: Path) -> None:
     rec = explorer_recording("bw2", episodes=3)
     html = report(extract_folder(rec, tmp_path / "out"))
     data = embedded(html)
@@ -243,24 +223,7 @@ def test_bad_input_is_one_line(
     assert err.count("\n") == 1
 
 
-SCRIPT = "</script><script>alert(1)</script>"
-TAG = "<img src=x onerror=alert(2)>"
-HOSTILE = f"'{SCRIPT}'"  # quoted atoms: legal Prolog, so a KB can hold them
-HOSTILE_EVENT = f"'{TAG}'"
-
-
-def hostile_recording() -> Recording:
-    """The scripted recording with an object type and an event only a hostile KB would have."""
-    rec = scripted_recording("predinet")
-    positions = rec.positions.copy()
-    positions.loc[positions["type"] == "sword", "type"] = HOSTILE
-    events = rec.events.copy()
-    events.loc[events.index[0], "event"] = HOSTILE_EVENT
-    tables = {name: rec.tables[name] for name in SCHEMA}
-    return Recording(**{**tables, "positions": positions, "events": events}, meta=rec.meta)
-
-
-def test_hostile_text_stays_text(tmp_path: Path) -> None:
+def test_hostile_text_stays_text(hostile_recording, tmp_path: Path) -> None:
     rec = hostile_recording()
     html = report(extract_folder(rec, tmp_path / "out"))
     assert SCRIPT not in html and TAG not in html
@@ -419,18 +382,22 @@ def test_a_bad_recording_meta_is_one_line(
     assert err.count("\n") == 1 and not (copy / "index.html").exists()
 
 
-def non_finite_recording() -> Recording:
-    """The scripted recording with reward +inf at its first step and relation values -inf, NaN."""
-    rec = scripted_recording("predinet")
-    steps, relations = rec.steps.copy(), rec.relations.copy()
-    steps.loc[steps.index[0], "reward"] = float("inf")
-    relations.loc[relations.index[0], "value"] = float("-inf")
-    relations.loc[relations.index[1], "value"] = float("nan")
-    tables = {name: rec.tables[name] for name in SCHEMA}
-    return Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
+@pytest.fixture(scope="session")
+def non_finite_recording(scripted_recording):  # noqa: ANN201
+    """``non_finite_recording(...)``, built from the shared builders."""
+    def non_finite_recording() -> Recording:
+        """The scripted recording with reward +inf at its first step and relation values -inf, NaN."""
+        rec = scripted_recording("predinet")
+        steps, relations = rec.steps.copy(), rec.relations.copy()
+        steps.loc[steps.index[0], "reward"] = float("inf")
+        relations.loc[relations.index[0], "value"] = float("-inf")
+        relations.loc[relations.index[1], "value"] = float("nan")
+        tables = {name: rec.tables[name] for name in SCHEMA}
+        return Recording(**{**tables, "steps": steps, "relations": relations}, meta=rec.meta)
+    return non_finite_recording
 
 
-def test_non_finite_values_reach_the_page_as_null() -> None:
+def test_non_finite_values_reach_the_page_as_null(non_finite_recording) -> None:
     """JSON has no NaN or infinity: the page's data say null where a recording has one (a
     recording read from disk never has one: Recording.load refuses it, see the next test)."""
     bad = non_finite_recording()
@@ -479,6 +446,7 @@ def test_a_probe_table_with_a_non_integer_head_is_one_line(
 
 
 def test_the_page_is_its_kbs_and_a_stale_one_is_told_and_rebuilt(
+    scripted_recording,
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A page carries the identity of the recording and KB it was built from; re-extracting
@@ -509,6 +477,7 @@ def test_the_page_is_its_kbs_and_a_stale_one_is_told_and_rebuilt(
 
 
 def test_a_page_is_not_published_beside_a_kb_extracted_while_it_was_built(
+    scripted_recording,
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     import neurosym.reports.web.page as page_module

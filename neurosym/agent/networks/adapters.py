@@ -370,3 +370,63 @@ class MHDPAAdapter(AttentionAdapter):
 
     def head_vector(self, value: torch.Tensor) -> torch.Tensor:
         return value.detach().amax(dim=2)
+
+
+@register
+class OutsideAttentionAdapter(AttentionAdapter):
+    """An agent trained outside neurosym whose named attention layer is tapped
+    (:mod:`neurosym.outside`): attention/6 from its weights, each head's attended values
+    (N, D) as its head point, max-pooled over cells for the probes. It is built by the
+    user's own code, never from a ModelConfig."""
+
+    name = "outside_attention"
+    label = "outside attention"
+    article = "an outside attention"
+    head_point = "head_out"
+
+    @classmethod
+    def build(cls, config: Any) -> nn.Module:
+        raise ConfigError(
+            "an outside agent's network is built by its own code (neurosym.outside), not from a "
+            "model config"
+        )
+
+    @classmethod
+    def keep(cls, intro: Any, grid: np.ndarray, top_keys: int = 1) -> Columns:
+        att = np.asarray(intro.attention)
+        cells = grid.shape[1]
+        if att.shape[-2:] != (cells, cells):
+            raise ConfigError(
+                f"the agent's attention is over {att.shape[-2]} queries x {att.shape[-1]} keys; "
+                f"neurosym reads attention as cell to cell over the env's {cells} grid cells "
+                "(entity k is cell k, row-major): name a layer whose tokens are the cells"
+            )
+        return super().keep(intro, grid, top_keys)
+
+    def head_vector(self, value: torch.Tensor) -> torch.Tensor:
+        return value.detach().amax(dim=2)
+
+
+@register
+class OutsideAdapter(RelationalAdapter):
+    """An agent trained outside neurosym with no attention layer named: its recordings have
+    behaviour only (no network tables, no heads)."""
+
+    name = "outside"
+    label = "outside agent"
+    article = "an outside agent"
+    head_point = "head_out"
+
+    @classmethod
+    def build(cls, config: Any) -> nn.Module:
+        return OutsideAttentionAdapter.build(config)
+
+    @classmethod
+    def keep(cls, intro: Any, grid: np.ndarray, top_keys: int = 1) -> Columns:
+        return {}
+
+    @classmethod
+    def rows(
+        cls, kept: Columns, ep: np.ndarray, t: np.ndarray, names: np.ndarray, width: int
+    ) -> dict[str, Columns]:
+        return {}

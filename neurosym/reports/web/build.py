@@ -253,7 +253,7 @@ def load_agent_or_note(
     from neurosym.agent.agent import load_agent
 
     try:
-        agent = load_agent(path)
+        agent = load_agent(path, play_env=(rec_meta or {}).get("env"))
     except NeurosymError as exc:
         return None, f"The checkpoint {path} could not be read ({exc}): its card is partial."
     differs = _other_agent(agent, rec_meta or {})

@@ -41,7 +41,7 @@ class ReportOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """``neurosym report``'s options."""
 
     checkpoint: str | None = option(None, metavar="FILE", exclusive="source", required_one=True)
-    """trained agent (.pt) to record"""
+    """trained agent: a checkpoint (.pt) or a shipped agent's name, FILE.py:FUNCTION (your PyTorch module) or a Stable-Baselines3 .zip, to record"""
     recording: str | None = option(None, metavar="DIR", exclusive="source")
     """report the folder `neurosym extract --out DIR` wrote"""
     threshold: str | None = option(None, metavar="SPEC")
@@ -150,7 +150,7 @@ def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path
     from neurosym.reports.web.card import agent_card
     from neurosym.reports.web.page import render
 
-    agent = load_agent(args.checkpoint)
+    agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     out = Path(args.out) if args.out else Path("kb_out") / env

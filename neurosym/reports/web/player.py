@@ -1,7 +1,7 @@
 """The episode player's data: the recording's tables, split per episode, as JSON-ready columns.
 
 Every table the player draws from (``positions``, ``holding``, ``events``,
-``attends``, ``relations``, ``attention``) is embedded as it was recorded,
+``attends``, ``relations``, ``attention``; Minigrid's ``facing`` and ``doors``) is embedded as it was recorded,
 one column list per schema column without ``episode``, floats at full
 precision: the page shows the recording's own values, and
 ``tests/reports/test_webreport_data.py`` checks that the embedded columns put back
@@ -22,6 +22,11 @@ from neurosym.record.recording import SCHEMA, Recording, empty_table
 
 PLAYER_TABLES = ("positions", "holding", "events", "attends", "relations", "attention")
 """recording tables embedded per episode"""
+
+MINIGRID_TABLES = ("facing", "doors")
+"""Minigrid's own tables (the agent's direction, each door's state by its id), embedded per
+episode as well when the recording has rows in them: the map draws the agent's direction and
+open, closed and locked doors from them"""
 
 
 def finite(value: float) -> float | None:
@@ -64,7 +69,8 @@ def player_data(rec: Recording) -> dict[str, Any]:
     if not heads:
         heads = list(range(int(meta.get("heads") or 0)))
     terrains: list[list[list[str]]] = []
-    by_episode = {name: dict(tuple(rec.tables[name].groupby("episode"))) for name in PLAYER_TABLES}
+    names = PLAYER_TABLES + tuple(n for n in MINIGRID_TABLES if not rec.tables[n].empty)
+    by_episode = {name: dict(tuple(rec.tables[name].groupby("episode"))) for name in names}
     steps = dict(tuple(rec.steps.groupby("episode")))
     episodes = []
     for row in rec.episodes.sort_values("episode").to_dict("records"):
@@ -80,7 +86,7 @@ def player_data(rec: Recording) -> dict[str, Any]:
                 "actions": [str(a) for a in own["action"]],
                 "rewards": [finite(float(r)) for r in own["reward"]],
                 "tables": {
-                    name: columns(by_episode[name].get(e, _empty(name))) for name in PLAYER_TABLES
+                    name: columns(by_episode[name].get(e, _empty(name))) for name in names
                 },
             }
         )

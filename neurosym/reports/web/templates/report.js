@@ -48,8 +48,9 @@
       texts.push(labels ? el("text", { x: c * cell + cell / 2, y: r * cell + cell / 2 + cell * 0.17,
         "text-anchor": "middle", "font-size": Math.round(cell * 0.5) }, svg) : null);
     }
+    const marks = el("g", { class: "marks" }, svg);
     const overlay = el("g", {}, svg);
-    return { svg, cell, cells, texts, overlay, shown: new Array(h * w).fill(null) };
+    return { svg, cell, cells, texts, marks, overlay, shown: new Array(h * w).fill(null) };
   }
 
   function gridAt(ep, t) {
@@ -75,6 +76,46 @@
       if (map.texts[k]) { map.texts[k].textContent = s.label; map.texts[k].setAttribute("fill", s.text); }
       map.shown[k] = grid[k];
     }
+  }
+
+  // Minigrid: each door's state (open: an outline in its colour; locked: a black keyhole;
+  // closed: the filled cell as painted) and the agent's direction, from the facing and doors
+  // tables (absent for the other envs); redrawn at every step
+  const POINTS = { east: [1, 0], south: [0, 1], west: [-1, 0], north: [0, -1] };
+  function drawMarks(map, ep, t, agent) {
+    const g = map.marks, c = map.cell, w = P.shape[1];
+    g.textContent = "";
+    const doors = ep.tables.doors, pos = ep.tables.positions;
+    if (doors) {
+      const cellOf = {};
+      for (const i of ep.byT.positions[t] || []) cellOf[pos.object[i]] = i;
+      for (const i of ep.byT.doors[t] || []) {
+        const p = cellOf[doors.id[i]];
+        if (p === undefined || pos.row[p] * w + pos.col[p] === agent) continue;
+        const r = pos.row[p], col = pos.col[p], st = doors.state[i], colour = styleOf(pos.type[p]).fill;
+        const d = el("g", { class: "door", "data-row": r, "data-col": col, "data-state": st }, g);
+        el("title", {}, d).textContent = `${doors.id[i]}: ${st}`;
+        if (st === "open") {
+          el("rect", { x: col * c + 2, y: r * c + 2, width: c - 4, height: c - 4,
+            fill: (styles.empty || styleOf("empty")).fill, stroke: colour, "stroke-width": 3 }, d);
+          el("text", { x: col * c + c / 2, y: r * c + c / 2 + c * 0.17, "text-anchor": "middle",
+            "font-size": Math.round(c * 0.5), fill: colour }, d).textContent = styleOf(pos.type[p]).label;
+        } else if (st === "locked") {
+          el("rect", { x: col * c + c * 0.62, y: r * c + c * 0.6, width: c * 0.22, height: c * 0.28,
+            fill: "#000000" }, d);
+        }
+      }
+    }
+    const facing = ep.tables.facing, is = facing ? ep.byT.facing[t] || [] : [];
+    if (agent < 0 || !is.length || !POINTS[facing.direction[is[0]]]) return;
+    const dir = facing.direction[is[0]], [dx, dy] = POINTS[dir];
+    const cx = (agent % w) * c + c / 2, cy = Math.floor(agent / w) * c + c / 2;
+    const tip = [cx + 0.42 * c * dx, cy + 0.42 * c * dy], back = [cx + 0.12 * c * dx, cy + 0.12 * c * dy];
+    const side = [-0.2 * c * dy, 0.2 * c * dx];
+    const pts = [tip, [back[0] + side[0], back[1] + side[1]], [back[0] - side[0], back[1] - side[1]]];
+    const arrow = el("polygon", { class: "facing", "data-direction": dir,
+      points: pts.map((q) => q.join(",")).join(" "), fill: styleOf("agent").text }, g);
+    el("title", {}, arrow).textContent = `agent facing ${dir}`;
   }
 
   // a highlighted cell: outline (solid or dashed) and a badge, named by data-row/data-col
@@ -236,8 +277,10 @@
     const t = state.t;
     const { grid, agent } = gridAt(ep, t);
     paint(mainMap, grid);
+    drawMarks(mainMap, ep, t, agent);
     for (const panel of panels) {
       paint(panel.map, grid);
+      drawMarks(panel.map, ep, t, agent);
       if (P.module === "mhdpa") drawMHDPA(panel, ep, t, agent); else drawPrediNet(panel, ep, t);
     }
     drawRelations(ep, t);
