@@ -50,8 +50,10 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
     seed (the network still runs on every state, so its facts are extracted;
     kb_meta(actions, random))"""
-    threshold: str = option("quantile:0.9", metavar="SPEC")
+    threshold: str | None = option(None, metavar="SPEC", shown="quantile:0.9")
     """per-relation threshold for holds/5: quantile:Q, abs:X or z:K"""
+    # an agent with the fact bottleneck (relation_bits=tau) defaults to abs:tau: the bits its
+    # policy read (extraction.model_threshold)
     format: str = option("pl", metavar="LIST")
     """comma-separated outputs: pl, parquet"""
     qlf: bool = False
@@ -96,7 +98,8 @@ def run(args: ExtractOptions) -> int:
     from neurosym.record.extraction import check_extract_options, extract, write_outputs
 
     formats = parse_formats(args.format)
-    parse_threshold(args.threshold)
+    if args.threshold is not None:
+        parse_threshold(args.threshold)  # a bad spec is refused before the agent is read
     check_extract_options(args.episodes, args.seed, args.batch, args.top_keys)
     agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)

@@ -66,7 +66,7 @@ def extract(
     episodes: int = 20,
     seed: int = 0,
     greedy: bool = True,
-    threshold: str | float | Any = DEFAULT_THRESHOLD,
+    threshold: str | float | Any | None = None,
     batch: int | None = None,
     top_keys: int | None = None,
     actions: str = "agent",
@@ -77,7 +77,8 @@ def extract(
 
     ``agent``: a checkpoint path (or a shipped agent's name) or a loaded Agent. ``env``: any env
     of its family with its observation shape (default: its own), ``env_kwargs`` options on top.
-    ``threshold``: the relations' threshold spec (``quantile:0.9``, ``abs:X``, ``z:K``).
+    ``threshold``: the relations' threshold spec (``quantile:0.9``, ``abs:X``, ``z:K``); None: the
+    agent's own (:func:`model_threshold`).
     ``top_keys``: MHDPA's strongest keys kept per query cell (refused for a module without
     attention/6 facts).
     ``faithfulness``: also measure how much of the agent's choices the relation facts
@@ -157,3 +158,13 @@ def is_report_page(path: Path) -> bool:
             return _PAGE_MARK in page.read(4096)
     except OSError:
         return False
+
+
+def model_threshold(config: Any) -> str:
+    """The holds/5 threshold an agent's KB is written with by default: ``abs:tau`` for the fact
+    bottleneck (ModelConfig.relation_bits, so the KB's holds/5 are the bits its policy read),
+    else quantile:0.9."""
+    from neurosym.agent.networks.predinet import bits_threshold
+
+    tau = bits_threshold(getattr(config, "relation_bits", None))
+    return DEFAULT_THRESHOLD if tau is None else f"abs:{tau!r}"
