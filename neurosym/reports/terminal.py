@@ -219,7 +219,7 @@ def _short(answer: Answer, limit: int = 20) -> str:
     shown = values[:limit]
     head = ", ".join(shown) + (", ..." if len(values) > limit else "")
     if answer.unit == "states":
-        return "\n".join(values)
+        return _links_cell(values)
     if len(values) == 1 and (answer.of is None or answer.unit == "distinct orders"):
         return head
     return f"{head}  ({_count(answer, len(shown))})"
@@ -231,9 +231,23 @@ def _brief(answer: Answer) -> str:
         return answer.empty
     if answer.unit.startswith("episodes"):
         return _count(answer, len(answer.values))
-    if answer.unit == "states":  # link answers: one per line, each says what it counts
-        return "\n".join(answer.values) or "none"
+    if answer.unit == "states":  # link answers: each says what it counts
+        return _links_cell(answer.values)
     return _short(answer, limit=3)
+
+
+def _links_cell(values: list[str]) -> str:
+    """Link answers in one cell: ``none`` once for every colour that has none, the others
+    joined by ``; `` (one answer per colour on Box-World, one in all on RGW)."""
+    if not values:
+        return "none"
+    nones = [v for v in values if v.endswith(": none")]
+    rest = [v for v in values if not v.endswith(": none")]
+    if len(nones) > 1 or (nones and rest):
+        rest.append(f"none for {len(nones)} colour{'s' if len(nones) > 1 else ''}")
+    elif nones:
+        rest.append(nones[0])
+    return "; ".join(rest)
 
 
 def add_rows(table: Any, rows: list[tuple[str, ...]], whole: tuple[int, ...]) -> None:
