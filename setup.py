@@ -23,7 +23,10 @@ setup(
         "neurosym.envs": ["maps/*.txt"],
         "neurosym.prolog": ["pl/*.pl"],  # the bridge's Prolog modules (not their .plt tests)
         "neurosym.induce": ["pl/*.pl"],  # the Prolog text learned files carry
-        "neurosym.play": ["pl/*.pl"],  # the Prolog half of neurosym play
+        "neurosym.play": [
+            "pl/*.pl",
+            "strategies/*.pl",
+        ],  # neurosym play's Prolog, --compare's strategies
         "neurosym.reports.web": ["templates/*"],
         "neurosym.rules": ["*.pl", "lib/*.pl"],
         "neurosym.checkpoints": ["*.pt"],

@@ -8,9 +8,11 @@ Lines, in order:
   :func:`neurosym.play.score_strategy` (batched env, live facts asserted through
   janus, goal/3 and route/4 in SWI-Prolog, scoring as ``neurosym eval``),
   best and median of ``--repeat`` runs of ``steps_per_s`` (env steps per
-  second of the whole loop), ``decide_ms`` (mean time of one decision: one
-  janus call that asserts the state and asks goal/3 and route/4), and the
-  strategy's ``success_rate`` and ``fallback_steps``;
+  second of the whole loop), ``decide_ms`` (mean Prolog time of one decision:
+  the step's one janus call, decide_all/5, that asserts each running
+  episode's state and asks goal/3 and route/4, divided by its decisions), and
+  the strategy's ``success_rate``, ``fallback_steps`` and ``deciders`` (steps
+  by what decided them) under ``--fallback``;
 * ``route`` : route/4 alone on a live rgw-random state, mean ms per call over
   ``--calls`` calls with route.pl's memory of routes cleared before each,
   and the same remembered (the cost a strategy pays when it asks again);
@@ -50,8 +52,10 @@ def emit(**fields: Any) -> None:
     print(json.dumps(fields), flush=True)
 
 
-def play_once(policy: Path, env: str, episodes: int, seed: int, kwargs: dict) -> dict[str, Any]:
-    with PrologAgent(policy) as agent:
+def play_once(
+    policy: Path, env: str, episodes: int, seed: int, kwargs: dict, fallback: str
+) -> dict[str, Any]:
+    with PrologAgent(policy, fallback=fallback) as agent:
         start = time.perf_counter()
         done = play_scored(
             agent.act,
@@ -68,6 +72,7 @@ def play_once(policy: Path, env: str, episodes: int, seed: int, kwargs: dict) ->
             "decide_ms": 1000 * agent.decide_seconds / max(agent.decisions, 1),
             "success_rate": sum(o in ("terminal", "gem") for o in done.outcomes) / episodes,
             "fallback_steps": int(sum(agent.fallbacks.values())),
+            "deciders": dict(agent.deciders),
         }
 
 
@@ -128,6 +133,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3_000_000_000)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--calls", type=int, default=200)
+    parser.add_argument("--fallback", choices=("default", "none"), default="default")
     args = parser.parse_args()
     emit(
         what="machine",
@@ -139,7 +145,8 @@ def main() -> None:
     kwargs = parse_env_options(args.env_option, args.env)
     for policy, env in runs:
         results = [
-            play_once(policy, env, args.episodes, args.seed, kwargs) for _ in range(args.repeat)
+            play_once(policy, env, args.episodes, args.seed, kwargs, args.fallback)
+            for _ in range(args.repeat)
         ]
         rates = [r["steps_per_s"] for r in results]
         emit(
@@ -154,6 +161,8 @@ def main() -> None:
             decide_ms=round(min(r["decide_ms"] for r in results), 3),
             success_rate=results[0]["success_rate"],
             fallback_steps=results[0]["fallback_steps"],
+            fallback=args.fallback,
+            deciders=results[0]["deciders"],
         )
     bench_route(args.calls)
 

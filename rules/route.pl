@@ -1,67 +1,101 @@
-/*  route.pl -- background knowledge for a Prolog agent: the first action of a
-    cheapest path from the agent to an object, in Relational-Grid-World and
-    Box-World.
+:- module(route,
+          [ route/4,
+            route/5,
+            route_distance/4,
+            route_exists/3,
+            route_forget/1,
+            safe_step/3,
+            default_goal/3,
+            route_moves/4,
+            route_moves/5
+          ]).
 
-    This file is background knowledge written by hand, not learned: a learned
-    strategy (strategy.pl, goal(E, T, Object)) says which object the agent goes
-    for next; route/4 says how to get there. `neurosym play` loads it beside
-    the strategy. Load it beside a neurosym knowledge base or live state:
-        swipl kb.pl rules/route.pl
+/** <module> route: how a Prolog agent gets to an object
 
-    Expects the facts of docs/design.md for state T of episode E:
-        at(E, T, Id, Row, Col)   the agent (Id agent) and the objects on the map
-        object(Id, Type)         RGW sword, enemy, terminal, teleport, pit;
-                                 Box-World key(C), lock(C), gem
-        holding(E, T, Item)      sword, or key(C)
-        terrain(E, Type, Row, Col)  wall, mountain (cells that hold no object)
-        grid(E, Rows, Cols)      the map's size
+Background knowledge for a Prolog agent, written by hand, not learned: the
+first action of a cheapest path from the agent to an object, in
+Relational-Grid-World and Box-World. A strategy (strategy.pl, goal(E, T,
+Object), learned by `neurosym induce strategy` or written by hand) says which
+object the agent goes for next; route/4 says how to get there. `neurosym play`
+loads it beside the strategy. Load it beside a neurosym knowledge base or live
+state:
 
-    Moves: up, right, down, left (row - 1, col + 1, row + 1, col - 1). A path
-    may not leave the grid, enter a wall, or enter a cell of an object other
-    than the goal: entering one triggers an event on the way (RGW: the sword is
-    picked up, an unarmed enemy hurts or blocks, a teleport end moves the agent,
-    a pit ends the episode, the terminal ends it; Box-World: a loose key is
-    picked up and the held key lost, a lock or a box's content blocks). The
-    exception: an agent that holds the sword may cross RGW enemies (the env
-    pays +1 and removes them). When no such path exists, a second search
-    takes the teleport (entering one of its two ends lands on the other). An
-    unarmed agent has no route to an enemy: meeting it costs -1 (and with a
-    blocking enemy the agent never gets through); nor has any agent a route
-    into a pit, which ends the episode.
+    swipl kb.pl rules/route.pl strategy.pl
 
-    Cost: a step costs 1; entering a mountain costs 1 + Rows * Cols, more than
-    any path without it. The env pays -0.1 for a mountain and nothing for a
-    step, so a path with fewer mountains always earns more; among those, the
-    shortest is taken (the step limit is the only price of a step). Ties go
-    to the first action in the order up, right, down, left.
+Reads the facts of docs/design.md for state T of episode E:
 
-    Dijkstra's search over library(heaps); the map and the visited cells are
-    terms with one argument per cell, read with arg/3. Each episode's
-    terrain and cell neighbours are built once (route_pl_grid_/6).
-    Helpers start with route_pl_, so this file loads beside the other rule
-    files and beside a learned strategy (whose own helpers start with route_).
+    at(E, T, Id, Row, Col)     the agent (Id agent) and the objects on the map
+    object(Id, Type)           RGW sword, enemy, terminal, teleport, pit;
+                               Box-World key(C), lock(C), gem
+    holding(E, T, Item)        sword, or key(C)
+    terrain(E, Type, Row, Col) wall, mountain (cells that hold no object)
+    grid(E, Rows, Cols)        the map's size
 
-    route_moves/4,5 count moves instead, for the route features of a learned
-    strategy (`neurosym induce --what strategy`): a breadth-first search
-    that enters no object on the way but the sword, and no teleport jump.
-    One search from a cell answers for every object of the state: it runs
-    once per state and start cell, and its answers are remembered.
+A module whose helpers stay inside it, so it loads beside the other rule
+files and beside a strategy (whose own helpers may be called anything but the
+exports above). It reads the facts as unqualified goals, which resolve through
+its default import module: user in plain swipl, the KB's own module in
+neurosym.prolog.KnowledgeBase (which loads a copy of the module per KB, see
+rules/lib/kb_common.pl). A KB without at/5 has nothing to route; one that
+defines none of the others (no holding/3, say) is read as holding none of
+them (a neurosym KB declares every schema predicate dynamic).
 
-    What route/5 and route_moves/5 remember (routes, move counts, searches,
-    each episode's map) lives in module route_pl_cache (memo_/5, moves_/5,
-    searched_/6, grid_/6, keyed by the module that loaded this file), out of
-    reach of the facts: a KB, which holds facts for predicates without a
-    module (in its own module, or in user), cannot plant answers there. The file
-    itself is plain Prolog (no module header), so that it loads into a KB
-    module, into user, and beside other rule files alike.
+Moves: up, right, down, left (row - 1, col + 1, row + 1, col - 1). A path may
+not leave the grid, enter a wall, or enter a cell of an object other than the
+goal: entering one triggers an event on the way (RGW: the sword is picked up,
+an unarmed enemy hurts or blocks, a teleport end moves the agent, a pit ends
+the episode, the terminal ends it; Box-World: a loose key is picked up and
+the held key lost, a lock or a box's content blocks). The exception: an agent
+that holds the sword may cross RGW enemies (the env pays +1 and removes
+them). When no such path exists, a second search takes the teleport (entering
+one of its two ends lands on the other). An unarmed agent has no route to an
+enemy: meeting it costs -1 (and with a blocking enemy the agent never gets
+through); nor has any agent a route into a pit, which ends the episode.
+
+Cost: a step costs 1; entering a mountain costs 1 + Rows * Cols, more than any
+path without it. The env pays -0.1 for a mountain and nothing for a step, so
+a path with fewer mountains always earns more; among those, the shortest is
+taken (the step limit is the only price of a step). Ties go to the first
+action in the order up, right, down, left.
+
+The search: a breadth-first search with mountains closed, which answers
+whenever a path without a mountain exists (every such path is cheaper than
+any with one); else a search by layers of mountains crossed, which visits
+the paths in the order of Dijkstra's (search_/4). The map and the
+visited cells are terms with one argument per cell, read with arg/3; each
+episode's terrain is built once, the cells' neighbours once per grid size.
+
+route_moves/4,5 count moves instead, for the route features of a learned
+strategy (`neurosym induce strategy`): a breadth-first search that enters no
+object on the way but the sword, and no teleport jump. One search from a cell
+answers for every object of the state.
+
+What is remembered: the routes and move counts of the state last asked (a
+strategy asks route_moves/4 for each candidate object, then the agent asks
+route/4 for the one chosen), in global variables of this module's copy (per
+thread); the terrain of each episode and the move searches by start cell
+and blocked cells, in this module's own dynamic predicates. Facts of a KB,
+which live in another module, cannot plant answers there. route_forget/1
+forgets an episode.
 */
 
-:- use_module(library(heaps)).
 :- use_module(library(assoc)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(library(error)).
 
-:- dynamic at/5, object/2, holding/3, terrain/4, grid/3.
+:- dynamic grid_/4, searched_/5, cache_key_/2.
+
+%   grid_(E, Rows, Cols, Terrain): episode E's terrain as a term with one
+%   argument per cell (mountain, wall, unbound for a free cell).
+%   searched_(E, Start, Hash, Blocked, Cells): a move search (route_moves/5).
+%   cache_key_(Kind, Key): the global variables of this copy of the module
+%   (routes, moves, adjacency), named after it when it loads.
+:- prolog_load_context(module, M),
+   retractall(cache_key_(_, _)),
+   forall(member(Kind, [routes, moves, adjacency]),
+          ( format(atom(Key), '$route ~w ~w', [M, Kind]),
+            assertz(cache_key_(Kind, Key)) )).
 
 %!  route(+E, +T, +Goal, -Action) is semidet.
 %
@@ -79,69 +113,44 @@ route(E, T, Goal, Action) :-
 %!  route(+E, +T, +Goal, -Action, -Cost) is semidet.
 %
 %   As route/4; Cost is the path's cost (steps, plus Rows * Cols per mountain).
+%   The answers of the state last asked are remembered.
 
 route(E, T, Goal, Action, Cost) :-
     ground(E-T-Goal),
     !,
-    context_module(M),
-    route_pl_memo_ready_,
-    (   route_pl_cache:memo_(M, E, T, Goal, Found)
+    cache_key_(routes, K),
+    (   nb_current(K, routes(E0, T0, Found0)), E0 == E, T0 == T
     ->  true
-    ;   (   route_pl_(E, T, Goal, A, C)
+    ;   Found0 = []
+    ),
+    (   memberchk(Goal-F, Found0)
+    ->  Found = F
+    ;   (   search_route_(E, T, Goal, A, C)
         ->  Found = found(A, C)
         ;   Found = none
         ),
-        assertz(route_pl_cache:memo_(M, E, T, Goal, Found))
+        nb_setval(K, routes(E, T, [Goal-Found|Found0]))
     ),
     Found = found(Action, Cost).
 route(E, T, Goal, Action, Cost) :-
-    route_pl_(E, T, Goal, Action, Cost).
+    search_route_(E, T, Goal, Action, Cost).
 
 %!  route_forget(+E) is det.
 %
-%   Forget what was remembered for episode E. route/5 remembers its answer
-%   for each state and goal, route_moves/5 its searches, both the episode's
-%   map, since a state's facts do not change (in a KB, and in the live
-%   states of `neurosym play`, which calls this when an episode ends); call
-%   it after changing the facts of an episode it was asked about.
+%   Forget what was remembered for episode E: its terrain, its move
+%   searches, and the routes and move counts of its state last asked. Call
+%   it after changing the facts of an episode it was asked about (in a KB
+%   and in the live states of `neurosym play` a state's facts do not
+%   change; play calls it when an episode ends).
 
 route_forget(E) :-
-    context_module(M),
-    route_pl_memo_ready_,
-    retractall(route_pl_cache:memo_(M, E, _, _, _)),
-    retractall(route_pl_cache:moves_(_, E, M, _, _)),
-    retractall(route_pl_cache:grid_(E, M, _, _, _, _)),
-    retractall(route_pl_cache:searched_(E, M, _, _, _, _)).
-
-%   The memos are declared when first used, not by a directive: a directive
-%   would tie them to this file, and unloading one copy of the file (a
-%   closed KB) would take the other copies' memos with them. Their module
-%   inherits from system only, not from user: facts of the same names in
-%   user (a KB consulted in plain swipl) stay out of sight. The flag is a
-%   global variable (per thread), which no fact can set.
-route_pl_memo_ready_ :-
-    (   nb_current(route_pl_memo_ready, true)
-    ->  true
-    ;   set_module(route_pl_cache:base(system)),
-        dynamic([ route_pl_cache:memo_/5, route_pl_cache:moves_/5,
-                  route_pl_cache:searched_/6, route_pl_cache:grid_/6 ]),
-        nb_setval(route_pl_memo_ready, true)
-    ).
-
-route_pl_(E, T, Goal, Action, Cost) :-
-    at(E, T, agent, R0, C0),
-    at(E, T, Goal, GR, GC),
-    Goal \== agent,
-    \+ (R0 == GR, C0 == GC),
-    \+ object(Goal, pit),
-    \+ ( object(Goal, enemy), \+ holding(E, T, sword) ),
-    !,
-    context_module(M),
-    route_pl_memo_ready_,
-    route_pl_mode_(Mode),
-    route_pl_map_(M, E, T, Goal, Mode, GR-GC, Map),
-    route_pl_search_(R0-C0, Map, Action, Cost),
-    !.
+    retractall(grid_(E, _, _, _)),
+    retractall(searched_(E, _, _, _, _)),
+    forall(( member(Kind, [routes, moves]),
+             cache_key_(Kind, K),
+             nb_current(K, V),
+             compound(V), arg(1, V, E0), E0 == E ),
+           nb_setval(K, none)).
 
 %!  route_distance(+E, +T, +Goal, -Cost) is semidet.
 %
@@ -170,10 +179,10 @@ route_exists(E, T, Goal) :-
 
 safe_step(E, T, Action) :-
     at(E, T, agent, R, C),
-    grid(E, Rows, Cols),
-    route_pl_blocked_(E, T, none, Blocked),
-    route_pl_move_(Action, R-C, R1-C1),
-    route_pl_inside_(R1-C1, Rows, Cols),
+    kb_grid_(E, Rows, Cols),
+    blocked_(E, T, none, Blocked),
+    move_(Action, R-C, R1-C1),
+    inside_(R1-C1, Rows, Cols),
     Cell is R1 * Cols + C1,
     \+ get_assoc(Cell, Blocked, _),
     !.
@@ -200,187 +209,215 @@ route_moves(E, T, Goal, Moves) :-
 %
 %   As route_moves/4, from cell From (Row-Col) instead of the agent's cell
 %   (a teleport end's, say). One breadth-first search from From answers for
-%   every object of the state; it is remembered, keyed by the loading
-%   module, E, T and From, until route_forget/1.
+%   every object of the state; the searches of the state last asked are
+%   remembered.
 
 route_moves(E, T, From, Goal, Moves) :-
     must_be(ground, E-T-From),
-    context_module(M),
-    route_pl_memo_ready_,
-    (   route_pl_cache:moves_(T, E, M, From, Table)
-    ->  true
-    ;   route_pl_moves_(M, E, T, From, Table),
-        assertz(route_pl_cache:moves_(T, E, M, From, Table))
-    ),
-    (   get_assoc(Goal, Table, Moves0)
-    ->  Moves = Moves0
+    moves_search_(E, T, From, Search),
+    (   at(E, T, Goal, R, C)
+    ->  moves_to_(Search, R, C, Moves)
     ;   Moves = 999
     ).
 
-%   route_pl_moves_(+M, +E, +T, +From, -Table): assoc of each object on
-%   the map (its first at/5 fact) to its moves from From: one more than the
-%   nearest of its neighbours the search reached, else 999.
-route_pl_moves_(M, E, T, R0-C0, Table) :-
-    findall(Id-(R-C), at(E, T, Id, R, C), Objects),
-    (   route_pl_grid_(M, E, Rows, Cols, Adj, Cells0),
-        route_pl_inside_(R0-C0, Rows, Cols)
+%   moves_search_(+E, +T, +From, -Search): the move search from From in
+%   state T, search(Rows, Cols, Cells) (Cells: the moves to each cell
+%   reached), or none (no grid, or From off it); remembered for the state
+%   last asked.
+moves_search_(E, T, From, Search) :-
+    cache_key_(moves, K),
+    (   nb_current(K, moves(E0, T0, Searches)), E0 == E, T0 == T
+    ->  true
+    ;   Searches = []
+    ),
+    (   memberchk(From-S, Searches)
+    ->  Search = S
+    ;   new_moves_search_(E, T, From, Search),
+        nb_setval(K, moves(E, T, [From-Search|Searches]))
+    ).
+
+new_moves_search_(E, T, R0-C0, Search) :-
+    (   grid_terrain_(E, Rows, Cols, Cells0),
+        inside_(R0-C0, Rows, Cols)
     ->  S is R0 * Cols + C0 + 1,
-        findall(I, ( member(Id-(R-C), Objects), Id \== agent, \+ route_pl_passable_(Id),
-                     route_pl_inside_(R-C, Rows, Cols), I is R * Cols + C + 1 ),
+        findall(I, ( at(E, T, Id, R, C), Id \== agent, \+ passable_(Id),
+                     inside_(R-C, Rows, Cols), I is R * Cols + C + 1 ),
                 Blocked0),
         sort(Blocked0, Blocked),
-        route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells),
-        Search = search(Rows, Cols, Adj, Cells)
+        moves_bfs_(E, S, Blocked, Rows, Cols, Cells0, Cells),
+        Search = search(Rows, Cols, Cells)
     ;   Search = none
-    ),
-    empty_assoc(A0),
-    foldl(route_pl_moves_put_(Search), Objects, A0, Table).
+    ).
 
-%   route_pl_searched_(+M, +E, +Start, +Blocked, +Adj, +Cells0, -Cells): the
+%   moves_bfs_(+E, +Start, +Blocked, +Rows, +Cols, +Cells0, -Cells): the
 %   search from cell Start (argument index) with the cells Blocked closed,
 %   Cells0 the episode's terrain. It depends on nothing else (the agent's
 %   cell is free), so it is remembered by episode, start and the blocked
 %   cells (a teleport end's search serves every state until an object
 %   moves or goes), until route_forget/1.
-route_pl_searched_(M, E, S, Blocked, Adj, Cells0, Cells) :-
+moves_bfs_(E, S, Blocked, Rows, Cols, Cells0, Cells) :-
     term_hash(Blocked, H),
-    (   route_pl_cache:searched_(E, M, S, H, Blocked, Cells1)
+    (   searched_(E, S, H, Blocked, Cells1)
     ->  Cells = Cells1
     ;   forall(member(I, Blocked), nb_setarg(I, Cells0, x)),
         nb_setarg(S, Cells0, 0),
-        route_pl_bfs_([S], 0, Adj, Cells0),
-        assertz(route_pl_cache:searched_(E, M, S, H, Blocked, Cells0)),
+        adjacency_(Rows, Cols, Adj),
+        bfs_([S], 0, Adj, Cells0),
+        assertz(searched_(E, S, H, Blocked, Cells0)),
         Cells = Cells0
     ).
 
-route_pl_moves_put_(Search, Id-(R-C), A0, A) :-
-    (   get_assoc(Id, A0, _)
-    ->  A = A0
-    ;   route_pl_moves_to_(Search, R, C, Moves),
-        put_assoc(Id, A0, Moves, A)
-    ).
-
-route_pl_moves_to_(search(Rows, Cols, Adj, Cells), R, C, Moves) :-
-    route_pl_inside_(R-C, Rows, Cols),
+%   moves_to_(+Search, +R, +C, -Moves): one more than the nearest of the
+%   cell's neighbours the search reached, else 999.
+moves_to_(search(Rows, Cols, Cells), R, C, Moves) :-
+    inside_(R-C, Rows, Cols),
     !,
+    adjacency_(Rows, Cols, Adj),
     I is R * Cols + C + 1,
     arg(I, Adj, Neighbours),
-    foldl(route_pl_nearer_(Cells), Neighbours, 999, Near),
+    foldl(nearer_(Cells), Neighbours, 999, Near),
     (   Near < 999 -> Moves is Near + 1 ; Moves = 999 ).
-route_pl_moves_to_(_, _, _, 999).
+moves_to_(_, _, _, 999).
 
-route_pl_nearer_(Cells, I, D0, D) :-
+nearer_(Cells, I, D0, D) :-
     arg(I, Cells, V),
     (   integer(V), V < D0 -> D = V ; D = D0 ).
 
 %   Objects a contact-free path may cross: the sword (a type sword, or a
 %   compound of that name).
-route_pl_passable_(Id) :-
-    object(Id, Type),
+passable_(Id) :-
+    kb_object_(Id, Type),
     (   compound(Type) -> functor(Type, sword, _) ; Type == sword ),
     !.
 
-%   route_pl_grid_(+M, +E, -Rows, -Cols, -Adj, -Cells): episode E's map as
-%   two terms with one argument per cell (Row * Cols + Col + 1). Adj: the
-%   list of the cells a step from it enters inside the grid, in the order
-%   up, right, down, left. Cells: a fresh copy (the caller may change it)
-%   of the cells' terrain: mountain, wall (any other terrain), unbound for
-%   a free cell. Built once per episode and remembered, keyed by the
-%   loading module and E, until route_forget/1.
-route_pl_grid_(M, E, Rows, Cols, Adj, Cells) :-
-    (   route_pl_cache:grid_(E, M, Rows0, Cols0, Adj0, Cells0)
-    ->  Rows = Rows0, Cols = Cols0, Adj = Adj0, Cells = Cells0
-    ;   grid(E, Rows, Cols),
+%   grid_terrain_(+E, -Rows, -Cols, -Cells): episode E's size and a fresh
+%   copy (the caller may change it) of its terrain, one argument per cell
+%   (Row * Cols + Col + 1): mountain, wall (any other terrain), unbound for
+%   a free cell. Built once per episode, until route_forget/1.
+grid_terrain_(E, Rows, Cols, Cells) :-
+    (   grid_(E, Rows0, Cols0, Cells0)
+    ->  Rows = Rows0, Cols = Cols0, Cells = Cells0
+    ;   kb_grid_(E, Rows, Cols),
         !,
-        route_pl_terrain_(E, Rows, Cols, Cells),
-        route_pl_adjacency_(Rows, Cols, Adj),
-        assertz(route_pl_cache:grid_(E, M, Rows, Cols, Adj, Cells))
+        terrain_(E, Rows, Cols, Cells),
+        assertz(grid_(E, Rows, Cols, Cells))
     ).
 
-route_pl_terrain_(E, Rows, Cols, Cells) :-
+terrain_(E, Rows, Cols, Cells) :-
     N is Rows * Cols,
     functor(Cells, cells, N),
-    forall(terrain(E, Type, R, C),
+    forall(kb_terrain_(E, Type, R, C),
            ( I is R * Cols + C + 1,
              ( Type == mountain -> nb_setarg(I, Cells, mountain) ; nb_setarg(I, Cells, wall) ) )).
 
-route_pl_adjacency_(Rows, Cols, Adj) :-
+%   adjacency_(+Rows, +Cols, -Adj): for each cell (argument Row * Cols + Col
+%   + 1), the list of the cells a step from it enters inside the grid, in
+%   the order up, right, down, left. Built once per grid size (kept in a
+%   global variable: read in place, never copied).
+adjacency_(Rows, Cols, Adj) :-
+    cache_key_(adjacency, K),
+    (   nb_current(K, adjacency(Rows0, Cols0, Adj0)), Rows0 == Rows, Cols0 == Cols
+    ->  Adj = Adj0
+    ;   build_adjacency_(Rows, Cols, Adj),
+        nb_setval(K, adjacency(Rows, Cols, Adj))
+    ).
+
+build_adjacency_(Rows, Cols, Adj) :-
     N is Rows * Cols,
     functor(Adj, adj, N),
     forall(between(1, N, I),
            ( Cell is I - 1, R is Cell // Cols, C is Cell mod Cols,
-             findall(J, ( route_pl_move_(_, R-C, R1-C1),
-                          route_pl_inside_(R1-C1, Rows, Cols),
+             findall(J, ( move_(_, R-C, R1-C1),
+                          inside_(R1-C1, Rows, Cols),
                           J is R1 * Cols + C1 + 1 ),
                      Js),
              nb_setarg(I, Adj, Js) )).
 
-%   route_pl_bfs_(+Frontier, +D, +Adj, !Cells): the cells D moves away are
-%   Frontier (argument indices); mark their free and mountain neighbours
-%   D + 1, and go on. Cells: the moves to each cell reached, wall or x for
-%   a blocked one.
-route_pl_bfs_([], _, _, _) :- !.
-route_pl_bfs_(Frontier, D, Adj, Cells) :-
+%   bfs_(+Frontier, +D, +Adj, !Cells): the cells D moves away are Frontier
+%   (argument indices); mark their free and mountain neighbours D + 1, and
+%   go on. Cells: the moves to each cell reached, wall or x for a blocked one.
+bfs_([], _, _, _) :- !.
+bfs_(Frontier, D, Adj, Cells) :-
     D1 is D + 1,
-    route_pl_bfs_level_(Frontier, D1, Adj, Cells, Next, []),
-    route_pl_bfs_(Next, D1, Adj, Cells).
+    bfs_level_(Frontier, D1, Adj, Cells, Next, []),
+    bfs_(Next, D1, Adj, Cells).
 
-route_pl_bfs_level_([], _, _, _, Next, Next).
-route_pl_bfs_level_([I|Is], D, Adj, Cells, Next0, Next) :-
+bfs_level_([], _, _, _, Next, Next).
+bfs_level_([I|Is], D, Adj, Cells, Next0, Next) :-
     arg(I, Adj, Neighbours),
-    route_pl_bfs_visit_(Neighbours, D, Cells, Next0, Next1),
-    route_pl_bfs_level_(Is, D, Adj, Cells, Next1, Next).
+    bfs_visit_(Neighbours, D, Cells, Next0, Next1),
+    bfs_level_(Is, D, Adj, Cells, Next1, Next).
 
-route_pl_bfs_visit_([], _, _, Next, Next).
-route_pl_bfs_visit_([J|Js], D, Cells, Next0, Next) :-
+bfs_visit_([], _, _, Next, Next).
+bfs_visit_([J|Js], D, Cells, Next0, Next) :-
     arg(J, Cells, V),
     (   ( var(V) ; V == mountain )
     ->  nb_setarg(J, Cells, D),
         Next0 = [J|Next1]
     ;   Next0 = Next1
     ),
-    route_pl_bfs_visit_(Js, D, Cells, Next1, Next).
+    bfs_visit_(Js, D, Cells, Next1, Next).
 
-% --------------------------------------------------------------- helpers
+% --------------------------------------------------------------- routes
 
-route_pl_move_(up,    R-C, R1-C) :- R1 is R - 1.
-route_pl_move_(right, R-C, R-C1) :- C1 is C + 1.
-route_pl_move_(down,  R-C, R1-C) :- R1 is R + 1.
-route_pl_move_(left,  R-C, R-C1) :- C1 is C - 1.
+%   search_route_(+E, +T, ?Goal, -Action, -Cost): route/5 without memory.
+search_route_(E, T, Goal, Action, Cost) :-
+    at(E, T, agent, R0, C0),
+    at(E, T, Goal, GR, GC),
+    Goal \== agent,
+    \+ (R0 == GR, C0 == GC),
+    \+ kb_object_(Goal, pit),
+    \+ ( kb_object_(Goal, enemy), \+ kb_holding_(E, T, sword) ),
+    !,
+    mode_(Mode),
+    map_(E, T, Goal, Mode, GR-GC, Map),
+    level_search_(R0-C0, Map, Result),
+    (   Result = found(Action, Cost)
+    ->  true
+    ;   Result == closed(mountain),
+        search_(R0-C0, Map, Action, Cost)
+    ),
+    !.
 
-route_pl_move_index_(up, 0).
-route_pl_move_index_(right, 1).
-route_pl_move_index_(down, 2).
-route_pl_move_index_(left, 3).
+move_(up,    R-C, R1-C) :- R1 is R - 1.
+move_(right, R-C, R-C1) :- C1 is C + 1.
+move_(down,  R-C, R1-C) :- R1 is R + 1.
+move_(left,  R-C, R-C1) :- C1 is C - 1.
 
-route_pl_inside_(R-C, Rows, Cols) :-
+move_index_(up, 0).
+move_index_(right, 1).
+move_index_(down, 2).
+move_index_(left, 3).
+
+inside_(R-C, Rows, Cols) :-
     R >= 0, R < Rows, C >= 0, C < Cols.
 
-%   route_pl_mode_(-Mode): the rules of a search, tried in turn: strict,
-%   then with the teleport's ends as jumps.
-route_pl_mode_(strict).
-route_pl_mode_(jumps).
+%   mode_(-Mode): the rules of a search, tried in turn: strict, then with
+%   the teleport's ends as jumps.
+mode_(strict).
+mode_(jumps).
 
-%   route_pl_map_(+M, +E, +T, +Goal, +Mode, +Target, -Map): what a search
-%   needs, as map(Rows, Cols, Cells, MountainCost, TargetCell, Adj). Cells
-%   is a term with one argument per cell (Row * Cols + Col + 1), so that a
-%   search looks a cell up with arg/3: unbound for a free cell, wall (walls,
-%   and objects a path may not enter), mountain, or jump(Landing) for a
+%   map_(+E, +T, +Goal, +Mode, +Target, -Map): what a search needs, as
+%   map(Rows, Cols, Cells, MountainCost, TargetCell, Adj). Cells is a term
+%   with one argument per cell (Row * Cols + Col + 1), so that a search
+%   looks a cell up with arg/3: unbound for a free cell, wall (walls, and
+%   objects a path may not enter), mountain, or jump(Landing) for a
 %   teleport end; it starts as a fresh copy of the episode's terrain
-%   (route_pl_grid_/6). Adj: each cell's neighbours inside the grid.
-route_pl_map_(M, E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target, Adj)) :-
-    route_pl_grid_(M, E, Rows, Cols, Adj, Cells),
+%   (grid_terrain_/4). Adj: each cell's neighbours inside the grid.
+map_(E, T, Goal, Mode, GR-GC, map(Rows, Cols, Cells, Mountain, Target, Adj)) :-
+    grid_terrain_(E, Rows, Cols, Cells),
+    adjacency_(Rows, Cols, Adj),
     Mountain is 1 + Rows * Cols,
     Target is GR * Cols + GC,
-    forall(( at(E, T, Id, R, C), Id \== agent, Id \== Goal, \+ route_pl_open_(E, T, Id) ),
+    forall(( at(E, T, Id, R, C), Id \== agent, Id \== Goal, \+ open_(E, T, Id) ),
            ( I is R * Cols + C + 1, nb_setarg(I, Cells, wall) )),
-    route_pl_jumps_(E, T, Goal, Mode, Cols, Cells).
+    jumps_(E, T, Goal, Mode, Cols, Cells).
 
-%   route_pl_jumps_: in mode jumps, entering a teleport end (not the goal)
-%   lands on the other end, when the map has exactly two.
-route_pl_jumps_(E, T, Goal, Mode, Cols, Cells) :-
+%   jumps_: in mode jumps, entering a teleport end (not the goal) lands on
+%   the other end, when the map has exactly two.
+jumps_(E, T, Goal, Mode, Cols, Cells) :-
     (   Mode \== strict,
-        findall(Id-(R-C), ( object(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
+        findall(Id-(R-C), ( kb_object_(Id, teleport), at(E, T, Id, R, C) ), [A-(RA-CA), B-(RB-CB)]),
         A \== Goal, B \== Goal
     ->  CellA is RA * Cols + CA, CellB is RB * Cols + CB,
         IA is CellA + 1, IB is CellB + 1,
@@ -390,119 +427,292 @@ route_pl_jumps_(E, T, Goal, Mode, Cols, Cells) :-
     ).
 
 %   Objects a path may cross: enemies, while the agent holds the sword.
-route_pl_open_(E, T, Id) :- object(Id, enemy), holding(E, T, sword).
+open_(E, T, Id) :- kb_object_(Id, enemy), kb_holding_(E, T, sword).
 
-%   route_pl_blocked_(+E, +T, +Goal, -Blocked): assoc of the cells a path
-%   may not enter (walls, and the objects other than Goal that route/4 does
-%   not cross), for safe_step/3.
-route_pl_blocked_(E, T, Goal, Blocked) :-
-    grid(E, _, Cols),
+%   blocked_(+E, +T, +Goal, -Blocked): assoc of the cells a path may not
+%   enter (walls, and the objects other than Goal that route/4 does not
+%   cross), for safe_step/3.
+blocked_(E, T, Goal, Blocked) :-
+    kb_grid_(E, _, Cols),
     findall(Cell-wall,
-            ( terrain(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
+            ( kb_terrain_(E, Type, R, C), Type \== mountain, Cell is R * Cols + C ),
             Walls),
     findall(Cell-Id,
             ( at(E, T, Id, R, C), Id \== agent, Id \== Goal,
-              \+ route_pl_open_(E, T, Id),
+              \+ open_(E, T, Id),
               Cell is R * Cols + C ),
             Objects),
     append(Walls, Objects, Pairs),
     empty_assoc(A0),
-    foldl(route_pl_put_, Pairs, A0, Blocked).
+    foldl(put_, Pairs, A0, Blocked).
 
-route_pl_put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
+put_(K-V, A0, A) :- put_assoc(K, A0, V, A).
 
-%   route_pl_search_(+Start, +Map, -Action, -Cost): Dijkstra from Start;
-%   each queue entry keeps the first action of its path and is keyed
-%   Cost * 4 + the action's index, so that of equally cheap paths the one
-%   whose first action comes first in up, right, down, left wins. The
-%   target is always enterable. Done cells are marked in a term with one
-%   argument per cell.
-route_pl_search_(R0-C0, Map, Action, Cost) :-
+%   level_search_(+Start, +Map, -Result): a breadth-first search with
+%   mountains closed; Result found(Action, Cost). Each step costs 1, so its queue, started with the
+%   start's neighbours in the order up, right, down, left, holds the paths
+%   in the order of their cost, then of their first action (a path keeps
+%   its first action, and the paths one step longer are queued in the order
+%   of the paths they extend): the first path to reach the target is the
+%   cheapest, with the first action first, as search_/4 would find it, and
+%   a path without a mountain is cheaper than any with one. Fails when no
+%   path without a mountain reaches the target: Result is then
+%   closed(mountain) when a mountain was met (search_/4 may find a path
+%   over it), else closed(none) (no path at all). A cell is marked in Done
+%   when queued (a teleport end marks the cell it lands on); Done's last
+%   argument notes a mountain met.
+level_search_(R0-C0, Map, Result) :-
     Map = map(Rows, Cols, _, _, _, _),
+    Start is R0 * Cols + C0,
+    N is Rows * Cols,
+    N1 is N + 1,
+    functor(Done, done, N1),
+    S1 is Start + 1,
+    nb_setarg(S1, Done, x),
+    nb_setarg(N1, Done, none),
+    Up is R0 - 1, Down is R0 + 1, Left is C0 - 1, Right is C0 + 1,
+    first_steps_([Up-C0-0, R0-Right-1, Down-C0-2, R0-Left-3], Map, Done, Frontier, Hit),
+    (   Hit == none
+    ->  level_(Frontier, 1, Map, Done, MI, Cost)
+    ;   MI = Hit, Cost = 1
+    ),
+    (   nonvar(MI)
+    ->  move_index_(Action, MI),
+        Result = found(Action, Cost)
+    ;   arg(N1, Done, Closed),
+        Result = closed(Closed)
+    ).
+
+%   first_steps_(+Steps, +Map, !Done, -Queue, -Hit): the start's neighbours
+%   (Row-Col-MoveIndex, in the order up, right, down, left) queued; Hit is
+%   the move index of the one that is the target, else none.
+first_steps_([], _, _, [], none).
+first_steps_([R-C-MI|Steps], Map, Done, Q0, Hit) :-
+    Map = map(Rows, Cols, Cells, _, Target, _),
+    (   R >= 0, R < Rows, C >= 0, C < Cols
+    ->  Cell0 is R * Cols + C,
+        (   Cell0 =:= Target
+        ->  Hit = MI
+        ;   I0 is Cell0 + 1,
+            arg(I0, Cells, Kind),
+            level_enter_(Kind, Cell0, Done, MI, Q0, Q1),
+            first_steps_(Steps, Map, Done, Q1, Hit)
+        )
+    ;   first_steps_(Steps, Map, Done, Q0, Hit)
+    ).
+
+%   level_enter_(+Kind, +Cell0, !Done, +MI, -Q0, ?Q): enter Cell0 of Kind
+%   (not the target): queue the cell it lands on, Cell-MI, unless closed
+%   (wall, mountain: noted in Done's last argument) or marked.
+level_enter_(Kind, _, Done, _, Q, Q) :-
+    Kind == mountain,
+    !,
+    functor(Done, _, N1),
+    nb_setarg(N1, Done, mountain).
+level_enter_(Kind, Cell0, Done, MI, Q0, Q) :-
+    (   var(Kind)
+    ->  Cell = Cell0
+    ;   Kind = jump(Cell)
+    ),
+    I is Cell + 1,
+    arg(I, Done, Seen),
+    var(Seen),
+    !,
+    nb_setarg(I, Done, x),
+    Q0 = [Cell-MI|Q].
+level_enter_(_, _, _, _, Q, Q).
+
+%   level_(+Frontier, +D, +Map, !Done, -MI, -Cost): Frontier holds the
+%   cells D steps away (Cell-MI, in queue order); the first of them next to
+%   the target ends the search; MI stays unbound when none is left.
+level_([], _, _, _, _, _) :- !.
+level_(Frontier, D, Map, Done, MI, Cost) :-
+    Map = map(_, _, Cells, _, Target, Adj),
+    D1 is D + 1,
+    expand_level_(Frontier, Adj, Cells, Target, Done, Next, [], Hit),
+    (   Hit == none
+    ->  level_(Next, D1, Map, Done, MI, Cost)
+    ;   MI = Hit, Cost = D1
+    ).
+
+%   expand_level_(+Frontier, +Adj, +Cells, +Target, !Done, -Q0, ?Q, -Hit):
+%   the next level queued in Q0-Q, Hit none; or Hit the move index of the
+%   first cell of Frontier next to the target.
+expand_level_([], _, _, _, _, Q, Q, none).
+expand_level_([Cell-MI|Rest], Adj, Cells, Target, Done, Q0, Q, Hit) :-
+    I is Cell + 1,
+    arg(I, Adj, Neighbours),
+    expand_cell_(Neighbours, MI, Cells, Target, Done, Q0, Q1, Hit0),
+    (   Hit0 == none
+    ->  expand_level_(Rest, Adj, Cells, Target, Done, Q1, Q, Hit)
+    ;   Hit = Hit0
+    ).
+
+expand_cell_([], _, _, _, _, Q, Q, none).
+expand_cell_([J|Js], MI, Cells, Target, Done, Q0, Q, Hit) :-
+    Cell0 is J - 1,
+    (   Cell0 =:= Target
+    ->  Hit = MI
+    ;   arg(J, Cells, Kind),
+        level_enter_(Kind, Cell0, Done, MI, Q0, Q1),
+        expand_cell_(Js, MI, Cells, Target, Done, Q1, Q, Hit)
+    ).
+
+%   search_(+Start, +Map, -Action, -Cost): the cheapest path over
+%   mountains, where level_search_/3 found none without. Its cost is
+%   Steps + Mountains * Mountain (Map's mountain cost, more than any number
+%   of steps), so paths rank by their mountains, then their steps, then
+%   their first action (up, right, down, left), as in Dijkstra's search
+%   keyed Cost * 4 + the action's index; the search visits them in that
+%   order without a priority queue: layer by layer of mountains crossed
+%   (the cells first entered over one more mountain start the next layer,
+%   in the order they were met), and in a layer step by step (the cells
+%   reached in S steps: those that start the layer with S, merged by first
+%   action with those the layer's breadth-first search reached). The first
+%   path to reach the target is the cheapest. A cell is marked in Done when
+%   queued (a teleport end marks the cell it lands on).
+search_(R0-C0, Map, Action, Cost) :-
+    Map = map(Rows, Cols, Cells, Mountain, Target, _),
     Start is R0 * Cols + C0,
     N is Rows * Cols,
     functor(Done, done, N),
     S1 is Start + 1,
     nb_setarg(S1, Done, x),
-    empty_heap(Heap0),
-    route_pl_expand_start_(Start, Map, Done, Heap0, Heap1),
-    route_pl_loop_(Heap1, Map, Done, Action, Cost).
+    Up is R0 - 1, Down is R0 + 1, Left is C0 - 1, Right is C0 + 1,
+    first_layer_steps_([Up-C0-0, R0-Right-1, Down-C0-2, R0-Left-3], Rows, Cols, Cells,
+                       Target, Done, Frontier, Seeds, Hit),
+    (   Hit \== none
+    ->  MI = Hit, Cost = 1
+    ;   layers_(0, [], Frontier, 1, Seeds, Map, Done, MI, Steps, Crossed),
+        Cost is Steps + Crossed * Mountain
+    ),
+    move_index_(Action, MI).
 
-route_pl_loop_(Heap0, Map, Done, Action, Cost) :-
-    get_from_heap(Heap0, Key, Cell-First, Heap1),
-    D is Key // 4,
+%   first_layer_steps_(+Steps, +Rows, +Cols, +Cells, +Target, !Done,
+%   -Frontier, -Seeds, -Hit): the start's neighbours: Frontier the ones
+%   entered without a mountain (MI-Cell), Seeds the mountains (1-MI-Cell),
+%   Hit the move index of the target, else none.
+first_layer_steps_([], _, _, _, _, _, [], [], none).
+first_layer_steps_([R-C-MI|Steps], Rows, Cols, Cells, Target, Done, F0, S0, Hit) :-
+    (   R >= 0, R < Rows, C >= 0, C < Cols
+    ->  Cell0 is R * Cols + C,
+        (   Cell0 =:= Target
+        ->  Hit = MI
+        ;   I0 is Cell0 + 1,
+            arg(I0, Cells, Kind),
+            layer_enter_(Kind, Cell0, Done, 1, MI, F0, F1, S0, S1),
+            first_layer_steps_(Steps, Rows, Cols, Cells, Target, Done, F1, S1, Hit)
+        )
+    ;   first_layer_steps_(Steps, Rows, Cols, Cells, Target, Done, F0, S0, Hit)
+    ).
+
+%   layer_enter_(+Kind, +Cell0, !Done, +S, +MI, -F0, ?F, -S0, ?S): a path
+%   with first action MI enters Cell0 of Kind (not the target) in its S-th
+%   step: the cell it lands on is queued in F0-F (MI-Cell), a mountain in
+%   S0-S (S-MI-Cell, the next layer's), unless closed or marked.
+layer_enter_(Kind, Cell0, Done, S, MI, F0, F, Q0, Q) :-
+    Kind == mountain,
+    !,
+    F0 = F,
+    I is Cell0 + 1,
+    arg(I, Done, Seen),
+    (   var(Seen)
+    ->  nb_setarg(I, Done, x),
+        Q0 = [S-MI-Cell0|Q]
+    ;   Q0 = Q
+    ).
+layer_enter_(Kind, Cell0, Done, _, MI, F0, F, Q, Q) :-
+    (   var(Kind)
+    ->  Cell = Cell0
+    ;   Kind = jump(Cell)
+    ),
     I is Cell + 1,
     arg(I, Done, Seen),
-    (   arg(5, Map, Target), Cell =:= Target
-    ->  Action = First, Cost = D
-    ;   nonvar(Seen)
-    ->  route_pl_loop_(Heap1, Map, Done, Action, Cost)
-    ;   nb_setarg(I, Done, x),
-        route_pl_expand_(Cell, First, D, Map, Done, Heap1, Heap2),
-        route_pl_loop_(Heap2, Map, Done, Action, Cost)
+    var(Seen),
+    !,
+    nb_setarg(I, Done, x),
+    F0 = [MI-Cell|F].
+layer_enter_(_, _, _, _, _, F, F, Q, Q).
+
+%   layers_(+M, +Seeds, +Frontier, +S, +Next, +Map, !Done, -MI, -Steps,
+%   -Crossed): layer M (paths over M mountains): Frontier holds its cells S
+%   steps away (MI-Cell, by first action), Seeds its cells entered over a
+%   mountain not yet taken (S-MI-Cell, in order), Next the next layer's
+%   seeds met so far. The target reached in Steps steps over Crossed
+%   mountains with first action MI; fails when no layer is left.
+layers_(M, Seeds, Frontier, S, Next, Map, Done, MI, Steps, Crossed) :-
+    seeds_at_(Seeds, S, Now, Later),
+    merge_by_action_(Now, Frontier, Level),
+    (   Level == []
+    ->  (   Later = [S2-_-_|_]
+        ->  layers_(M, Later, [], S2, Next, Map, Done, MI, Steps, Crossed)
+        ;   Next = [S3-_-_|_]
+        ->  M1 is M + 1,
+            layers_(M1, Next, [], S3, [], Map, Done, MI, Steps, Crossed)
+        )
+    ;   Map = map(_, _, Cells, _, Target, Adj),
+        S1 is S + 1,
+        append(Next, More, Next1),       % this layer's mountains after those met before
+        expand_layer_(Level, S1, Adj, Cells, Target, Done, Frontier1, [], More, [], Hit),
+        (   Hit \== none
+        ->  MI = Hit, Steps = S1, Crossed = M
+        ;   layers_(M, Later, Frontier1, S1, Next1, Map, Done, MI, Steps, Crossed)
+        )
     ).
 
-%   From the start: each neighbour's move is the first action of the paths
-%   through it.
-route_pl_expand_start_(Cell, Map, Done, Heap0, Heap) :-
-    arg(2, Map, Cols),
-    R is Cell // Cols, C is Cell mod Cols,
-    Up is R - 1, Down is R + 1, Left is C - 1, Right is C + 1,
-    route_pl_neighbour_(Up, C, up, none, 0, Map, Done, Heap0, Heap1),
-    route_pl_neighbour_(R, Right, right, none, 0, Map, Done, Heap1, Heap2),
-    route_pl_neighbour_(Down, C, down, none, 0, Map, Done, Heap2, Heap3),
-    route_pl_neighbour_(R, Left, left, none, 0, Map, Done, Heap3, Heap).
+%   seeds_at_(+Seeds, +S, -Now, -Later): the seeds S steps away (MI-Cell),
+%   and the rest.
+seeds_at_([S0-MI-Cell|Seeds], S, [MI-Cell|Now], Later) :-
+    S0 =:= S,
+    !,
+    seeds_at_(Seeds, S, Now, Later).
+seeds_at_(Seeds, _, [], Seeds).
 
-%   Past the start, a path keeps its first action: the neighbours come from
-%   the episode's adjacency (Adj), their order does not matter (a queue
-%   key holds cost and first action, so equal keys are equal paths).
-route_pl_expand_(Cell, First, D, Map, Done, Heap0, Heap) :-
-    arg(6, Map, Adj),
+%   merge_by_action_(+A, +B, -Merged): two lists of MI-Cell, each ordered
+%   by MI, merged (stable: A first on equal MI).
+merge_by_action_([], B, B) :- !.
+merge_by_action_(A, [], A) :- !.
+merge_by_action_([MA-CA|As], [MB-CB|Bs], [X|Xs]) :-
+    (   MA =< MB
+    ->  X = MA-CA, merge_by_action_(As, [MB-CB|Bs], Xs)
+    ;   X = MB-CB, merge_by_action_([MA-CA|As], Bs, Xs)
+    ).
+
+%   expand_layer_(+Level, +S1, +Adj, +Cells, +Target, !Done, -F0, ?F, -Q0,
+%   ?Q, -Hit): the neighbours of Level's cells (MI-Cell, in order), S1
+%   steps away: queued in F0-F, mountains in Q0-Q; Hit the move index of
+%   the first next to the target, else none.
+expand_layer_([], _, _, _, _, _, F, F, Q, Q, none).
+expand_layer_([MI-Cell|Rest], S1, Adj, Cells, Target, Done, F0, F, Q0, Q, Hit) :-
     I is Cell + 1,
     arg(I, Adj, Neighbours),
-    route_pl_move_index_(First, MI),
-    route_pl_adjacent_(Neighbours, First, MI, D, Map, Done, Heap0, Heap).
-
-route_pl_adjacent_([], _, _, _, _, _, Heap, Heap).
-route_pl_adjacent_([J|Js], First, MI, D, Map, Done, Heap0, Heap) :-
-    Map = map(_, _, Cells, Mountain, Target, _),
-    Cell0 is J - 1,
-    (   arg(J, Cells, Kind),
-        route_pl_enter_(Kind, Cell0, Target, Mountain, Cell, Step),
-        I is Cell + 1,
-        arg(I, Done, Seen),
-        var(Seen)
-    ->  Key is (D + Step) * 4 + MI,
-        add_to_heap(Heap0, Key, Cell-First, Heap1)
-    ;   Heap1 = Heap0
-    ),
-    route_pl_adjacent_(Js, First, MI, D, Map, Done, Heap1, Heap).
-
-route_pl_neighbour_(R, C, Move, First, D, Map, Done, Heap0, Heap) :-
-    Map = map(Rows, Cols, Cells, Mountain, Target, _),
-    (   R >= 0, R < Rows, C >= 0, C < Cols,
-        Cell0 is R * Cols + C,
-        I0 is Cell0 + 1,
-        arg(I0, Cells, Kind),
-        route_pl_enter_(Kind, Cell0, Target, Mountain, Cell, Step),
-        I is Cell + 1,
-        arg(I, Done, Seen),
-        var(Seen)
-    ->  D1 is D + Step,
-        ( First == none -> First1 = Move ; First1 = First ),
-        route_pl_move_index_(First1, MI),
-        Key is D1 * 4 + MI,
-        add_to_heap(Heap0, Key, Cell-First1, Heap)
-    ;   Heap = Heap0
+    expand_layer_cell_(Neighbours, MI, S1, Cells, Target, Done, F0, F1, Q0, Q1, Hit0),
+    (   Hit0 == none
+    ->  expand_layer_(Rest, S1, Adj, Cells, Target, Done, F1, F, Q1, Q, Hit)
+    ;   Hit = Hit0
     ).
 
-%   route_pl_enter_(+Kind, +Cell0, +Target, +Mountain, -Cell, -Step):
-%   entering Cell0 of Kind puts the agent on Cell at the cost Step; fails
-%   for a cell a path may not enter.
-route_pl_enter_(_, Target, Target, _, Target, 1) :- !.
-route_pl_enter_(Kind, Cell0, _, _, Cell0, 1) :- var(Kind), !.
-route_pl_enter_(mountain, Cell0, _, Mountain, Cell0, Step) :- !, Step is 1 + Mountain.
-route_pl_enter_(jump(Landing), _, _, _, Landing, 1).
+expand_layer_cell_([], _, _, _, _, _, F, F, Q, Q, none).
+expand_layer_cell_([J|Js], MI, S1, Cells, Target, Done, F0, F, Q0, Q, Hit) :-
+    Cell0 is J - 1,
+    (   Cell0 =:= Target
+    ->  Hit = MI
+    ;   arg(J, Cells, Kind),
+        layer_enter_(Kind, Cell0, Done, S1, MI, F0, F1, Q0, Q1),
+        expand_layer_cell_(Js, MI, S1, Cells, Target, Done, F1, F, Q1, Q, Hit)
+    ).
+
+% --------------------------------------------------------------- facts
+
+%   The KB's facts but at/5, read where the KB may have none of them at all
+%   (a KB of one's own that declares only what it holds): no such predicate
+%   visible through the default import module is no answer, not an error.
+kb_object_(Id, Type) :- current_predicate(_, object(_, _)), object(Id, Type).
+kb_holding_(E, T, Item) :- current_predicate(_, holding(_, _, _)), holding(E, T, Item).
+kb_terrain_(E, Type, R, C) :- current_predicate(_, terrain(_, _, _, _)), terrain(E, Type, R, C).
+kb_grid_(E, Rows, Cols) :- current_predicate(_, grid(_, _, _)), grid(E, Rows, Cols).
+
+% --------------------------------------------------------------- default goal
 
 %!  default_goal(+E, +T, -Object) is semidet.
 %
@@ -518,58 +728,58 @@ route_pl_enter_(jump(Landing), _, _, _, Landing, 1).
 %       G = terminal.
 
 default_goal(E, T, Goal) :-
-    route_pl_default_(E, T, Goal),
+    default_(E, T, Goal),
     route_exists(E, T, Goal),
     !.
 
-route_pl_default_(E, T, sword) :-
-    \+ holding(E, T, sword),
+default_(E, T, sword) :-
+    \+ kb_holding_(E, T, sword),
     at(E, T, sword, _, _).
-route_pl_default_(E, T, Enemy) :-
-    holding(E, T, sword),
-    route_pl_nearest_(E, T, X, object(X, enemy), Enemy).
-route_pl_default_(_, _, terminal).
-route_pl_default_(E, T, End) :-
-    object(End, teleport),
+default_(E, T, Enemy) :-
+    kb_holding_(E, T, sword),
+    nearest_(E, T, X, kb_object_(X, enemy), Enemy).
+default_(_, _, terminal).
+default_(E, T, End) :-
+    kb_object_(End, teleport),
     at(E, T, End, _, _).
-route_pl_default_(E, T, Lock) :-
-    holding(E, T, key(C)),
-    object(Lock, lock(C)),
-    route_pl_useful_(E, T, Lock).
-route_pl_default_(E, T, Key) :-
-    route_pl_nearest_(E, T, K,
-                      ( object(K, key(C)), route_pl_loose_(E, T, K),
-                        object(L, lock(C)), route_pl_useful_(E, T, L) ),
-                      Key).
-route_pl_default_(E, T, Key) :-
-    route_pl_nearest_(E, T, K, ( object(K, key(_)), route_pl_loose_(E, T, K) ), Key).
+default_(E, T, Lock) :-
+    kb_holding_(E, T, key(C)),
+    kb_object_(Lock, lock(C)),
+    useful_(E, T, Lock).
+default_(E, T, Key) :-
+    nearest_(E, T, K,
+             ( kb_object_(K, key(C)), loose_(E, T, K),
+               kb_object_(L, lock(C)), useful_(E, T, L) ),
+             Key).
+default_(E, T, Key) :-
+    nearest_(E, T, K, ( kb_object_(K, key(_)), loose_(E, T, K) ), Key).
 
-%   route_pl_nearest_(+E, +T, ?X, :Cond, -Nearest): of the objects X on the
-%   map for which Cond holds, the one with the cheapest route.
-route_pl_nearest_(E, T, X, Cond, Nearest) :-
-    findall(D-X, ( Cond, at(E, T, X, _, _), route_distance(E, T, X, D) ), Ds),
+%   nearest_(+E, +T, ?X, +Cond, -Nearest): of the objects X on the map for
+%   which Cond holds, the one with the cheapest route.
+nearest_(E, T, X, Cond, Nearest) :-
+    findall(D-X, ( call(Cond), at(E, T, X, _, _), route_distance(E, T, X, D) ), Ds),
     msort(Ds, [_-Nearest|_]).
 
 %   Box-World: a box is a lock with its content in the cell to its left; a
 %   loose key has no lock to its right.
-route_pl_content_(E, T, Lock, Content) :-
+content_(E, T, Lock, Content) :-
     at(E, T, Lock, R, C),
     Left is C - 1,
     at(E, T, X, R, Left),
-    object(X, Content).
+    kb_object_(X, Content).
 
-route_pl_useful_(E, T, Lock) :-
+useful_(E, T, Lock) :-
     at(E, T, Lock, _, _),
-    (   route_pl_content_(E, T, Lock, gem)
+    (   content_(E, T, Lock, gem)
     ->  true
-    ;   route_pl_content_(E, T, Lock, key(C)),
-        object(Next, lock(C)),
+    ;   content_(E, T, Lock, key(C)),
+        kb_object_(Next, lock(C)),
         Next \== Lock,
-        route_pl_useful_(E, T, Next)
+        useful_(E, T, Next)
     ),
     !.
 
-route_pl_loose_(E, T, Key) :-
+loose_(E, T, Key) :-
     at(E, T, Key, R, C),
     Right is C + 1,
-    \+ ( at(E, T, X, R, Right), object(X, lock(_)) ).
+    \+ ( at(E, T, X, R, Right), kb_object_(X, lock(_)) ).

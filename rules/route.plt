@@ -1,4 +1,5 @@
-/*  route.plt -- plunit tests for route.pl over tests/route_facts.pl.
+/*  route.plt -- plunit tests for module route (route.pl) over tests/route_facts.pl,
+    loaded as a user would: the facts in user, then the module.
 
     Run from any directory:  swipl -g run_tests -t halt rules/route.plt
 */
@@ -119,7 +120,7 @@ test(moves_not_on_the_map, D == 999) :-
 test(moves_from_a_teleport_end, D == 3) :-
     route_moves(4, 0, 2-3, terminal, D).
 
-% One search per state and start cell is remembered until route_forget/1:
+% The searches of the state last asked are remembered until route_forget/1:
 % a wall added later is seen only after it.
 test(moves_remembered_until_forgotten,
      [ true(D0-D1-D2 == 3-3-999),
@@ -130,23 +131,41 @@ test(moves_remembered_until_forgotten,
     route_forget(5),
     route_moves(5, 0, terminal, D2).
 
-% The memos live in module route_pl_cache: facts named like them where the
-% KB's facts are (here user), asserted after the memos were first used, do
-% not change an answer (tests/route_facts.pl holds some from the start).
+% A route with mountains (Dijkstra's search) and one without (the
+% breadth-first search) asked in the same state, then again: the same answers.
+test(routes_remembered_in_a_state, Answers == [down-8, down-7, down-8, down-7]) :-
+    route_forget(0),
+    route(0, 0, sword, A1, C1),
+    route(0, 0, terminal, A2, C2),
+    route(0, 0, sword, A3, C3),
+    route(0, 0, terminal, A4, C4),
+    Answers = [A1-C1, A2-C2, A3-C3, A4-C4].
+
+% What route remembers lives in module route: facts named like its memos
+% where the KB's facts are (here user) do not change an answer
+% (tests/route_facts.pl holds some from the start).
 test(kb_facts_cannot_reach_the_memos,
      [ true(Answers == [7, down-7, 4, down-8]),
        setup(( route_forget(0),
-              assertz(user:moves_(0, 0, user, 0-0, t(terminal-1, sword-1))),
-              assertz(user:moves_(0, 0, user, 0-0, _)),
-              assertz(user:memo_(user, 0, 0, terminal, found(up, 1))),
-              assertz(user:memo_(user, 0, 0, sword, none)) )),
-      cleanup(( retractall(user:moves_(_, _, _, _, _)),
-                retractall(user:memo_(_, _, _, _, _)),
+              assertz(user:searched_(0, 1, _, _, _)),
+              assertz(user:grid_(0, 1, 1, cells(wall))),
+              assertz(user:cache_key_(routes, nowhere)) )),
+      cleanup(( retractall(user:searched_(_, _, _, _, _)),
+                retractall(user:grid_(_, _, _, _)),
+                retractall(user:cache_key_(_, _)),
                 route_forget(0) ))]) :-
     route_moves(0, 0, terminal, D1),
     route(0, 0, terminal, A1, C1),
     route_moves(0, 0, sword, D2),
     route(0, 0, sword, A2, C2),
     Answers = [D1, A1-C1, D2, A2-C2].
+
+% Its helpers stay inside the module: the user sees only the exports.
+test(exports_only, Visible == [default_goal/3, route/4, route/5, route_distance/4,
+                               route_exists/3, route_forget/1, route_moves/4,
+                               route_moves/5, safe_step/3]) :-
+    findall(N/A, ( predicate_property(user:H, imported_from(route)),
+                   functor(H, N, A) ), Visible0),
+    sort(Visible0, Visible).
 
 :- end_tests(route).

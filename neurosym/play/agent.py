@@ -7,15 +7,28 @@ object to go for and ``route(E, T, Object, Action)`` (rules/route.pl, loaded
 as code beside the strategy) the action. The Prolog side is
 :mod:`neurosym.play.prolog`: one call per sub-env and step.
 
-When goal/3 has no answer, or no route to its object exists, the agent falls
-back to ``default_goal/3`` of route.pl (a hand-written strategy: RGW the
-sword, then enemies, then the terminal; Box-World the held key's lock, else
-a loose key), then to ``safe_step/3`` (the first move into a free cell), then
-to ``up``. It does the same in a state the episode has been in before (the
-same positions and held items): a strategy that reads the state alone would
-choose as it did then and go round the same loop for good.
-:attr:`PrologAgent.fallbacks` counts those steps by cause (``no_goal``,
-``no_route``, ``loop``).
+The strategy leaves a state undecided when goal/3 has no answer
+(``no_goal``), when route/4 finds no path to its object (``no_route``: the
+route planner refuses it), or when the episode has been in this very state
+before (``loop``: the same positions and held items; a strategy that reads the
+state alone would choose as it did then and go round the same loop for good).
+What happens then is the agent's ``fallback``:
+
+* ``default`` (the default): route.pl's ``default_goal/3`` (a hand-written
+  strategy: RGW the sword, then enemies, then the terminal; Box-World the
+  held key's lock, else a loose key) decides, else ``safe_step/3`` (the first
+  move into a free cell), else ``up``;
+* ``none``: nothing decides for the strategy, and the episode ends there as
+  a failure. The env is stepped once more (a batched env steps every
+  sub-env), but nothing of that step counts: its reward is 0, it has no
+  events, and the episode's outcome is the cause (``no_goal``, ``no_route``
+  or ``loop``); the step counts in the episode's length.
+
+:attr:`PrologAgent.deciders` counts the steps by what decided them
+(``strategy``: goal/3 and route/4; ``default_goal``, ``safe_step``, ``up``:
+the fallback; ``none``: an episode ended by ``fallback="none"``), and
+:attr:`PrologAgent.fallbacks` the undecided ones by cause. One janus call
+decides the running episodes of a step (``decide_all/5``).
 
 Episode E of the facts is the episode's number (its reset seed minus the
 first seed), T its state; an episode's facts are retracted when it ends.
@@ -48,6 +61,14 @@ SCHEMA = tuple(group(TRACE))
 """every predicate of the KB schema (:mod:`neurosym.facts.schema`), declared dynamic in the agent's module"""
 
 _ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
+
+FALLBACKS = ("default", "none")
+"""what decides a state the strategy leaves undecided: route.pl's default_goal/3, safe_step/3
+and up (default), or nothing: the episode ends as a failure (none)"""
+
+DECIDERS = ("strategy", "default_goal", "safe_step", "up", "none")
+"""what can decide a step: the strategy (goal/3 and route/4), a part of the fallback, or
+nothing (fallback none: the episode ends)"""
 
 _C_STACK_BASE = 16 << 20
 _C_STACK_PER_LEVEL = 768
@@ -86,10 +107,14 @@ class PrologAgent:
         *,
         thresholds: dict[int, float] | None = None,
         inference_limit: int = INFERENCE_LIMIT,
+        fallback: str = "default",
     ) -> None:
         from neurosym.prolog.knowledge_base import KnowledgeBase
         from neurosym.shipped import rule_file
 
+        if fallback not in FALLBACKS:
+            raise ConfigError(f"fallback must be one of {', '.join(FALLBACKS)}, got {fallback!r}")
+        self.fallback = fallback
         self.policy = policy if isinstance(policy, Policy) else read_policy(policy)
         if self.policy.needs_network and network is None:
             raise ConfigError(
@@ -102,7 +127,8 @@ class PrologAgent:
         try:
             with interruptible():
                 self.kb.query(
-                    "forall(member(PI, Ps), dynamic(PI))", Ps=[Term("/", (p.name, p.arity)) for p in SCHEMA]
+                    "forall(member(PI, Ps), dynamic(PI))",
+                    Ps=[Term("/", (p.name, p.arity)) for p in SCHEMA],
                 )
                 self.kb.load_rules(rule_file("route"))
                 _load_policy(self.kb, self.policy.path)
@@ -122,13 +148,16 @@ class PrologAgent:
             raise
         self.module = self.kb.module
         self.fallbacks: Counter[str] = Counter()
+        """undecided steps by cause: no_goal, no_route, loop"""
+        self.deciders: Counter[str] = Counter()
+        """steps by what decided them: strategy, default_goal, safe_step, up, none"""
         self.decisions = 0
         self.chosen = 0
-        """decisions whose object the strategy chose (status ok)"""
+        """decisions whose object the strategy chose (decider strategy)"""
         self.decide_seconds = 0.0
         self.goals: Counter[str] = Counter()
         self.last: tuple[str, str, str] | None = None
-        """(status, goal, action) of the latest decision"""
+        """(decider, goal, action) of the latest decision"""
 
     # -- envs -------------------------------------------------------------
 
@@ -141,49 +170,61 @@ class PrologAgent:
     # -- acting -----------------------------------------------------------
 
     def act(self, obs: np.ndarray, venv: _Watched) -> np.ndarray:
-        """Actions (n,) for the batch: Prolog's choice for every running episode, 0 for idle ones."""
+        """Actions (n,) for the batch: Prolog's choice for every running episode, 0 for idle ones
+        (and for an episode that ``fallback="none"`` ends in this step)."""
         actions = np.zeros(len(obs), dtype=np.int64)
         live = [i for i in range(len(obs)) if venv.running[i]]
+        if not live:
+            return actions
         extra: dict[int, list[Any]] = {}
-        if self.relations is not None and live:
+        if self.relations is not None:
             extra = self.relations.facts(obs, venv, live)
-        for i in live:
-            actions[i] = self._decide(venv, i, extra.get(i, []))
+        items = [self._item(venv, i, extra.get(i, [])) for i in live]
+        start = time.perf_counter()
+        outs = self._query(
+            f"{play_prolog.MODULE}:decide_all(M, Items, L, F, Outs)",
+            {"M": self.module, "Items": items, "L": self.inference_limit, "F": self.fallback},
+        )["Outs"]
+        self.decide_seconds += time.perf_counter() - start
+        for i, item, out in zip(live, items, outs, strict=True):
+            actions[i] = self._taken(venv, i, item[0], item[1], out)
         return actions
 
-    def _decide(self, venv: _Watched, i: int, extra: list[Any]) -> int:
-        e, t = int(venv.episode[i]), int(venv.t[i])
+    def _item(self, venv: _Watched, i: int, extra: list[Any]) -> list[Any]:
+        """decide_all/5's item for sub-env i: [E, T, State, Prev, Extra, Seen]."""
         ats, held = venv.state[i]
         key = (tuple(ats), tuple(held))
         seen = key in venv.visited[i]
         venv.visited[i].add(key)
-        start = time.perf_counter()
-        out = self._query(
-            f"{play_prolog.MODULE}:decide(M, E, T, S, P, X, L, Seen, Out)",
-            {
-                "M": self.module, "E": e, "T": t,
-                "S": [[list(a) for a in ats], [live.encode(h) for h in held]],
-                "P": venv.prev[i], "X": extra, "L": self.inference_limit,
-                "Seen": "true" if seen else "false",
-            },
-        )["Out"]  # fmt: skip
-        self.decide_seconds += time.perf_counter() - start
-        self.decisions += 1
-        venv.prev[i] = []
+        prev, venv.prev[i] = venv.prev[i], []
+        return [
+            int(venv.episode[i]), int(venv.t[i]),
+            [[list(a) for a in ats], [live.encode(h) for h in held]],
+            prev, extra, "true" if seen else "false",
+        ]  # fmt: skip
+
+    def _taken(self, venv: _Watched, i: int, e: int, t: int, out: Any) -> int:
+        """The action index of one decision ([Decider, Why, Goal, Action]), counted."""
         if out[0] == "error":
             raise PrologError(f"{self.policy.path}: {' '.join(str(out[1]).split())}")
-        (status, goal), action = out
+        decider, why, goal, action = out
+        self.decisions += 1
+        self.deciders[decider] += 1
+        if why != "none":
+            self.fallbacks[why] += 1
+        if decider == "none":
+            venv.ended[i] = str(why)
+            self.last = (decider, str(goal), "none")
+            return 0
         if action not in _ACTION_INDEX:
             raise PrologError(
                 f"{self.policy.path}: route/4 answered {_shown(action)} for {_shown(goal)} in "
                 f"state {t} of episode {e}; an action is one of {', '.join(ACTION_NAMES)} "
                 "(a strategy may not redefine route.pl's predicates)"
             )
-        self.last = (status, str(goal), action)
-        if status == "ok":
+        self.last = (decider, str(goal), action)
+        if decider == "strategy":
             self.chosen += 1
-        else:
-            self.fallbacks[status] += 1
         self.goals[str(goal)] += 1
         return _ACTION_INDEX[action]
 
@@ -305,6 +346,10 @@ class _Watched:
         self.state: list[Any] = [None] * n
         self.prev: list[list[Any]] = [[] for _ in range(n)]
         self.visited: list[set[Any]] = [set() for _ in range(n)]
+        self.ended: dict[int, str] = {}
+        """sub-env -> cause, for episodes the agent ends in the coming step (fallback none)"""
+        self.outcomes: dict[int, str] = {}
+        """sub-env -> cause, for the episodes the latest step ended that way"""
         self.info: Any = None
 
     def __getattr__(self, name: str) -> Any:
@@ -324,10 +369,14 @@ class _Watched:
             self.prev[i] = []
             self.visited[i] = set()
             self.agent.begin(e, live.episode_facts(d, np.asarray(grids[i]), self.names))
+        self.ended, self.outcomes = {}, {}
         return obs, info
 
     def step(self, actions: np.ndarray) -> tuple[Any, ...]:
         obs, reward, terminated, truncated, info = self.venv.step(actions)
+        self.outcomes = {}
+        if self.ended:
+            reward, terminated, truncated, info = self._end(reward, terminated, truncated, info)
         self.info = info
         for i in np.flatnonzero(self.running):
             d = self.venv.decode_info(info, i)
@@ -343,6 +392,32 @@ class _Watched:
                 [live.encode(ev) for ev in d["events"]],
             ]
         return obs, reward, terminated, truncated, info
+
+    def _end(self, reward: Any, terminated: Any, truncated: Any, info: Any) -> tuple[Any, ...]:
+        """The step's results with the episodes in :attr:`ended` ended: terminated, reward 0,
+        no events (the action was not the strategy's); their outcome is the cause
+        (:meth:`episode_outcome`)."""
+        rows = list(self.ended)
+        reward, terminated, truncated = (
+            np.array(x, copy=True) for x in (reward, terminated, truncated)
+        )
+        reward[rows], terminated[rows], truncated[rows] = 0.0, True, False
+        if isinstance(info, dict) and "events" in info:
+            info = {**info, "events": np.array(info["events"], copy=True)}
+            info["events"][rows] = 0
+        self.outcomes = dict(self.ended)
+        self.ended = {}
+        return reward, terminated, truncated, info
+
+    def episode_outcome(self, info: Any, i: int) -> str | None:
+        """The outcome of sub-env i's episode that ended in the latest step: the cause, for one
+        the agent ended (fallback none), else the env's."""
+        if i in self.outcomes:
+            return self.outcomes[i]
+        quick = getattr(self.venv, "episode_outcome", None)
+        if quick is not None:
+            return quick(info, i)
+        return self.venv.decode_info(info, i).get("outcome")
 
     def close(self) -> None:
         for i in np.flatnonzero(self.running):

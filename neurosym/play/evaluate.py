@@ -30,6 +30,8 @@ def score_strategy(
     checkpoint: str | os.PathLike[str] | None = None,
     batch: int = BATCH,
     kb: str | os.PathLike[str] | None = None,
+    fallback: str = "default",
+    refuse_undecided: bool = True,
 ) -> dict[str, Any]:
     """Play ``episodes`` episodes of the strategy ``policy`` on ``env``; a dict of plain values.
 
@@ -37,15 +39,23 @@ def score_strategy(
     (needed for ``features: relations`` or ``both``); its env is the default
     ``env``; ``kb``: the KB the strategy was learned from, whose
     ``threshold/2`` sets which relations hold (when the strategy file has
-    none). Keys: those of ``neurosym eval --json`` that do not describe a
-    network (mean_return ... outcomes), plus ``policy``, ``features``,
-    ``fallbacks`` (steps by cause), ``fallback_steps``, ``goals`` (steps per
+    none). ``fallback``: what decides a state the strategy leaves undecided
+    (:data:`~neurosym.play.agent.FALLBACKS`: ``default``, route.pl's
+    default_goal/3, safe_step/3, up; ``none``, nothing: the episode ends as a
+    failure, its outcome the cause). ``refuse_undecided``: ConfigError when the strategy
+    chose nothing in any step (:func:`check_decided`; off for the strategies a run is compared
+    with, whose failing everywhere is a figure). Keys: those of ``neurosym eval --json``
+    that do not describe a network (mean_return ... outcomes), plus
+    ``policy``, ``features``, ``fallback``, ``fallbacks`` (undecided steps by
+    cause: no_goal, no_route, loop), ``fallback_steps``, ``deciders`` (steps
+    by what decided them: strategy, default_goal, safe_step, up, none) and
+    ``decider_shares`` (the same as shares of all steps), ``goals`` (steps per
     object chosen), ``steps`` and ``steps_per_s`` (env steps per second of the
     whole loop: facts, Prolog, env).
     """
     from neurosym.agent.evaluation import play_scored, scores_of
     from neurosym.envs import canonical_name
-    from neurosym.play.agent import PrologAgent
+    from neurosym.play.agent import DECIDERS, PrologAgent
     from neurosym.play.policy import read_policy
     from neurosym.prolog.interrupt import sigint_region
 
@@ -67,7 +77,10 @@ def score_strategy(
     kwargs = dict(env_kwargs or {})
     thresholds = kb_thresholds(kb) if kb is not None else None
     # One SIGINT handler for the whole play: each Prolog call only marks itself (interrupt.py).
-    with sigint_region(), PrologAgent(spec, network, thresholds=thresholds) as agent:
+    with (
+        sigint_region(),
+        PrologAgent(spec, network, thresholds=thresholds, fallback=fallback) as agent,
+    ):
         start = time.perf_counter()
         done = play_scored(
             agent.act,
@@ -77,7 +90,8 @@ def score_strategy(
             batch,
         )
         seconds = time.perf_counter() - start
-        check_decided(agent, env)
+        if refuse_undecided:
+            check_decided(agent, env)
         steps = int(sum(done.lengths))
         return {
             "policy": str(spec.path),
@@ -88,8 +102,13 @@ def score_strategy(
             "episodes": episodes,
             "seed": seed,
             **scores_of(done).as_dict(),
+            "fallback": fallback,
             "fallbacks": dict(sorted(agent.fallbacks.items())),
             "fallback_steps": int(sum(agent.fallbacks.values())),
+            "deciders": {d: agent.deciders[d] for d in DECIDERS},
+            "decider_shares": {
+                d: agent.deciders[d] / agent.decisions if agent.decisions else 0.0 for d in DECIDERS
+            },
             "goals": dict(sorted(agent.goals.items())),
             "steps": steps,
             "steps_per_s": steps / seconds if seconds > 0 else None,

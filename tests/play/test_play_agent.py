@@ -65,6 +65,45 @@ def test_a_goal_off_the_map_counts_as_no_route(tmp_path: Path) -> None:
     assert report["fallbacks"] == {"no_route": report["steps"] - 1}
 
 
+def test_fallback_none_ends_the_episode_where_the_strategy_has_no_answer(tmp_path: Path) -> None:
+    """goal/3 answers in state 0 only: the episode ends in state 1 as a failure, outcome
+    no_goal; that step counts in its length, with reward 0 and no events (rgw2: no sword taken
+    on the way), and what decided each step is counted."""
+    policy = _policy(tmp_path, "goal(_, 0, sword).\n")
+    report = score_strategy(policy, "rgw2", 2, fallback="none")
+    assert report["outcomes"] == {"no_goal": 2} and report["success_rate"] == 0.0
+    assert report["mean_length"] == 2 and report["mean_return"] == 0.0
+    assert report["optimal_rate"] == 0.0 and report["sword_first_guarded"] == 0.0
+    assert report["fallback"] == "none" and report["fallbacks"] == {"no_goal": 2}
+    assert report["deciders"] == {
+        "strategy": 2, "default_goal": 0, "safe_step": 0, "up": 0, "none": 2,
+    }  # fmt: skip
+    assert report["decider_shares"]["none"] == 0.5
+
+
+def test_fallback_none_ends_the_episode_where_the_goal_routes_nowhere(tmp_path: Path) -> None:
+    policy = _policy(tmp_path, "goal(_, T, unicorn) :- T > 0.\ngoal(_, 0, sword).\n")
+    report = score_strategy(policy, "rgw1", 1, fallback="none")
+    assert report["outcomes"] == {"no_route": 1} and report["mean_length"] == 2
+    assert report["deciders"]["none"] == 1 and report["fallbacks"] == {"no_route": 1}
+
+
+def test_deciders_with_the_default_fallback(tmp_path: Path) -> None:
+    """The same strategy under the default fallback: default_goal/3 decides from state 1 on."""
+    policy = _policy(tmp_path, "goal(_, 0, sword).\n")
+    report = score_strategy(policy, "rgw2", 1)
+    steps = report["steps"]
+    assert report["deciders"] == {
+        "strategy": 1, "default_goal": steps - 1, "safe_step": 0, "up": 0, "none": 0,
+    }  # fmt: skip
+    assert sum(report["decider_shares"].values()) == pytest.approx(1.0)
+
+
+def test_an_unknown_fallback_is_refused() -> None:
+    with pytest.raises(ConfigError, match="fallback must be one of default, none, got 'never'"):
+        PrologAgent(RGW, fallback="never")
+
+
 @pytest.mark.parametrize(
     ("policy", "env", "causes"),
     [
@@ -168,8 +207,10 @@ def test_features_line() -> None:
         (
             "goal(_, _, terminal).\nroute(_, _, _, jump).\n",
             2,
-            "a clause for route/4, which rules/route.pl defines; a strategy uses route.pl's "
-            "predicates and may not redefine them",
+            "a clause for route/4, which module route (rules/route.pl) exports; a strategy calls "
+            "route's predicates (default_goal/3, route/4, route/5, route_distance/4, "
+            "route_exists/3, route_forget/1, route_moves/4, route_moves/5, safe_step/3) and may "
+            "not redefine them",
         ),
         (
             "term_expansion(a, (:- halt)).\na.\n",

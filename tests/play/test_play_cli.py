@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -38,9 +39,50 @@ def test_text_and_env_option(neurosym_main) -> None:
     assert [line.split()[0] for line in lines[:5]] == [
         "policy", "episodes", "mean", "success", "optimal",
     ]  # fmt: skip
-    assert [line.split()[0] for line in lines[-4:]] == ["mean", "outcomes", "fallbacks", "speed"]
+    assert [line.split()[0] for line in lines[-5:]] == [
+        "mean", "outcomes", "fallbacks", "decided", "speed",
+    ]  # fmt: skip
     assert lines[3] == "success      100.0 %"
-    assert lines[-2] == "fallbacks    0 of " + lines[-2].split()[3] + " steps (0.0 %)"
+    assert lines[-3] == "fallbacks    0 of " + lines[-3].split()[3] + " steps (0.0 %)"
+    assert lines[-2] == "decided by   strategy 100.0 %"
+
+
+def test_compare_prints_one_table_of_the_same_levels(neurosym_main, tmp_path: Path) -> None:
+    """--compare trivial,handwritten under --fallback none: the shipped strategies play the
+    same levels; the strategy under test answers in state 0 only, so both its episodes end
+    there (no_goal); the trivial one goes straight for the terminal (rgw2's enemy blocks the
+    way: no route)."""
+    policy = tmp_path / "once.pl"
+    policy.write_text("goal(_, 0, sword).\n")
+    args = ["play", "--policy", policy, "--env", "rgw2", "--episodes", "2", "--fallback", "none"]
+    proc = neurosym_main(*args, "--compare", "trivial,handwritten")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert "ended        2 of 4 steps (50.0 %): no_goal 2" in lines
+    assert "decided by   strategy 50.0 %, none 50.0 %" in lines
+    table = lines[lines.index("") + 1 :]
+    assert [re.sub(r" +\d+$", "", line) for line in table] == [
+        "strategy      success  optimal  return by goal/3 fallback   ended  steps/s",
+        "once.pl         0.0 %    0.0 %    0.00    50.0 %    0.0 %  50.0 %",
+        "trivial         0.0 %    0.0 %    0.00     0.0 %    0.0 % 100.0 %",
+        "handwritten   100.0 %  100.0 %   10.70   100.0 %    0.0 %   0.0 %",
+        "(same 2 levels from seed 0, fallback none; by goal/3, fallback, ended: shares of steps)",
+    ]
+    proc = neurosym_main(*args, "--compare", "trivial", "--json")
+    report = json.loads(proc.stdout)
+    trivial = report["compare"]["trivial"]
+    assert trivial["policy"].endswith("neurosym/play/strategies/rgw_trivial.pl")
+    assert trivial["outcomes"] == {"no_route": 2} and trivial["fallback"] == "none"
+    assert report["outcomes"] == {"no_goal": 2}
+
+
+def test_compare_names_a_shipped_strategy_or_a_file(neurosym_main) -> None:
+    proc = neurosym_main("play", "--policy", RGW, "--env", "rgw2", "--compare", "trivial,,x")
+    assert proc.returncode == 1
+    assert proc.stderr == (
+        "neurosym play: error: --compare 'trivial,,x': give strategies separated by commas, "
+        "e.g. trivial,handwritten\n"
+    )
 
 
 @pytest.mark.parametrize(

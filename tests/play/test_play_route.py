@@ -42,9 +42,13 @@ HOSTILE = (
     "moves_(0, 0, user, 0-0, t(terminal, 1, t, t)).\n"
     "searched_(0, user, 1, 0, [], cells(0, 1, 1)).\n"
     "grid_(0, user, 1, 1, adj([]), cells(wall)).\n"
+    ":- dynamic searched_/5, grid_/4, cache_key_/2.\n"
+    "searched_(0, 1, 0, [], cells(0, 1, 1)).\n"
+    "grid_(0, 1, 1, cells(wall)).\n"
+    "cache_key_(routes, nowhere).\n"
 )
-"""facts named like route.pl's caches (the one it once kept in the loading module, and the
-ones of module route_pl_cache): planted answers"""
+"""facts named like route.pl's caches (the one it once kept in the loading module, the ones
+of module route_pl_cache it once kept, and module route's own): planted answers"""
 
 
 DATA_KB = (
@@ -78,7 +82,9 @@ def test_kb_facts_cannot_change_a_route(
         [str(swipl), "-q", "-g", shown, "-t", "halt", str(code), str(ROOT / "rules" / "route.pl")],
         capture_output=True, text=True, timeout=60, check=False,
     )  # fmt: skip
-    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7-7\nsword-down-8-4\n"), plain.stderr
+    assert (plain.returncode, plain.stdout) == (0, "terminal-down-7-7\nsword-down-8-4\n"), (
+        plain.stderr
+    )
 
 
 def _only(tmp_path: Path, body: str) -> Path:

@@ -50,8 +50,8 @@ test(trace_route, [Rows == [ 0-0-agent-teleport_1-1, 0-0-agent-teleport_2-3, 0-0
 
 test(forget_trace_forgets_the_searches, [Before-After == true-0]) :-
     once(trace_route(_, _, _, _, _)),
-    ( route_pl_cache:moves_(_, 0, _, _, _) -> Before = true ; Before = false ),
+    ( route:searched_(0, _, _, _, _) -> Before = true ; Before = false ),
     forget_trace,
-    aggregate_all(count, route_pl_cache:moves_(_, _, _, _, _), After).
+    aggregate_all(count, ( route:searched_(_, _, _, _, _) ; route:grid_(_, _, _, _) ), After).
 
 :- end_tests(route_table).

@@ -6,9 +6,10 @@ neurosym/play/prolog.py says what each exported predicate does; the Python
 side (neurosym/play/agent.py) calls them through janus.
 */
 
-:- module(neurosym_play, [begin_episode/5, decide/9, end_episode/2, check_policy/4, guard/1]).
+:- module(neurosym_play, [begin_episode/5, decide/10, decide_all/5, end_episode/2, check_policy/4, guard/1]).
 :- use_module(library(apply), [maplist/2, maplist/3]).
 :- use_module(library(lists), [member/2]).
+:- use_module(library(error), [must_be/2]).
 
 :- thread_local choosing_/0, halted_/1.
 
@@ -56,20 +57,35 @@ assert_state_(M, E, T, [Ats, Held], Prev, Extra) :-
     forall(member(X0, Extra),
            ( term_(X0, X), functor(X, N, A), extra_(N, A), assertz(M:X) )).
 
-%!  decide(+M, +E, +T, +State, +Prev, +Extra, +Limit, +Seen, -Out) is det.
+%!  decide_all(+M, +Items, +Limit, +Fallback, -Outs) is det.
+%   decide/10 for each item [E, T, State, Prev, Extra, Seen] in turn (the running
+%   episodes of one step: one call from Python per step); Outs their Outs, in order.
+decide_all(M, Items, Limit, Fallback, Outs) :-
+    must_be(list, Items),
+    maplist(decide_item_(M, Limit, Fallback), Items, Outs).
+
+decide_item_(M, Limit, Fallback, [E, T, State, Prev, Extra, Seen], Out) :-
+    decide(M, E, T, State, Prev, Extra, Limit, Seen, Fallback, Out).
+
+%!  decide(+M, +E, +T, +State, +Prev, +Extra, +Limit, +Seen, +Fallback, -Out) is det.
 %   Assert state T's at/5 and holding/3, the previous transition's step/4 and event/3,
 %   and Extra (the network's holds/5, attends/8 or attention/6 facts of state T), then
-%   ask goal(E, T, G) (first answer) and route(E, T, G, A); when either fails, fall back
-%   to default_goal/3, then safe_step/3, then up. Seen true (the episode was in this
-%   very state before) goes to the fallback at once. Out is Status-Goal-Action (Status
-%   ok, no_goal, no_route or loop) or error-Text when the strategy raised or ran past
-%   Limit inferences.
-decide(M, E, T, State, Prev, Extra, Limit, Seen, Out) :-
+%   ask goal(E, T, G) (first answer) and route(E, T, G, A). Out is
+%   [Decider, Why, Goal, Action]: [strategy, none, G, A] when both answer. Else Why is
+%   no_goal (goal/3 has no answer), no_route (route/4 has none for G) or loop (Seen is
+%   true: the episode was in this very state before, and a strategy that reads the
+%   state would choose as it did then), and Fallback says what happens: default
+%   falls back to default_goal/3 (Decider default_goal), then safe_step/3
+%   (safe_step), then up (up); none decides nothing (Decider none, Action none: the
+%   episode fails). Out is error-Text when the strategy raised or ran past Limit
+%   inferences.
+decide(M, E, T, State, Prev, Extra, Limit, Seen, Fallback, Out) :-
     assert_state_(M, E, T, State, Prev, Extra),
     retractall(halted_(_)),
     setup_call_cleanup(
         assertz(choosing_),
-        catch(call_with_inference_limit(choose_(M, E, T, Seen, Out0), Limit, Result), Err, true),
+        catch(call_with_inference_limit(choose_(M, E, T, Seen, Fallback, Out0), Limit, Result),
+              Err, true),
         retractall(choosing_)),
     (   retract(halted_(Goal))
     ->  format(string(Text), "the strategy called ~q while choosing in state ~w of episode ~w: a strategy may not end the process", [Goal, T, E]),
@@ -82,25 +98,30 @@ decide(M, E, T, State, Prev, Extra, Limit, Seen, Out) :-
     ;   Out = Out0
     ).
 
-choose_(M, E, T, true, Out) :-
-    !,
-    fallback_(M, E, T, loop, none, Status, Goal, Action),
-    Out = Status-Goal-Action.
-choose_(M, E, T, false, Status-Goal-Action) :-
-    (   once(M:goal(E, T, G))
+choose_(M, E, T, Seen, Fallback, Out) :-
+    (   Seen == true
+    ->  Why = loop, G0 = none
+    ;   once(M:goal(E, T, G))
     ->  (   M:route(E, T, G, A)
-        ->  Status = ok, Goal = G, Action = A
-        ;   fallback_(M, E, T, no_route, G, Status, Goal, Action)
+        ->  Out = [strategy, none, G, A]
+        ;   Why = no_route, G0 = G
         )
-    ;   fallback_(M, E, T, no_goal, none, Status, Goal, Action)
+    ;   Why = no_goal, G0 = none
+    ),
+    (   nonvar(Out)
+    ->  true
+    ;   Fallback == none
+    ->  Out = [none, Why, G0, none]
+    ;   fallback_(M, E, T, G0, By, Goal, Action),
+        Out = [By, Why, Goal, Action]
     ).
 
-fallback_(M, E, T, Why, G0, Why, Goal, Action) :-
+fallback_(M, E, T, G0, By, Goal, Action) :-
     (   M:default_goal(E, T, G), G \== G0, M:route(E, T, G, A)
-    ->  Goal = G, Action = A
+    ->  By = default_goal, Goal = G, Action = A
     ;   M:safe_step(E, T, A)
-    ->  Goal = G0, Action = A
-    ;   Goal = G0, Action = up
+    ->  By = safe_step, Goal = G0, Action = A
+    ;   By = up, Goal = G0, Action = up
     ).
 
 message_to_codes_(E, Text) :-
@@ -244,7 +265,7 @@ term_problem_(M, Clause, Text) :-
     clause_parts_(Clause, H, B),
     (   head_problem_(M, H, Text)
     ->  true
-    ;   body_problem_(B, Text)
+    ;   body_problem_(M, B, Text)
     ).
 
 directive_problem_(D, Text) :-
@@ -293,24 +314,61 @@ head_problem_(M, H, Text) :-
     ->  format(string(Text), "a clause for ~q/~w, which SWI-Prolog calls while it loads files; a strategy may not define it", [N, A])
     ;   built_in_(N, A)
     ->  format(string(Text), "a clause for the built-in predicate ~q/~w", [N, A])
-    ;   current_predicate(M:N/A),  % asked first: predicate_property/2 could autoload
+    ;   route_module_(M, R),
+        current_predicate(M:N/A),  % asked first: predicate_property/2 could autoload
+        predicate_property(M:G, imported_from(R))
+    ->  route_exports_(R, Exports),
+        format(string(Text), "a clause for ~q/~w, which module route (rules/route.pl) exports; a strategy calls route's predicates (~w) and may not redefine them", [N, A, Exports])
+    ;   current_predicate(M:N/A),
         \+ predicate_property(M:G, dynamic),
         \+ predicate_property(M:G, imported_from(_))
-    ->  format(string(Text), "a clause for ~q/~w, which rules/route.pl defines; a strategy uses route.pl's predicates and may not redefine them", [N, A])
+    ->  format(string(Text), "a clause for ~q/~w, which is defined where the strategy loads; a strategy may not redefine it", [N, A])
     ).
+
+%   route_module_(+M, -R): the module whose route/4 M imports (module route, or
+%   its copy route@M in a neurosym KB).
+route_module_(M, R) :-
+    current_predicate(M:route/4),
+    predicate_property(M:route(_, _, _, _), imported_from(R)),
+    !.
+
+route_exports_(R, Text) :-
+    module_property(R, exports(PIs0)),
+    msort(PIs0, PIs),
+    maplist([N/A, X]>>format(atom(X), "~q/~w", [N, A]), PIs, Xs),
+    atomic_list_concat(Xs, ', ', Text).
+
+%   A goal qualified with the name of route's module (route, route@KB, or the
+%   module M imports route/4 from): route's helpers stay inside it.
+route_qualifier_(M, Q) :-
+    atom(Q),
+    (   Q == route
+    ;   sub_atom(Q, 0, _, _, 'route@')
+    ;   route_module_(M, Q)
+    ),
+    !.
 
 hook_(term_expansion, 2).
 hook_(term_expansion, 4).
 hook_(goal_expansion, 2).
 hook_(goal_expansion, 4).
 
-body_problem_(B, Text) :-
+body_problem_(_, B, Text) :-
     sub_term(S, B),
     callable(S),
     functor(S, N, A),
     forbidden_(N, A),
     !,
     format(string(Text), "it names ~q/~w; a strategy may not end the process, run programs, load code or change files", [N, A]).
+body_problem_(M, B, Text) :-
+    sub_term(S, B),
+    compound(S),
+    S = Q:G,
+    route_qualifier_(M, Q),
+    !,
+    (   callable(G) -> functor(G, N, A), format(atom(What), "~q/~w", [N, A]) ; What = G ),
+    (   route_module_(M, R) -> route_exports_(R, Exports) ; Exports = "route/4, ..." ),
+    format(string(Text), "it calls ~q:~w; a strategy calls the predicates module route exports (~w) as they are, unqualified, and none of its own", [Q, What, Exports]).
 
 message_to_codes(E, _, Codes) :-
     '$messages':translate_message(E, Lines, []),

@@ -5,14 +5,17 @@
     swipl -g run_tests -t halt neurosym/play/pl/neurosym_play.plt
 
 A KB module is set up as neurosym/play/agent.py sets one up: the state
-predicates dynamic, rules/route.pl and the strategy (tests/play_strategy.pl)
-loaded into it as code, then guard/1. Values are passed as janus passes
+predicates dynamic, module route (rules/route.pl) loaded for it by the janus
+bridge's load/6 (a copy, route@KB, that reads the KB's facts), the strategy
+(tests/play_strategy.pl) loaded into it as code, then guard/1. Values are passed as janus passes
 them: atoms, numbers, lists, a compound as -('$t', Name, Args).
 */
 
 :- prolog_load_context(directory, Dir),
    atom_concat(Dir, '/neurosym_play.pl', Play),
-   use_module(Play).
+   atom_concat(Dir, '/../../prolog/pl/bridge.pl', Bridge),
+   use_module(Play),
+   use_module(Bridge, [load/6]).
 
 :- begin_tests(neurosym_play).
 
@@ -32,7 +35,9 @@ kb(M, Strategy, Guard) :-
            dynamic(M:PI)),
     dir(Dir),
     atom_concat(Dir, '/../../../rules/route.pl', Route),
-    load_into(M, Route),
+    format(atom(Id), "~w#~w", [Route, M]),
+    c_stack(CStack0),
+    load(M, Id, Route, rules, CStack0, []),
     (   Strategy == true
     ->  atom_concat(Dir, '/tests/play_strategy.pl', File),
         c_stack(CStack),
@@ -66,10 +71,14 @@ episode(3, [[wall, 0, 1]], [1, 3], [[agent, 0, 0], [terminal, 0, 2]]).
 
 %   decide_(+M, +E, +T, +Seen, -Out): begin episode E (state 0) and decide in state T.
 decide_(M, E, T, Seen, Out) :-
+    decide_(M, E, T, Seen, default, Out).
+
+decide_(M, E, T, Seen, Fallback, Out) :-
     objects(Os),
     (   episode(E, Terrain, Grid, Ats) -> true ; Terrain = [], Grid = [1, 1], Ats = [] ),
+    end_episode(M, E),
     begin_episode(M, E, Os, Terrain, Grid),
-    decide(M, E, T, [Ats, []], [], [], 100000, Seen, Out0),
+    decide(M, E, T, [Ats, []], [], [], 100000, Seen, Fallback, Out0),
     trimmed(Out0, Out).
 
 %   trimmed(+Out0, -Out): an error line without the space message_to_codes_/2
@@ -81,20 +90,36 @@ guarded(M, N) :- clause(M:N, neurosym_play:refused_(N/0)).
 
 % --- decisions and fallbacks ---------------------------------------------
 
-test(goal_and_route, [Out == ok-terminal-right]) :-
+test(goal_and_route, [Out == [strategy, none, terminal, right]]) :-
     decide_(plt_play_kb, 0, 0, false, Out).
 
-test(no_goal_falls_back_to_the_default_goal, [Out == no_goal-sword-left]) :-
+test(no_goal_falls_back_to_the_default_goal, [Out == [default_goal, no_goal, sword, left]]) :-
     decide_(plt_play_kb, 1, 0, false, Out).
 
-test(no_route_falls_back_to_a_safe_step, [Out == no_route-terminal-down]) :-
+test(no_route_falls_back_to_a_safe_step, [Out == [safe_step, no_route, terminal, down]]) :-
     decide_(plt_play_kb, 2, 0, false, Out).
 
-test(nowhere_safe_falls_back_to_up, [Out == no_route-terminal-up]) :-
+test(nowhere_safe_falls_back_to_up, [Out == [up, no_route, terminal, up]]) :-
     decide_(plt_play_kb, 3, 0, false, Out).
 
-test(a_state_seen_before_goes_to_the_fallback, [Out == loop-terminal-right]) :-
+test(a_state_seen_before_goes_to_the_fallback, [Out == [default_goal, loop, terminal, right]]) :-
     decide_(plt_play_kb, 0, 0, true, Out).
+
+% Fallback none: what the strategy left undecided is not decided.
+test(fallback_none, [Outs == [[strategy, none, terminal, right], [none, no_goal, none, none],
+                              [none, no_route, terminal, none], [none, loop, none, none]]]) :-
+    findall(Out, ( member(E-Seen, [0-false, 1-false, 2-false, 0-true]),
+                   decide_(plt_play_kb, E, 0, Seen, none, Out) ),
+            Outs).
+
+% decide_all/5: the running episodes of a step in one call, in order.
+test(decide_all, [Outs == [[strategy, none, terminal, right], [default_goal, no_goal, sword, left]]]) :-
+    M = plt_play_kb,
+    objects(Os),
+    forall(member(E, [20, 21]), begin_episode(M, E, Os, [], [1, 4])),
+    decide_all(M, [[20, 0, [[[agent, 0, 0], [terminal, 0, 3]], []], [], [], false],
+                   [21, 0, [[[agent, 0, 2], [sword, 0, 0]], []], [], [], false]],
+               100000, default, Outs).
 
 % --- facts asserted and retracted ----------------------------------------
 
@@ -116,7 +141,7 @@ test(decide_asserts_the_state_the_transition_and_the_extra,
     begin_episode(M, 10, Os, [], [1, 2]),
     decide(M, 10, 1, [[[agent, 0, 1]], [-('$t', key, [red])]],
            [right, -0.1, [-('$t', picked, [-('$t', key, [red])])]],
-           [-('$t', holds, [10, 1, -('$t', r, [2]), sword, terminal])], 100000, false, _),
+           [-('$t', holds, [10, 1, -('$t', r, [2]), sword, terminal])], 100000, false, default, _),
     findall(at(10, T, I, R, C), M:at(10, T, I, R, C), As),
     findall(holding(10, T, I), M:holding(10, T, I), Hs),
     findall(step(10, T, A, W), M:step(10, T, A, W), Ss),
@@ -126,11 +151,11 @@ test(decide_asserts_the_state_the_transition_and_the_extra,
 
 test(extra_other_than_the_network_facts_refused, [fail]) :-
     M = plt_play_kb,
-    decide(M, 11, 0, [[], []], [], [-('$t', at, [11, 0, terminal, 0, 0])], 100000, false, _).
+    decide(M, 11, 0, [[], []], [], [-('$t', at, [11, 0, terminal, 0, 0])], 100000, false, default, _).
 
 test(extra_refused_is_not_asserted, [fail]) :-
     M = plt_play_kb,
-    \+ decide(M, 11, 0, [[], []], [], [-('$t', at, [11, 0, terminal, 0, 0])], 100000, false, _),
+    \+ decide(M, 11, 0, [[], []], [], [-('$t', at, [11, 0, terminal, 0, 0])], 100000, false, default, _),
     M:at(11, 0, terminal, _, _).
 
 test(end_episode_retracts_the_episode_but_not_object, [Left == []-[]-[]-3]) :-
@@ -138,12 +163,15 @@ test(end_episode_retracts_the_episode_but_not_object, [Left == []-[]-[]-3]) :-
     decide_(M, 12, 0, false, _),
     objects(Os),
     decide(M, 12, 1, [[[agent, 0, 0]], [sword]], [up, 0.0, [-('$t', picked, [sword])]],
-           [-('$t', attention, [12, 1, 0, agent, sword, 0.5])], 100000, false, _),
+           [-('$t', attention, [12, 1, 0, agent, sword, 0.5])], 100000, false, default, _),
+    predicate_property(M:route(_, _, _, _), imported_from(R)),
+    M:route_moves(12, 1, 0-0, terminal, _),
+    R:grid_(12, _, _, _),                    % route remembered the episode's terrain
     end_episode(M, 12),
     findall(x, M:at(12, _, _, _, _), A),
     findall(x, ( M:step(12, _, _, _) ; M:event(12, _, _) ; M:holding(12, _, _)
                ; M:grid(12, _, _) ; M:attention(12, _, _, _, _, _) ), B),
-    findall(x, route_pl_cache:memo_(M, 12, _, _, _), C),
+    findall(x, R:grid_(12, _, _, _), C),
     aggregate_all(count, M:object(_, _), N),
     length(Os, N),
     Left = A-B-C-N.
@@ -161,7 +189,7 @@ test(inference_limit, [Out == error-"the strategy took more than 1,000 inference
                                      in state 0 of episode 8"]) :-
     objects(Os),
     begin_episode(plt_play_kb, 8, Os, [], [1, 1]),
-    decide(plt_play_kb, 8, 0, [[], []], [], [], 1000, false, Out).
+    decide(plt_play_kb, 8, 0, [[], []], [], [], 1000, false, default, Out).
 
 % --- a strategy may not end the process -------------------------------------
 
@@ -215,8 +243,30 @@ policy_case("goal(_, _, x) :- catch(halt, _, true).\n",
             1-"it names halt/0; a strategy may not end the process, run programs, load code \c
                or change files").
 policy_case("\ngoal(_, _, x).\nroute(_, _, _, up).\n",
-            3-"a clause for route/4, which rules/route.pl defines; a strategy uses route.pl's \c
-               predicates and may not redefine them").
+            3-"a clause for route/4, which module route (rules/route.pl) exports; a strategy \c
+               calls route's predicates (default_goal/3, route/4, route/5, route_distance/4, \c
+               route_exists/3, route_forget/1, route_moves/4, route_moves/5, safe_step/3) and \c
+               may not redefine them").
+policy_case("route_moves(_, _, _, 0).\n",
+            1-"a clause for route_moves/4, which module route (rules/route.pl) exports; a strategy \c
+               calls route's predicates (default_goal/3, route/4, route/5, route_distance/4, \c
+               route_exists/3, route_forget/1, route_moves/4, route_moves/5, safe_step/3) and \c
+               may not redefine them").
+% What a learned strategy imports from route: route_moves/4,5, called as they are.
+policy_case("route_length(E, T, O, D) :- route_moves(E, T, O, D).\n\c
+             route_from_(E, T, F, O, D) :- route_moves(E, T, F, O, D).\n\c
+             goal(E, T, O) :- route_length(E, T, O, D), D < 3, route_exists(E, T, O).\n",
+            none).
+policy_case("goal(E, T, O) :- route:grid_(E, _, _, _), O = terminal.\n",
+            1-"it calls route:grid_/4; a strategy calls the predicates module route exports \c
+               (default_goal/3, route/4, route/5, route_distance/4, route_exists/3, \c
+               route_forget/1, route_moves/4, route_moves/5, safe_step/3) as they are, \c
+               unqualified, and none of its own").
+policy_case("goal(E, T, O) :- assertz('route@kb':searched_(E, T, O, [], x)).\n",
+            1-"it calls 'route@kb':searched_/5; a strategy calls the predicates module route \c
+               exports (default_goal/3, route/4, route/5, route_distance/4, route_exists/3, \c
+               route_forget/1, route_moves/4, route_moves/5, safe_step/3) as they are, \c
+               unqualified, and none of its own").
 policy_case("user:goal(_, _, x).\n",
             1-"a clause for user:goal/3; a strategy defines its predicates where it is loaded, \c
                not in another module").
