@@ -1,14 +1,15 @@
-/*  minigrid_handwritten.pl -- the hand-written Minigrid strategy (DoorKey and
-    the like) that `neurosym play --compare handwritten` plays beside a
-    strategy (not learned; the learned ones come from `neurosym induce
-    strategy`).
+/*  minigrid_strategy.pl -- a hand-written Minigrid strategy for
+    `neurosym play` (DoorKey and the like; not learned: the learned ones
+    come from `neurosym induce strategy`): the key of the locked door, then
+    the door, then the goal.
 
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. route.pl's route/4, which `neurosym play`
-    loads beside it, turns the agent, walks it there and does the
-    interaction (pickup a key, toggle a door, forward onto the goal).
+    loads beside it, turns the agent, walks it next to the object, facing
+    it, and does the interaction: pickup a key, toggle a door, forward onto
+    the goal.
 
-        neurosym play --policy strategy.pl --env MiniGrid-DoorKey-8x8-v0 --compare handwritten
+        neurosym play --policy examples/play/minigrid_strategy.pl --env MiniGrid-DoorKey-8x8-v0
 */
 %! features: world
 
