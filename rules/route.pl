@@ -14,7 +14,10 @@
 
 Background knowledge for a Prolog agent, written by hand, not learned: the
 first action of a cheapest path from the agent to an object, in
-Relational-Grid-World and Box-World. A strategy (strategy.pl, goal(E, T,
+Relational-Grid-World and Box-World; in Minigrid and BabyAI (states with
+facing/3) the first action of a cheapest path over (cell, direction)
+states, turning as it goes, then the interaction with the object (the
+Minigrid section at the end). A strategy (strategy.pl, goal(E, T,
 Object), learned by `neurosym induce strategy` or written by hand) says which
 object the agent goes for next; route/4 says how to get there. `neurosym play`
 loads it beside the strategy. Load it beside a neurosym knowledge base or live
@@ -30,6 +33,8 @@ Reads the facts of docs/design.md for state T of episode E:
     holding(E, T, Item)        sword, or key(C)
     terrain(E, Type, Row, Col) wall, mountain (cells that hold no object)
     grid(E, Rows, Cols)        the map's size
+    facing(E, T, Dir)          Minigrid: the agent's direction (east, south, ...)
+    door_state(E, T, Id, S)    Minigrid: a door's state (open, closed, locked)
 
 A module whose helpers stay inside it, so it loads beside the other rule
 files and beside a strategy (whose own helpers may be called anything but the

@@ -7,6 +7,11 @@ object to go for and ``route(E, T, Object, Action)`` (rules/route.pl, loaded
 as code beside the strategy) the action. The Prolog side is
 :mod:`neurosym.play.prolog`: one call per sub-env and step.
 
+On Minigrid and BabyAI the state also has ``facing/3`` and ``door_state/4``
+(:func:`neurosym.play.live.minigrid_rows`, as the recorder writes them), route/4
+answers Minigrid's actions (left, right, forward, pickup, toggle: the env's
+``action_names``), and a state is its positions, held items, direction and doors.
+
 The strategy leaves a state undecided when goal/3 has no answer
 (``no_goal``), when route/4 finds no path to its object (``no_route``: the
 route planner refuses it), or when the episode has been in this very state
@@ -16,8 +21,9 @@ What happens then is the agent's ``fallback``:
 
 * ``default`` (the default): route.pl's ``default_goal/3`` (a hand-written
   strategy: RGW the sword, then enemies, then the terminal; Box-World the
-  held key's lock, else a loose key) decides, else ``safe_step/3`` (the first
-  move into a free cell), else ``up``;
+  held key's lock, else a loose key; Minigrid the key of a locked door, the
+  door, the goal) decides, else ``safe_step/3`` (the first move into a free
+  cell; Minigrid: forward into a free cell, else left), else ``up``;
 * ``none``: nothing decides for the strategy, and the episode ends there as
   a failure. The env is stepped once more (a batched env steps every
   sub-env), but nothing of that step counts: its reward is 0, it has no
