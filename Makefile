@@ -40,7 +40,9 @@ test-fast: setup
 NS := $(VENV)/bin/neurosym
 demo: setup
 	@echo "== 1/3 The general PrediNet (trained on random levels) plays rgw2, a map it never saw: its route,"
-	@echo "==     its relation heads (head 0 relates the agent to what it is after) and the rules' answers"
+	@echo "==     its relation heads (head 0 relates the agent to what it is after) and the rules' answers:"
+	@echo "==     whether it followed each level's optimal order, and whether the heads relate sword and enemy"
+	@echo "==     at one state (direct), through an object within one step (indirect) or only in one recording"
 	@$(NS) extract --checkpoint checkpoints/rgw-random-predinet-cellkeys.pt --env rgw2 --episodes 20 --seed 0 --out kb_out/rgw2-cellkeys
 	@echo "   The same episodes on one page (open it in a browser: episode player, heads, rule answers):"
 	@$(NS) report --recording kb_out/rgw2-cellkeys
@@ -55,7 +57,7 @@ demo: setup
 	  print("success %.0f %%, mean return %.2f (the general PrediNet: %.0f %% on 300 such levels)" \
 	  % (100 * r["success_rate"], r["mean_return"], 100 * g["success_rate"]))'
 	@echo
-	@echo "Next: neurosym query --kb kb_out/rgw2-cellkeys/kb.pl --rules rgw 'visit_order(E, Order)'; neurosym agents"
+	@echo "Next: neurosym query --kb kb_out/rgw2-cellkeys/kb.pl --rules rgw 'visit_order(E, Order)'; 'sword_enemy_link(How)'; neurosym agents"
 
 bench: setup
 	$(PY) bench/envs.py

@@ -249,7 +249,19 @@ def measure() -> dict[str, dict[str, list[int]]]:
             if lines:
                 places[name][rel] = lines
     places["import_cycles"] = {" <-> ".join(c): [] for c in import_cycles(trees)}
+    places["shared_class_names"] = shared_class_names(trees)
     return places
+
+
+def shared_class_names(trees: dict[str, ast.Module]) -> dict[str, list[int]]:
+    """Class names (a leading ``_`` ignored) defined in more than one place: name -> lines."""
+    where: dict[str, list[tuple[str, int]]] = defaultdict(list)
+    for rel, tree in trees.items():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ClassDef):
+                where[node.name.lstrip("_")].append((rel, node.lineno))
+    return {f"{name}: {', '.join(r for r, _ in v)}": [n for _, n in v]
+            for name, v in where.items() if len(v) > 1}  # fmt: skip
 
 
 def main() -> None:
@@ -267,6 +279,7 @@ def main() -> None:
         ),
         "functions_over_100_lines": sum(len(v) for v in places["functions_over_100_lines"].values()),
         "import_cycles": len(places["import_cycles"]),
+        "shared_class_names": len(places["shared_class_names"]),
     }
     print(json.dumps(counts))
     if args.detail:

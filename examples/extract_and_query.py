@@ -30,12 +30,19 @@ with neurosym.KnowledgeBase(kb_path, rules=[family, "relations"]) as kb:  # ship
         print(
             "sword before enemy in episodes:", [a["E"] for a in kb.query("sword_before_enemy(E)")]
         )
+        print(
+            "visited in the level's optimal order:", [a["E"] for a in kb.query("optimal_order(E)")]
+        )
+        # direct(Links, share(N, D)): related at one state, on N of the D states the agent
+        # acted in; indirect([via(X, share(N, D))]): through X at one state or two consecutive
+        # ones; co_occurring([apart(X, ...)]): through X only across the recording; none
         print("how the network links sword and enemy:", kb.once("sword_enemy_link(A)")["A"])
     else:
         print(
             "reached the gem along the solution:",
             [a["E"] for a in kb.query("followed_solution(E)")],
         )
-        print("key-lock links in the network:", kb.query("key_lock_link(C, L)"))
+        # per lock colour, the same answers as sword_enemy_link/1 (rules/rgw.pl)
+        print("key-lock links in the network:", kb.query("key_lock_link(C, A)"))
     print("relations that consistently order two object types:")
     print(kb.query_df("consistently_orders(J, A, B), A \\== empty, B \\== empty"))

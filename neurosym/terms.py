@@ -206,7 +206,7 @@ def _unescape(match: re.Match[str]) -> str:
     raise FactError(f"unknown escape sequence \\{seq} in a quoted atom")
 
 
-class _Parser:
+class _TermParser:
     """Recursive descent over the canonical text: atoms, numbers, compounds, lists."""
 
     def __init__(self, text: str) -> None:
@@ -284,7 +284,7 @@ def parse_term(text: str) -> ParsedTerm:
     :class:`Term`, lists -> ``tuple``. Raises :class:`FactError` naming the
     position of anything else (variables, operators written infix, trailing text).
     """
-    parser = _Parser(text)
+    parser = _TermParser(text)
     value = parser.term()
     if text[parser.pos :].strip():
         raise parser.fail("trailing text")

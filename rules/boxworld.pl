@@ -167,17 +167,25 @@ distractor_avoided(E) :-
     kb_event_(E, got(gem)),
     \+ kb_event_(E, hit(distractor)).
 
-%!  key_lock_link(?Colour, ?Link) is nondet.
+%!  key_lock_link(?Colour, -Answer) is nondet.
 %
-%   The network relates a key of Colour (loose key(C) or held key held(C))
-%   with the lock of the same colour, through Link: r(J) above threshold
-%   (PrediNet) or attention(Head) (MHDPA). Each Colour-Link once.
+%   How the network relates a key of Colour (loose key(C) or held key
+%   held(C), as one key) with the lock(C) of the same colour, state by
+%   state: Answer is direct(Links, share(N, D)), indirect(Vias),
+%   co_occurring(Vias) or none, as sword_enemy_link/1 of rgw.pl words them.
+%   Every share(N, D) is N states out of the D states the agent acted in,
+%   over all episodes (the sum of episode/4's Steps). One answer per colour
+%   of a lock among the KB's objects (object/2), in standard order.
 %
-%       ?- key_lock_link(C, L).
-%       C = red, L = r(1).
+%       ?- key_lock_link(C, A).
+%       C = blue, A = direct([r(2)], share(1, 317)) ;
+%       C = red, A = direct([r(1)], share(1, 317)) ;
+%       C = yellow, A = none.
 
-key_lock_link(C, Link) :-
-    distinct(C-Link, ( kb_link_(K, lock(C), Link), key_colour_(K, C) )).
+key_lock_link(C, Answer) :-
+    setof(C0, Id^object(Id, lock(C0)), Cs),
+    member(C, Cs),
+    kb_link_answer_([key(C), held(C)], [lock(C)], Answer).
 
 %!  wrong_key_lock_link(?Key, ?Lock, ?Link) is nondet.
 %

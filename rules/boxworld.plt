@@ -57,16 +57,30 @@ test(distractor_avoided, Es == [0]) :-
 
 :- begin_tests(boxworld_network).
 
-test(key_lock_link, Ls == [red-r(1), blue-r(2)]) :-
+% Shares are of the 317 states the agent acted in (12 + 5 + 300).
+test(key_lock_link, Ls == [blue-direct([r(2)], share(1, 317)),
+                           red-direct([r(1)], share(1, 317)),
+                           yellow-none]) :-
     findall(C-L, key_lock_link(C, L), Ls).
+
+% The held key and the loose key are one key: held(yellow) beside the agent
+% at state 3 and the agent beside lock(yellow) at state 4 link them through
+% the agent, on both states.
+test(key_lock_link_through_the_agent,
+     [ setup(( user:assertz(holds(2, 3, r(0), held(yellow), agent)),
+               user:assertz(holds(2, 4, r(1), agent, lock(yellow))) )),
+       cleanup(( user:retract(holds(2, 3, r(0), held(yellow), agent)),
+                 user:retract(holds(2, 4, r(1), agent, lock(yellow))) )),
+       true(A == indirect([via(agent, share(2, 317))])) ]) :-
+    key_lock_link(yellow, A).
 
 test(wrong_key_lock_link, Ws == [held(red)-lock(green)-r(0)]) :-
     findall(K-L-R, wrong_key_lock_link(K, L, R), Ws).
 
 test(mhdpa_link, [ setup(user:assertz(attention(0, 3, 2, held(yellow), lock(yellow), 0.5))),
                    cleanup(user:retractall(attention(_, _, _, _, _, _))),
-                   true(Ls == [red-r(1), blue-r(2), yellow-attention(2)]) ]) :-
-    findall(C-L, key_lock_link(C, L), Ls).
+                   true(A == direct([attention(2)], share(1, 317))) ]) :-
+    key_lock_link(yellow, A).
 
 test(attends_matching_lock, As == [0-4-1]) :-
     findall(E-T-H, attends_matching_lock(E, T, H), As).

@@ -8,6 +8,8 @@
         holds(E, T, r(J), A, B)                thresholded, oriented: Value > 0
         threshold(J, Value)
         attention(E, T, Head, Query, Key, W)   MHDPA: strongest keys per query
+    episode(E, Steps, Return, Outcome)     entity_link/3's shares count
+                                           states out of the Steps' sum
     Heads and relations count from 0. Entities are named by type (sword,
     key(red), ...), so these rules speak about types, not single objects.
 
@@ -27,7 +29,8 @@
             held_count/4,
             consistently_orders/3,
             order_support/5,
-            strongest_pairs/2
+            strongest_pairs/2,
+            entity_link/3
           ]).
 
 :- use_module(library(lists)).
@@ -35,6 +38,8 @@
 :- use_module(library(apply)).
 :- use_module(library(aggregate)).
 :- use_module(library(solution_sequences)).
+
+:- include(lib/kb_common).
 
 %!  head(?Head) is nondet.
 %
@@ -161,6 +166,28 @@ strongest_pairs(N, Top) :-
     length(First, K),
     append(First, _, Sorted),
     maplist(held_, First, Top).
+
+%!  entity_link(+A, +B, -Answer) is det.
+%
+%   How the network relates entity types A and B, state by state (holds/5
+%   above threshold, attention/6's strongest keys): Answer is
+%   direct(Links, share(N, D)) when some Link relates them at one state (N
+%   such states), else indirect(Vias) with via(Z, share(N, D)) for each
+%   third entity Z related to both at one state or two consecutive states
+%   of one episode (N states: one link there and the other at that state,
+%   the one before or the one after; most first), else co_occurring(Vias)
+%   with apart(Z, share(NA, D), share(NB, D)) for each Z related to A on NA
+%   states and to B on NB states, never close in time, else none. D is
+%   the number of states the agent acted in, over all episodes (the sum of
+%   episode/4's Steps). Z is the agent, a map object's type or a held key.
+%
+%       ?- entity_link(sword, agent, A).
+%       A = direct([r(0)], share(1, 8)).
+
+entity_link(A, B, Answer) :-
+    must_be(ground, A),
+    must_be(ground, B),
+    kb_link_answer_([A], [B], Answer).
 
 % ------------------------------------------------------------------ helpers
 

@@ -68,4 +68,13 @@ test(mhdpa_pairs, [ setup(( user:assertz(attention(0, 0, 3, agent, sword, 0.75))
                     true(Ps == [2-(agent-sword)]) ]) :-
     head_pairs(3, Ps).
 
+test(entity_link_direct, A == direct([r(0), r(1)], share(2, 4))) :-
+    entity_link(sword, enemy, A).
+
+test(entity_link_one_way_round, A == direct([r(0)], share(1, 4))) :-
+    entity_link(agent, sword, A).
+
+test(entity_link_none, A == none) :-
+    entity_link(agent, enemy, A).
+
 :- end_tests(relations).

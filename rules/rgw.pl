@@ -5,6 +5,8 @@
     Behavioural rules read the recorded trace:
         episode/4, event/3 (picked(sword), teleported, defeated(enemy),
         hurt_by(enemy), reached(terminal), fell(pit)), holding/3.
+    optimal_visits/2 holds each level's optimal visit order (the env's
+    solver), which optimal_order/1 compares the agent's with.
     Representational rules read the network's facts:
         holds/5 (PrediNet, thresholded and oriented so the value is positive),
         attention/6 (MHDPA, strongest keys per query), object/2.
@@ -27,6 +29,8 @@
             enemy_beaten_with_sword/1,
             visit_order/2,
             optimal_order/1,
+            optimal_visit_order/2,
+            off_optimal_order/3,
             orders_sword_before_enemy/1,
             sword_enemy_direct/1,
             sword_enemy_via/1,
@@ -102,14 +106,47 @@ visit_order(E, Order) :-
 
 %!  optimal_order(?Episode) is nondet.
 %
-%   Episode visited the key objects in the order of the optimal route of
-%   Configuration-2 (thesis, figure 9): sword, teleport, enemy, terminal.
+%   Episode visited the key objects in the order of its level's optimal
+%   route: its visit_order/2 equals its optimal_visits/2 fact, the order in
+%   which the env's own solver (neurosym/envs/rgw_solver.py, playing the
+%   level's best return) first reaches them. On rgw2 that is sword, teleport,
+%   enemy, terminal; on rgw1 and procedural levels it is whatever their map
+%   asks. An episode without the fact (a KB recorded before it, a level the
+%   solver cannot search) is never answered.
 %
 %       ?- optimal_order(E).
 %       E = 0.
 
 optimal_order(E) :-
-    visit_order(E, [sword, teleport, enemy, terminal]).
+    optimal_visit_order(E, Optimal),
+    visit_order(E, Optimal).
+
+%!  optimal_visit_order(?Episode, -Order:list) is nondet.
+%
+%   Order is the key objects of Episode's level in the order its optimal
+%   route first reaches them (the KB's optimal_visits/2 fact, written by
+%   the recorder from the env's solver). Deterministic when Episode is bound.
+%
+%       ?- optimal_visit_order(0, O).
+%       O = [sword, teleport, enemy, terminal].
+
+optimal_visit_order(E, Order) :-
+    kb_episode_(E),
+    kb_fact_(optimal_visits(E, Order)).
+
+%!  off_optimal_order(?Episode, -Visited:list, -Optimal:list) is nondet.
+%
+%   Episode's level has an optimal visit order (optimal_visits/2) and the
+%   agent visited the key objects in another one.
+%
+%       ?- off_optimal_order(1, V, O).
+%       V = [teleport, enemy, sword, terminal],
+%       O = [sword, teleport, enemy, terminal].
+
+off_optimal_order(E, Visited, Optimal) :-
+    optimal_visit_order(E, Optimal),
+    visit_order(E, Visited),
+    Visited \== Optimal.
 
 %!  orders_sword_before_enemy(?Relation) is nondet.
 %
@@ -126,10 +163,10 @@ orders_sword_before_enemy(R) :-
 
 %!  sword_enemy_direct(?Link) is nondet.
 %
-%   The network relates sword and enemy directly: some head attended the pair
-%   {sword, enemy} with relation Link above threshold (Link = r(J), PrediNet),
-%   or some MHDPA head's strongest key for one of them is the other
-%   (Link = attention(Head)). Each Link once.
+%   The network relates sword and enemy directly at some state: some head
+%   attended the pair {sword, enemy} with relation Link above threshold
+%   (Link = r(J), PrediNet), or some MHDPA head's strongest key for one of
+%   them is the other (Link = attention(Head)). Each Link once.
 %
 %       ?- sword_enemy_direct(L).
 %       L = r(1).
@@ -139,41 +176,48 @@ sword_enemy_direct(Link) :-
 
 %!  sword_enemy_via(?Object) is nondet.
 %
-%   The network relates the sword to Object and Object to the enemy (either
-%   orientation, any relation or head, anywhere in the KB): Object may carry
-%   the link between them. Object is another entity type that occurs as an
-%   object or is the agent. Each Object once.
+%   The network relates the sword to Object and Object to the enemy at one
+%   state, or at two consecutive states of one episode (either orientation,
+%   any relation or head): Object may carry the link between them. Object is
+%   another entity type that occurs as an object, or the agent. Answered most
+%   states first (see sword_enemy_link/1), whether or not a direct link
+%   exists too.
 %
 %       ?- sword_enemy_via(X).
-%       X = agent ;
 %       X = teleport.
 
 sword_enemy_via(X) :-
-    entity_type_(X),
-    X \== sword,
-    X \== enemy,
-    once(kb_link_(sword, X, _)),
-    once(kb_link_(X, enemy, _)).
+    kb_thirds_([sword], [sword], [enemy], SStates),
+    kb_thirds_([enemy], [sword], [enemy], EStates),
+    kb_via_(SStates, EStates, 0, Near, _),
+    member(via(X, _), Near).
 
 %!  sword_enemy_link(-Answer) is det.
 %
-%   How the network relates sword and enemy: direct(Links) when it relates
-%   them directly (the list of links), otherwise indirect(Objects) when only
-%   through other objects, otherwise none.
+%   How the network relates sword and enemy, state by state. Every share is
+%   share(N, D): N states out of the D states the agent acted in, over all
+%   episodes (D is the sum of episode/4's Steps: states 0..Steps-1 of each
+%   episode, those with a step/4 fact and the network's outputs).
+%
+%     * direct(Links, share(N, D)): some Link (r(J) or attention(Head))
+%       relates sword and enemy at one state; N states have such a link.
+%     * indirect(Vias), when no state has a direct link: Vias lists
+%       via(Object, share(N, D)), most states first. The network relates the
+%       sword to Object and Object to the enemy at one state or at two
+%       consecutive states of one episode; N counts the states at which one
+%       of the two links holds and the other holds at that state, the one
+%       before or the one after.
+%     * co_occurring(Vias), when no Object does that: Vias lists
+%       apart(Object, share(NS, D), share(NE, D)): Object is related to the
+%       sword on NS states and to the enemy on NE states, but never at one
+%       state or two consecutive ones: the two links only share the recording.
+%     * none: neither is related to a common object at all.
 %
 %       ?- sword_enemy_link(A).
-%       A = direct([r(1), r(0)]).
+%       A = direct([r(1), r(0)], share(4, 124)).
 
 sword_enemy_link(Answer) :-
-    findall(L, sword_enemy_direct(L), Links),
-    (   Links \== []
-    ->  Answer = direct(Links)
-    ;   findall(X, sword_enemy_via(X), Xs),
-        (   Xs \== []
-        ->  Answer = indirect(Xs)
-        ;   Answer = none
-        )
-    ).
+    kb_link_answer_([sword], [enemy], Answer).
 
 % ------------------------------------------------------------------ helpers
 %
@@ -194,6 +238,3 @@ visit_(hurt_by(enemy), enemy).
 visit_(reached(terminal), terminal).
 visit_(fell(pit), pit).
 
-%   entity_type_(-Type): object types of the map, and the agent; each once.
-entity_type_(Type) :-
-    distinct(Type, ( Type = agent ; object(_, Type) )).

@@ -50,6 +50,31 @@ test(visit_order_all, Os == [0-[sword, teleport, enemy, terminal],
 test(optimal_order, Es == [0]) :-
     findall(E, optimal_order(E), Es).
 
+test(optimal_visit_order, Os == [0, 1, 2, 3]) :-
+    findall(E, optimal_visit_order(E, [sword, teleport, enemy, terminal]), Os).
+
+test(off_optimal_order, Os == [1-[teleport, enemy, sword, terminal],
+                               2-[sword, pit],
+                               3-[sword, teleport, enemy]]) :-
+    findall(E-V, off_optimal_order(E, V, _), Os).
+
+% The order compared with is the level's own: rgw1's route (sword, enemy,
+% terminal, no teleport) makes episode 3's visits the optimal ones.
+test(optimal_order_of_the_level, [ setup(( user:retract(optimal_visits(3, Saved)),
+                                           user:assertz(optimal_visits(3, [sword, teleport, enemy])) )),
+                                   cleanup(( user:retractall(optimal_visits(3, _)),
+                                             user:assertz(optimal_visits(3, Saved)) )),
+                                   true(Es == [0, 3]) ]) :-
+    findall(E, optimal_order(E), Es).
+
+% A KB without optimal_visits/2 (recorded before it) answers no episode.
+test(no_optimal_visits_no_answer, [ setup(( findall(E-O, user:optimal_visits(E, O), Saved),
+                                            user:retractall(optimal_visits(_, _)) )),
+                                    cleanup(forall(member(E-O, Saved),
+                                                   user:assertz(optimal_visits(E, O)))),
+                                    fail ]) :-
+    optimal_order(_).
+
 % The rules look events up by episode only: after running all of them,
 % SWI-Prolog's just-in-time indexes on event/3 are on the first argument alone.
 test(event_indexed_on_the_episode_only, Kinds == [single(1)]) :-
@@ -72,7 +97,9 @@ test(sword_enemy_direct, Ls == [r(1), r(0)]) :-
 test(sword_enemy_via, Xs == [agent, teleport]) :-
     findall(X, sword_enemy_via(X), Xs).
 
-test(link_direct, A == direct([r(1), r(0)])) :-
+% Shares are of the 124 states the agent acted in (14 + 23 + 7 + 40 + 40);
+% r(1) and r(0) hold between sword and enemy on 4 states.
+test(link_direct, A == direct([r(1), r(0)], share(4, 124))) :-
     sword_enemy_link(A).
 
 test(link_indirect, [ setup(( saved_holds_(Saved),
@@ -80,7 +107,50 @@ test(link_indirect, [ setup(( saved_holds_(Saved),
                                        msort([X, Y], [enemy, sword]) ),
                                      user:retract(holds(E, T, R, X, Y))) )),
                       cleanup(restore_holds_(Saved)),
-                      true(A == indirect([agent, teleport])) ]) :-
+                      true(A == indirect([via(agent, share(1, 124)),
+                                          via(teleport, share(1, 124))])) ]) :-
+    sword_enemy_link(A).
+
+% rgw1's head 0: the agent with the sword on states 0-5, with the enemy on
+% 12-19. The two links never meet in time: co-occurring, not indirect.
+test(link_co_occurring, [ setup(( saved_holds_(Saved),
+                                  user:retractall(holds(_, _, _, _, _)),
+                                  forall(between(0, 5, T), user:assertz(holds(0, T, r(0), agent, sword))),
+                                  forall(between(12, 19, T), user:assertz(holds(0, T, r(0), enemy, agent))) )),
+                          cleanup(restore_holds_(Saved)),
+                          true(A == co_occurring([apart(agent, share(6, 124), share(8, 124))])) ]) :-
+    sword_enemy_link(A).
+
+% Consecutive states of one episode carry the link; both states count.
+test(link_consecutive_states, [ setup(( saved_holds_(Saved),
+                                        user:retractall(holds(_, _, _, _, _)),
+                                        user:assertz(holds(0, 5, r(0), agent, sword)),
+                                        user:assertz(holds(0, 6, r(1), enemy, agent)) )),
+                                cleanup(restore_holds_(Saved)),
+                                true(A == indirect([via(agent, share(2, 124))])) ]) :-
+    sword_enemy_link(A).
+
+% Two states apart, or the same T in two episodes, is not consecutive.
+test(link_not_consecutive, [ setup(( saved_holds_(Saved),
+                                     user:retractall(holds(_, _, _, _, _)),
+                                     user:assertz(holds(0, 5, r(0), agent, sword)),
+                                     user:assertz(holds(0, 7, r(1), enemy, agent)),
+                                     user:assertz(holds(1, 5, r(1), enemy, agent)) )),
+                             cleanup(restore_holds_(Saved)),
+                             true(A == co_occurring([apart(agent, share(1, 124), share(2, 124))])) ]) :-
+    sword_enemy_link(A).
+
+% Every state of a run of links counts once, whichever side it is on.
+test(link_share_counts_states, [ setup(( saved_holds_(Saved),
+                                         user:retractall(holds(_, _, _, _, _)),
+                                         forall(between(0, 3, T), user:assertz(holds(1, T, r(0), agent, sword))),
+                                         user:assertz(holds(1, 4, r(0), enemy, agent)),
+                                         user:assertz(holds(1, 4, r(1), enemy, agent)),
+                                         user:assertz(holds(1, 9, r(1), teleport, sword)),
+                                         user:assertz(holds(1, 9, r(1), enemy, teleport)) )),
+                                 cleanup(restore_holds_(Saved)),
+                                 true(A == indirect([via(agent, share(2, 124)),
+                                                     via(teleport, share(1, 124))])) ]) :-
     sword_enemy_link(A).
 
 test(link_none, [ setup(( saved_holds_(Saved), user:retractall(holds(_, _, _, _, _)) )),

@@ -23,6 +23,9 @@ from neurosym.envs import env_family, make
 from neurosym.record.recorder import record
 from neurosym.record.recording import Recording
 
+REPO = Path(__file__).resolve().parents[1]
+"""the repository's root"""
+
 SMALL_MAX_STEPS = 25
 
 

@@ -10,7 +10,7 @@ import threading
 from pathlib import Path
 
 import pytest
-from conftest import REPO
+from builders import REPO
 
 from neurosym.cli import BROKEN_PIPE_EXIT
 

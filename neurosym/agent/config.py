@@ -49,6 +49,8 @@ MODULES = ("predinet", "mhdpa")
 FAMILIES = ("rgw", "boxworld", "minigrid")
 PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
+IMITATE_FAMILIES = ("rgw", "minigrid")
+"""families with a planner for ``--algo imitate`` (Minigrid's: DoorKey levels)"""
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
@@ -348,6 +350,14 @@ class ModelConfig:
     reads their mean; the recorded argument is the first in row-major order).
     ``--init-from`` may switch an agent to cells: W_K starts afresh, every other weight is
     copied."""
+    relation_bits: float | None = field(default=None, metadata=bounded("[0, 1000]"))
+    """PrediNet's fact bottleneck: None (off) or the threshold tau of every relation. On, the
+    policy and value read only which relations hold between which attended cells, exactly as
+    holds/5 writes them with threshold(J, tau): per head, D_j > tau and D_j < -tau as 0/1 and
+    the observation of each argument's argmax cell (the thing attends/8 names; on RGW also
+    the held-sword plane), no positions and no relation values. Straight-through gradients
+    (sigmoid(D_j -+ tau) for the bits, the soft attention for the cells). tau is rounded to
+    float32, as the forward compares it; extract writes abs:tau for such an agent."""
     init: str = "orthogonal"
     """weight initialisation of the MLP, the value head and PrediNet's read-out: "orthogonal"
     (gain sqrt 2 before ReLUs, 1 for the value and read-out, as in SB3 and CleanRL) or "torch"
@@ -380,6 +390,11 @@ class ModelConfig:
                     f"{name} {value!r} is PrediNet's; {self.module}'s {plural} come from each "
                     f"entity (use {name} {default!r})"
                 )
+        if self.relation_bits is not None and self.module != "predinet":
+            raise ConfigError(
+                f"relation_bits is PrediNet's (the policy reads its thresholded relations); "
+                f"{self.module} has no relations (leave relation_bits unset)"
+            )
         if self.init not in INITS:
             raise ConfigError(f"unknown init {self.init!r}; expected one of {', '.join(INITS)}")
 
@@ -624,9 +639,14 @@ class TrainConfig:
         """A preset's settings for an env family and learner, then the overrides that are not None."""
         _check_family(family)
         _check_preset(preset)
-        if algo == "imitate" and family != "rgw":
+        if algo == "imitate" and family not in IMITATE_FAMILIES:
             raise ConfigError(
-                f"--algo imitate learns from the RGW planner; {family} has none (use a3c or ppo)"
+                f"--algo imitate learns from an env's planner (RGW's, Minigrid DoorKey's); "
+                f"{family} has none (use a3c or ppo)"
+            )
+        if algo == "imitate" and family == "minigrid" and overrides.get("augment"):
+            raise ConfigError(
+                "--augment turns RGW levels; Minigrid's actions turn the agent (leave it off)"
             )
         if preset == "thesis":
             if algo != "a3c":

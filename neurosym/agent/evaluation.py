@@ -87,7 +87,7 @@ def play_scored(
         n, venv = wave.count, wave.venv
         outcome: list[str] = [""] * n
         scores = (
-            _LevelScores(venv, wave.info, n) if levels and "optimal_return" in wave.info else None
+            _LevelTally(venv, wave.info, n) if levels and "optimal_return" in wave.info else None
         )
         for step in wave.steps():
             if scores is not None:
@@ -108,7 +108,7 @@ def play_scored(
     return out
 
 
-class _LevelScores:
+class _LevelTally:
     """One wave's RGW level facts (optimal return, guarded, best without the sword) and sword timing."""
 
     def __init__(self, venv: Any, info: dict[str, Any], n: int) -> None:

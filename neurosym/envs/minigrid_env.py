@@ -106,7 +106,7 @@ class MinigridEnv(gym.Env[np.ndarray, np.int64]):
         self.observation_space = spaces.Box(0, 1, (ms.NUM_PLANES, height, width), np.uint8)
         self.action_space = spaces.Discrete(len(ms.ACTION_NAMES))
         self._namer = ms.Namer()
-        self._snap: ms.Snapshot | None = None
+        self._snap: ms.GridState | None = None
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -158,7 +158,7 @@ class MinigridEnv(gym.Env[np.ndarray, np.int64]):
         self.inner.close()
 
 
-def _info(snap: ms.Snapshot, events: tuple[str, ...], outcome: str | None) -> dict[str, Any]:
+def _info(snap: ms.GridState, events: tuple[str, ...], outcome: str | None) -> dict[str, Any]:
     return {
         "agent": snap.agent,
         "direction": ms.DIRECTIONS[snap.direction],

@@ -1,6 +1,6 @@
 """What neurosym reads from a Farama Minigrid (or BabyAI) env's own grid, one state at a time.
 
-A :class:`Snapshot` is one pass over the env's cells (row-major; Minigrid keeps
+A :class:`GridState` is one pass over the env's cells (row-major; Minigrid keeps
 its grid as a flat list indexed ``y * width + x``, so row = y, col = x): the
 cells' (type, colour, state) codes as Minigrid encodes them, the named objects
 on the map with their ids, the doors' states, the agent's cell and direction,
@@ -97,7 +97,7 @@ def name_of(obj: Any) -> str:
 
 
 @dataclass
-class Snapshot:
+class GridState:
     """One state of a Minigrid env, read from its grid (see the module docstring)."""
 
     cells: np.ndarray
@@ -137,7 +137,7 @@ class Namer:
         return name
 
 
-def snapshot(env: Any, namer: Namer) -> Snapshot:
+def snapshot(env: Any, namer: Namer) -> GridState:
     """Read the unwrapped Minigrid env ``env``'s state; ``namer`` gives its objects their ids."""
     grid = env.grid
     width, height = grid.width, grid.height
@@ -157,7 +157,7 @@ def snapshot(env: Any, namer: Namer) -> Snapshot:
                 doors.append((ident, DOOR_STATES[int(code[2])]))
     x, y = (int(v) for v in env.agent_pos)
     carried = env.carrying
-    return Snapshot(
+    return GridState(
         cells=cells.reshape(height, width, 3),
         objects=(("agent", "agent", y, x), *objects),
         doors=tuple(doors),
@@ -169,7 +169,7 @@ def snapshot(env: Any, namer: Namer) -> Snapshot:
     )
 
 
-def observation(snap: Snapshot, out: np.ndarray | None = None) -> np.ndarray:
+def observation(snap: GridState, out: np.ndarray | None = None) -> np.ndarray:
     """(NUM_PLANES, H, W) uint8 0/1 planes of a snapshot (written into ``out`` when given).
 
     The agent's cell shows only the agent and its direction (what it stands on,
@@ -200,7 +200,7 @@ def observation(snap: Snapshot, out: np.ndarray | None = None) -> np.ndarray:
     return obs
 
 
-def entity_codes(snap: Snapshot) -> np.ndarray:
+def entity_codes(snap: GridState) -> np.ndarray:
     """(H, W) int64 entity codes (names in :data:`ENTITY_NAMES`); the agent's cell is ``agent``."""
     codes = _ENTITY[snap.cells[..., 0], snap.cells[..., 1]]
     codes[snap.agent] = ENTITY_NAMES.index("agent")
@@ -208,7 +208,7 @@ def entity_codes(snap: Snapshot) -> np.ndarray:
 
 
 def events(
-    before: Snapshot, after: Snapshot, action: int, reward: float, terminated: bool
+    before: GridState, after: GridState, action: int, reward: float, terminated: bool
 ) -> tuple[str, ...]:
     """The events of the step from ``before`` to ``after``, in this order.
 
@@ -259,7 +259,7 @@ _AHEAD = ((0, 1), (1, 0), (0, -1), (-1, 0))
 """(drow, dcol) of each direction"""
 
 
-def outcome(after: Snapshot, reward: float, terminated: bool, truncated: bool) -> str | None:
+def outcome(after: GridState, reward: float, terminated: bool, truncated: bool) -> str | None:
     """The episode's outcome (:data:`OUTCOMES`) on the step that ends it, else None."""
     if terminated:
         under = TYPES[int(after.cells[after.agent][0])]

@@ -29,7 +29,7 @@ agent whose evaluation must show ``optimal_rate`` 1.0 (tests/agent/test_evaluati
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -573,3 +573,77 @@ class Planner:
             remaining = int(limit - t[i]) if limit is not None else len(plan.layers)
             out.append((plan, (int(pos[i]), int(removed[i]), max(remaining, 1))))
         return out
+
+
+MAX_UNLIMITED_STEPS = 10_000
+"""the most steps an optimal route is followed for under rules without a step limit"""
+
+VISITS: dict[str, str] = {
+    "picked(sword)": "sword",
+    "teleported": "teleport",
+    "defeated(enemy)": "enemy",
+    "hurt_by(enemy)": "enemy",
+    "reached(terminal)": "terminal",
+    "fell(pit)": "pit",
+}
+"""event -> the key object it reaches (the visits rules/rgw.pl's visit_order/2 reads)"""
+
+
+def optimal_visit_orders(venv: object, seeds: list[int]) -> list[tuple[str, ...] | None]:
+    """The key objects each level's optimal route first reaches, in order, one per seed.
+
+    Level k is the one ``venv.reset`` plays from ``seeds[k]`` (the recorder's
+    episode k); it is played by :class:`Plan` on the env itself, ``num_envs``
+    levels at a time, and the events the env reports are read through
+    :data:`VISITS`, first visits only: rgw2 gives ``("sword", "teleport",
+    "enemy", "terminal")``. None for a level the search cannot settle (more
+    than MAX_REMOVABLE swords and enemies, classic rules without a step limit).
+    """
+    env = getattr(venv, "unwrapped", venv)
+    n = int(env.num_envs)
+    out: list[tuple[str, ...] | None] = []
+    plans: dict[tuple[bytes, int], Plan | None] = {}  # a fixed map is searched once
+    for first in range(0, len(seeds), n):
+        wave = list(seeds[first : first + n])
+        wave += [wave[-1] + 1 + i for i in range(n - len(wave))]  # idle sub-envs
+        out += _wave_orders(env, wave, plans)[: len(seeds) - first]
+        if len(plans) > Planner.MAX_PLANS:
+            plans.clear()
+    return out
+
+
+def _wave_orders(
+    env: Any, seeds: list[int], cache: dict[tuple[bytes, int], Plan | None]
+) -> list[tuple[str, ...] | None]:
+    """:func:`optimal_visit_orders` of one reset of every sub-env (plans kept in ``cache``)."""
+    _, info = env.reset(seed=seeds)
+    cells, starts = env.current_levels()
+    plans: list[Plan | None] = []
+    for i in range(len(seeds)):
+        key = (cells[i].tobytes(), int(starts[i]))
+        if key not in cache:
+            try:
+                ok = np.isfinite(info["optimal_return"][i])
+                cache[key] = Plan(cells[i], starts[i], env.height, env.width, env.rules) if ok else None
+            except ValueError:
+                cache[key] = None
+        plans.append(cache[key])
+    limit = env.rules.max_steps
+    visits: list[list[str]] = [[] for _ in seeds]
+    live = np.array([p is not None for p in plans])
+    for _ in range(limit if limit is not None else MAX_UNLIMITED_STEPS):
+        if not live.any():
+            break
+        pos, removed, t = env.agent_states()
+        actions = np.zeros(len(seeds), dtype=np.int64)
+        for i in np.flatnonzero(live):
+            left = int(limit - t[i]) if limit is not None else len(plans[i].layers)
+            actions[i] = plans[i].action(0, int(pos[i]), int(removed[i]), max(left, 1))
+        _, _, terminated, truncated, info = env.step(actions)
+        for i in np.flatnonzero(live):
+            for event in rules.EVENT_TUPLES[int(info["events"][i])]:
+                reached = VISITS.get(event)
+                if reached is not None and reached not in visits[i]:
+                    visits[i].append(reached)
+        live &= ~(np.asarray(terminated) | np.asarray(truncated))
+    return [tuple(v) if p is not None else None for v, p in zip(visits, plans, strict=True)]

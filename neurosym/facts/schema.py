@@ -138,6 +138,12 @@ SCHEMA: dict[str, Predicate] = {
            "every non-empty cell of E's map after the reset that holds no object and is not "
            "the agent (RGW `wall`, `mountain`; Box-World `wall`; Minigrid `wall`, `lava`, "
            "`floor`); terrain never changes within an episode", TRACE, "extract intervene"),
+        _p("optimal_visits", "episode:E:int order:term",
+           "the key objects of E's level in the order its fastest optimal route first reaches "
+           "them, as the env's own solver plays it (RGW: `[sword, teleport, enemy, terminal]` on "
+           "rgw2; the first of equally fast routes); none for a level without an optimal return "
+           "(unsolvable, or too large to search) and none on Box-World or Minigrid",
+           TRACE, "extract intervene"),
         _p("step", "episode:E:int t:T:int action:atom reward:float",
            "the action taken in state T (`up, right, down, left`; Minigrid `left, right, forward, "
            "pickup, drop, toggle, done`) and its reward",
@@ -172,6 +178,14 @@ SCHEMA: dict[str, Predicate] = {
            TRACE, "extract"),
         _p("attention", "episode:E:int t:T:int head:int query:term key:term weight:float",
            "MHDPA: each query cell's strongest key (`--top-keys N`: N of them)",
+           TRACE, "extract"),
+        _p("faithfulness", "target:atom features:atom score:float states:int episodes:int",
+           "Target `next_object` or `action`: the share Score of States held-out states (of "
+           "Episodes held-out episodes) whose target a decision tree learned on the other "
+           "episodes predicts from Features: `relations` (the network's relation facts), "
+           "`world` (world facts only), `untrained_relations` (an untrained network of the same "
+           "config on the same states: the control) or `chance` (a uniform pick among the "
+           "objects; the commonest action)",
            TRACE, "extract"),
         _p("probe", "head:int j:J:value predicate:term accuracy:float control:float",
            "held-out accuracy and control accuracy", PROBE, "probe"),

@@ -6,6 +6,7 @@
     kb_meta(Key, Value)            object(Id, Type)
     episode(E, Steps, Return, Outcome)
     grid(E, Rows, Cols)            terrain(E, Type, Row, Col)
+    optimal_visits(E, Order)
     step(E, T, Action, Reward)     at(E, T, Id, Row, Col)
     holding(E, T, Item)            event(E, T, Event)
     facing(E, T, Dir)              door_state(E, T, Id, State)     mission(E, Text)
@@ -317,6 +318,7 @@ def extract_facts(
         ),
         "grid": _frame("grid", rec.grids),
         "terrain": _frame("terrain", rec.terrain),
+        "optimal_visits": _frame("optimal_visits", rec.optimal),
         "step": _frame("step", rec.steps),
         "at": _frame(
             "at",

@@ -80,7 +80,7 @@ class Literal:
 
 
 @dataclass
-class Clause:
+class WorldClause:
     """``predicts(E, T, head) :- body``."""
 
     head: str
@@ -242,7 +242,7 @@ def _bound(body: tuple[Literal, ...]) -> list[str]:
 
 def _grow(
     g: Grounded, template: str, remaining: np.ndarray, all_pos: np.ndarray, bias: Bias
-) -> Clause | None:
+) -> WorldClause | None:
     """One clause by greedy FOIL gain (with a literal of lookahead); None when none is consistent."""
     has_var = head_var(template)
     body: tuple[Literal, ...] = ()
@@ -262,7 +262,7 @@ def _grow(
         _, _, added, p0, n0 = best
         body = (*body, *added)
         if n0 == 0 and (not has_var or HEAD_VAR in _bound(body)):
-            return Clause(template, body)
+            return WorldClause(template, body)
     return None
 
 
@@ -302,7 +302,7 @@ def _safe(body: tuple[Literal, ...], has_var: bool) -> bool:
     return all(lit.named_var in bound for lit in body if lit.negated and lit.named_var)
 
 
-def _prune(g: Grounded, clause: Clause, all_pos: np.ndarray) -> Clause:
+def _prune(g: Grounded, clause: WorldClause, all_pos: np.ndarray) -> WorldClause:
     """Drop literals (last first) while the clause stays safe and covers no negative."""
     has_var = head_var(clause.head)
     body = clause.body
@@ -312,15 +312,15 @@ def _prune(g: Grounded, clause: Clause, all_pos: np.ndarray) -> Clause:
             _, n = _counts(evaluate(g, trial, has_var), all_pos, all_pos)
             if n == 0:
                 body = trial
-    return Clause(clause.head, body)
+    return WorldClause(clause.head, body)
 
 
-def learn(g: Grounded, template: str, bias: Bias = Bias()) -> tuple[list[Clause], int]:
+def learn(g: Grounded, template: str, bias: Bias = Bias()) -> tuple[list[WorldClause], int]:
     """Clauses for ``template`` by sequential covering; returns them and the positives left uncovered."""
     has_var = head_var(template)
     all_pos = positives(g, template)
     remaining = all_pos
-    clauses: list[Clause] = []
+    clauses: list[WorldClause] = []
     while len(remaining) and len(clauses) < bias.max_clauses:
         clause = _grow(g, template, remaining, all_pos, bias)
         if clause is None:

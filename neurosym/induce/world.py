@@ -25,7 +25,7 @@ import numpy as np
 from neurosym.errors import ConfigError
 from neurosym.induce.background import BACKGROUND, FAMILIES  # noqa: F401 (BACKGROUND: re-exported)
 from neurosym.induce.examples import Grounded, ground
-from neurosym.induce.foil import Bias, Clause, evaluate, head_var, learn, positives
+from neurosym.induce.foil import Bias, WorldClause, evaluate, head_var, learn, positives
 from neurosym.induce.readback import Code, Part, check_reads_back, comment
 
 
@@ -36,7 +36,7 @@ class EventScore:
     event: str
     status: str  # "determined" or "undetermined"
     reason: str
-    clauses: list[Clause]
+    clauses: list[WorldClause]
     train_examples: int
     train_precision: float | None
     train_recall: float | None
@@ -69,7 +69,7 @@ class WorldRules:
     notes: list[str] = field(default_factory=list)
 
     @property
-    def clauses(self) -> list[Clause]:
+    def clauses(self) -> list[WorldClause]:
         return [c for s in self.scores.values() if s.status == "determined" for c in s.clauses]
 
     def write(self, path: str | os.PathLike[str]) -> Path:
@@ -90,7 +90,7 @@ def _ratio(num: int, den: int) -> float:
 
 
 def score(
-    g: Grounded, template: str, clauses: list[Clause]
+    g: Grounded, template: str, clauses: list[WorldClause]
 ) -> tuple[int, float | None, float | None]:
     """(examples, precision, recall) of ``clauses`` for ``template`` on ``g``."""
     has_var = head_var(template)

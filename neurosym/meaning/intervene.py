@@ -66,7 +66,7 @@ from neurosym.terms import Term
 DEFAULT_EPISODES = 100
 """episodes per experiment by default (sampled actions, seeds S..S+99)"""
 
-TRACE_TABLES = ("episodes", "grids", "terrain", "steps", "positions", "holding", "events")
+TRACE_TABLES = ("episodes", "grids", "terrain", "optimal", "steps", "positions", "holding", "events")
 
 NETWORK_FACTS = tuple(p.name for p in group(TRACE) if "intervene" not in p.writers)
 """the trace predicates an experiment KB leaves out (:mod:`neurosym.facts.schema`: those intervene does

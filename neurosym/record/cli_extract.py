@@ -2,7 +2,7 @@
 
     neurosym extract --checkpoint ckpt.pt [--env rgw2] [--map FILE] [--episodes 20] [--seed 0]
         [--greedy|--sample] [--actions agent|random] [--threshold quantile:0.9|abs:0.5|z:2] [--out DIR]
-        [--format pl,parquet] [--qlf] [--verbose]
+        [--format pl,parquet] [--qlf] [--no-faithfulness] [--verbose]
 
 Writes into ``--out`` (default ``kb_out/<env>``):
 
@@ -10,6 +10,11 @@ Writes into ``--out`` (default ``kb_out/<env>``):
   and its signature ``kb.qlf.sig`` beside it;
 * ``facts/<predicate>.parquet`` (format ``parquet``) -- the same fact tables;
 * ``recording/`` -- the Recording itself, for ``neurosym plot --recording``.
+
+Unless ``--no-faithfulness``, the KB also holds ``faithfulness/5``: how much of the
+agent's next objects and actions its relation facts predict on held-out episodes,
+beside world facts, an untrained network's relation facts on the same states and
+chance (:mod:`neurosym.record.faithfulness`); the report prints them in one table.
 
 The products are written beside the previous ones and published together
 by one rename (:mod:`neurosym.publish`), so a failed or killed run writes
@@ -45,8 +50,10 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """who chooses the actions: the agent, or uniformly random draws seeded by each episode's
     seed (the network still runs on every state, so its facts are extracted;
     kb_meta(actions, random))"""
-    threshold: str = option("quantile:0.9", metavar="SPEC")
+    threshold: str | None = option(None, metavar="SPEC", shown="quantile:0.9")
     """per-relation threshold for holds/5: quantile:Q, abs:X or z:K"""
+    # an agent with the fact bottleneck (relation_bits=tau) defaults to abs:tau: the bits its
+    # policy read (extraction.model_threshold)
     format: str = option("pl", metavar="LIST")
     """comma-separated outputs: pl, parquet"""
     qlf: bool = False
@@ -55,6 +62,10 @@ class ExtractOptions(EnvChoice, Episodes, ActionMode, Out, Quiet):
     """environments stepped together"""
     top_keys: int | None = option(None, metavar="N", shown="1")
     """MHDPA only: keep each query cell's N strongest keys as attention/6 facts"""
+    faithfulness: bool = True
+    """measure how much of the agent's next objects and actions the relation facts predict on
+    held-out episodes, beside world facts and an untrained network's relation facts on the
+    same states (faithfulness/5; it records the episodes a second time)"""
     verbose: bool = False
     """print the full report: episodes, fact counts, thresholds, relation tables, every answer"""
     episodes: int = 20
@@ -87,7 +98,8 @@ def run(args: ExtractOptions) -> int:
     from neurosym.record.extraction import check_extract_options, extract, write_outputs
 
     formats = parse_formats(args.format)
-    parse_threshold(args.threshold)
+    if args.threshold is not None:
+        parse_threshold(args.threshold)  # a bad spec is refused before the agent is read
     check_extract_options(args.episodes, args.seed, args.batch, args.top_keys)
     agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
@@ -98,13 +110,16 @@ def run(args: ExtractOptions) -> int:
     got = extract(
         agent, env, env_kwargs, episodes=args.episodes, seed=args.seed, greedy=args.greedy,
         threshold=args.threshold, batch=args.batch, top_keys=args.top_keys,
-        actions=args.actions, progress=show and _tty(),
+        actions=args.actions, progress=show and _tty(), faithfulness=args.faithfulness,
     )  # fmt: skip
     written = write_outputs(out, got.recording, got.facts, formats, qlf=args.qlf)
     if show:
         from neurosym.reports.terminal import print_report
 
-        print_report(got.recording, got.facts, written, kb=written.get("kb.pl"), verbose=args.verbose)
+        print_report(
+            got.recording, got.facts, written, kb=written.get("kb.pl"), verbose=args.verbose,
+            faithfulness=got.faithfulness,
+        )  # fmt: skip
     return 0
 
 

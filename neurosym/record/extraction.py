@@ -14,6 +14,7 @@ from typing import Any
 
 from neurosym.errors import ConfigError
 from neurosym.facts.tables import DEFAULT_THRESHOLD, FactSet
+from neurosym.record.faithfulness import Faithfulness
 from neurosym.record.recording import Recording
 from neurosym.seeds import check_seed
 
@@ -39,6 +40,9 @@ class Extraction:
     env_kwargs: dict[str, Any]
     recording: Recording
     facts: FactSet
+    faithfulness: Faithfulness | None = None
+    """how much of the agent's choices the relation facts predict, beside controls (None: not
+    measured); also in ``facts`` as faithfulness/5"""
 
 
 def check_extract_options(
@@ -62,19 +66,24 @@ def extract(
     episodes: int = 20,
     seed: int = 0,
     greedy: bool = True,
-    threshold: str | float | Any = DEFAULT_THRESHOLD,
+    threshold: str | float | Any | None = None,
     batch: int | None = None,
     top_keys: int | None = None,
     actions: str = "agent",
     progress: bool = False,
+    faithfulness: bool = True,
 ) -> Extraction:
     """Record ``episodes`` episodes of ``agent`` on ``env`` and extract their facts.
 
     ``agent``: a checkpoint path (or a shipped agent's name) or a loaded Agent. ``env``: any env
     of its family with its observation shape (default: its own), ``env_kwargs`` options on top.
-    ``threshold``: the relations' threshold spec (``quantile:0.9``, ``abs:X``, ``z:K``).
+    ``threshold``: the relations' threshold spec (``quantile:0.9``, ``abs:X``, ``z:K``); None: the
+    agent's own (:func:`model_threshold`).
     ``top_keys``: MHDPA's strongest keys kept per query cell (refused for a module without
     attention/6 facts).
+    ``faithfulness``: also measure how much of the agent's choices the relation facts
+    predict on held-out episodes, beside world facts and an untrained network's relation
+    facts on the same states (:mod:`neurosym.record.faithfulness`; needs 2 episodes).
     """
     from neurosym.agent.agent import env_for, load_agent
     from neurosym.agent.networks.adapters import adapter_class
@@ -95,11 +104,19 @@ def extract(
             f"{agent.config.module} (its facts are {facts})"
         )
     env, env_kwargs = env_for(agent, env, env_kwargs)
-    rec = record(
-        agent, env, episodes=episodes, seed=seed, greedy=greedy, batch=batch,
-        progress=progress, top_keys=top_keys or 1, env_kwargs=env_kwargs, actions=actions,
+    options = dict(
+        env=env, episodes=episodes, seed=seed, greedy=greedy, batch=batch,
+        top_keys=top_keys or 1, env_kwargs=env_kwargs, actions=actions,
     )  # fmt: skip
-    return Extraction(agent.path, env, env_kwargs, rec, extract_facts(rec, threshold=threshold))
+    rec = record(agent, progress=progress, **options)
+    facts = extract_facts(rec, threshold=threshold)
+    measured = None
+    if faithfulness:
+        from neurosym.record.faithfulness import faithfulness as measure
+
+        measured = measure(agent, rec, facts, **options)
+        facts.tables["faithfulness"] = measured.facts()
+    return Extraction(agent.path, env, env_kwargs, rec, facts, measured)
 
 
 def write_outputs(
@@ -141,3 +158,13 @@ def is_report_page(path: Path) -> bool:
             return _PAGE_MARK in page.read(4096)
     except OSError:
         return False
+
+
+def model_threshold(config: Any) -> str:
+    """The holds/5 threshold an agent's KB is written with by default: ``abs:tau`` for the fact
+    bottleneck (ModelConfig.relation_bits, so the KB's holds/5 are the bits its policy read),
+    else quantile:0.9."""
+    from neurosym.agent.networks.predinet import bits_threshold
+
+    tau = bits_threshold(getattr(config, "relation_bits", None))
+    return DEFAULT_THRESHOLD if tau is None else f"abs:{tau!r}"

@@ -105,7 +105,7 @@ class _Columns:
         return {name: col[order] for name, col in cols.items()}
 
 
-class _Trace:
+class _SymbolicColumns:
     """The symbolic side of the episodes (positions, holding, events), from decoded infos.
 
     Per state it keeps one reference to the decoded tuples; the columns are
@@ -289,12 +289,30 @@ def record(
             recorder = _Recorder(agent, venv, episodes, seed, greedy, top_keys, max_steps, advance)
             recorder.random = actions == "random"
             rec = recorder.run()
+            rec.optimal = optimal_table(name, venv, seed, episodes)
     finally:
         torch.set_num_threads(saved_threads)
         venv.close()
     rec.meta.update(_meta(agent, name, seed, greedy, kwargs))
     rec.meta["actions"] = actions
     return rec
+
+
+def optimal_table(name: str, venv: Any, seed: int, episodes: int) -> pd.DataFrame:
+    """The recording's ``optimal`` table: episode k's level (``reset(seed=seed + k)``) and the
+    key objects its optimal route visits, in order, as Prolog list text
+    (:func:`neurosym.envs.rgw_solver.optimal_visit_orders`, which replays the levels on
+    ``venv``). RGW only; a level without an optimal return has no row.
+    """
+    from neurosym.envs import env_family
+    from neurosym.envs.rgw_solver import optimal_visit_orders
+    from neurosym.record.recording import conform
+
+    if env_family(name) != "rgw":
+        return conform("optimal", None)
+    orders = optimal_visit_orders(venv, [seed + k for k in range(episodes)])
+    rows = [(k, "[" + ",".join(o) + "]") for k, o in enumerate(orders) if o is not None]
+    return conform("optimal", pd.DataFrame(rows, columns=["episode", "order"]))
 
 
 def _by_episode(df: pd.DataFrame) -> pd.DataFrame:
@@ -323,7 +341,7 @@ class _Recorder:
         self.n = venv.num_envs
         self.names = np.asarray(venv.entity_names, dtype=object)
         self.adapter = adapter_class(agent.config.module)
-        self.trace = _Trace()
+        self.trace = _SymbolicColumns()
         self.model = _Columns()  # model outputs per (episode, t)
         self.step_cols = _Columns()  # steps table
         self.ep_rows: list[tuple[int, int, float, str, int]] = []

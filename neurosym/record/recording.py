@@ -52,6 +52,7 @@ SCHEMA: dict[str, tuple[tuple[str, str], ...]] = {
     "holding": _arguments("holding"),
     "terrain": _arguments("terrain"),
     "grids": _arguments("grid"),
+    "optimal": _arguments("optimal_visits"),
     "events": _arguments("event"),
     "attends": _arguments("attends"),
     "relations": _arguments("relation"),
@@ -78,9 +79,9 @@ META_KEYS = (
     "checkpoint", "env", "module", "heads", "relations", "seed", "actions", "created", "version",
 )  # fmt: skip
 
-OPTIONAL_TABLES = ("terrain", "grids", "facing", "doors", "missions")
+OPTIONAL_TABLES = ("terrain", "grids", "facing", "doors", "missions", "optimal")
 """tables that recordings of older versions lack: they load as empty tables (RGW and Box-World
-recordings have no rows in Minigrid's facing, doors and missions)"""
+recordings have no rows in Minigrid's facing, doors and missions; only RGW ones in optimal)"""
 
 MAX_COUNT = 1024
 """the most heads or relations a recording's meta may give (they size the tables readers draw)"""
@@ -130,7 +131,8 @@ class Recording:
     Missing tables default to empty ones (an MHDPA recording has no ``relations``,
     a PrediNet one no ``attention``; a hand-made one may have no ``terrain``
     (the cells of each episode's map that hold terrain, read after the reset)
-    or ``grids`` (each episode's map size)). Tables are brought to the schema on
+    or ``grids`` (each episode's map size) or ``optimal`` (each RGW level's optimal
+    visit order, Prolog list text)). Tables are brought to the schema on
     construction, so column order and dtypes are always the documented ones.
     """
 
@@ -140,6 +142,7 @@ class Recording:
     holding: pd.DataFrame = field(default_factory=lambda: empty_table("holding"))
     terrain: pd.DataFrame = field(default_factory=lambda: empty_table("terrain"))
     grids: pd.DataFrame = field(default_factory=lambda: empty_table("grids"))
+    optimal: pd.DataFrame = field(default_factory=lambda: empty_table("optimal"))
     events: pd.DataFrame = field(default_factory=lambda: empty_table("events"))
     attends: pd.DataFrame = field(default_factory=lambda: empty_table("attends"))
     relations: pd.DataFrame = field(default_factory=lambda: empty_table("relations"))

@@ -22,16 +22,14 @@ QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("sword before enemy", "sword_before_enemy(E)", "E"),
         ("teleport before enemy", "teleport_before_enemy(E)", "E"),
         ("enemy beaten with sword", "enemy_beaten_with_sword(E)", "E"),
-        ("optimal order (sword, teleport, enemy, terminal)", "optimal_order(E)", "E"),
+        ("level's optimal order followed", "optimal_order(E)", "E"),
         ("relations ordering sword before enemy", "orders_sword_before_enemy(R)", "R"),
-        ("sword-enemy link in the network", "sword_enemy_link(A)", "A"),
     ),
     "boxworld": (
         ("followed the solution chain", "followed_solution(E)", "E"),
         ("distractor taken", "distractor_taken(E)", "E"),
         ("distractor avoided", "distractor_avoided(E)", "E"),
         ("key opens lock", "key_opens(K, L), X = K-L", "X"),
-        ("key-lock links in the network", "key_lock_link(C, L), X = C-L", "X"),
     ),
     "minigrid": (
         ("key before door", "key_before_door(E)", "E"),
@@ -40,6 +38,22 @@ QUERIES: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("key-door links in the network", "key_door_link(C, L), X = C-L", "X"),
     ),
 }
+LINKS: dict[str, tuple[tuple[str, str, str, str, tuple[str, str]], ...]] = {
+    "rgw": (
+        ("sword-enemy link in the network", "sword_enemy_link(A)", "", "A", ("sword", "enemy")),
+    ),
+    "boxworld": (
+        ("key-lock link in the network", "key_lock_link(C, A)", "C", "A", ("key", "lock")),
+    ),
+}
+"""family -> (title, goal, the variable naming what is linked (a colour) or "", the answer's
+variable, the two sides' names): link answers (rules/lib/kb_common.pl), printed in words
+with their shares of the states the agent acted in (:func:`link_text`)"""
+LINK_NOTE = (
+    "  (links: states out of all the states the agent acted in; indirect: through",
+    "  an object at one state or two consecutive ones; co-occurring: only in one",
+    "  recording)",
+)
 RULE_FILES: dict[str, tuple[str, ...]] = {
     "rgw": ("rgw.pl", "relations.pl"),
     "boxworld": ("boxworld.pl", "relations.pl"),
@@ -60,6 +74,13 @@ _WITH_DISTRACTOR = (
     "no distractor on these levels",
 )
 SCOPES: dict[str, dict[str, tuple[str, str, str]]] = {
+    "rgw": {
+        "level's optimal order followed": (
+            "current_predicate(optimal_visits/2), optimal_visits(E, _)",
+            "episodes of solved levels",
+            "no optimal order in this KB (recorded before optimal_visits/2, or no level solved)",
+        ),
+    },
     "boxworld": {"distractor taken": _WITH_DISTRACTOR, "distractor avoided": _WITH_DISTRACTOR},
 }
 """family -> title -> (goal over E naming the episodes the question is about, what they
@@ -77,7 +98,8 @@ class Answer:
     of: int | None = None
     """the episodes asked about (goals over episodes) or the distinct visit orders"""
     unit: str = ""
-    """what ``of`` counts: ``episodes``, ``episodes with a distractor``, ``distinct orders``"""
+    """what ``of`` counts: ``episodes``, ``episodes with a distractor``, ``distinct orders``;
+    ``states`` for link answers, whose words say their shares (:func:`link_text`)"""
     empty: str | None = None
     """said instead of a count when ``of`` is 0 (no distractor on these levels)"""
 
@@ -105,15 +127,67 @@ def answers(kb_path: Path, family: str) -> list[Answer]:
                 out.append(Answer(title, goal, found, episodes, "episodes"))
             else:
                 out.append(Answer(title, goal, found))
+        out += _link_answers(kb, family)
         if family == "rgw":
-            visits = kb.query("visit_order(_, O), format(atom(Text__), '~q', [O])")
-            orders = Counter(str(r["Text__"]) for r in visits)
-            if orders:
-                common = [f"{o} x{n}" for o, n in orders.most_common(3)]
-                title, goal = "visit orders (most common)", "visit_order(_, Order)"
-                out.append(Answer(title, goal, common, len(orders), "distinct orders"))
+            out += _order_answers(kb)
     finally:
         kb.close()
+    return out
+
+
+def link_text(answer: Any, sides: tuple[str, str]) -> str:
+    """A link answer of rules/lib/kb_common.pl in words, with the states it counts.
+
+    ``direct([r(1)], share(4, 124))`` -> ``direct: r(1) on 4 of 124 states``;
+    ``indirect([via(agent, share(2, 124))])`` -> ``indirect via agent on 2 of 124 states``;
+    ``co_occurring([apart(agent, share(6, 40), share(8, 40))])`` -> ``co-occurring only:
+    agent: with sword on 6, with enemy on 8 of 40 states, never within one step``.
+    """
+    from neurosym.terms import Term
+
+    if not isinstance(answer, Term):
+        return str(answer)
+    a, b = sides
+    if answer.functor == "direct":
+        links, share = answer.args
+        n, d = share.args
+        return f"direct: {', '.join(map(str, links))} on {n} of {d} states"
+    if answer.functor == "indirect":
+        parts = [f"{v.args[0]} on {v.args[1].args[0]} of {v.args[1].args[1]} states"
+                 for v in answer.args[0]]
+        return "indirect via " + "; ".join(parts)
+    if answer.functor == "co_occurring":
+        parts = [f"{v.args[0]}: with {a} on {v.args[1].args[0]}, with {b} on "
+                 f"{v.args[2].args[0]} of {v.args[1].args[1]} states"
+                 for v in answer.args[0]]
+        return "co-occurring only: " + "; ".join(parts) + ", never within one step"
+    return str(answer)
+
+
+def _link_answers(kb: Any, family: str) -> list[Answer]:
+    """The family's link questions (:data:`LINKS`), each answer in words (:func:`link_text`)."""
+    out = []
+    for title, goal, what, var, sides in LINKS.get(family, ()):
+        values = []
+        for row in kb.query(goal):
+            text = link_text(row[var], sides)
+            values.append(f"{row[what]}: {text}" if what else text)
+        out.append(Answer(title, goal, values, unit="states"))
+    return out
+
+
+def _order_answers(kb: Any) -> list[Answer]:
+    """The most common visit orders, and the levels' optimal orders (optimal_visits/2)."""
+    out = []
+    for title, goal in (
+        ("visit orders (most common)", "visit_order(_, Order)"),
+        ("levels' optimal orders (most common)", "optimal_visit_order(_, Order)"),
+    ):
+        rows = kb.query(goal.replace("Order", "O") + ", format(atom(Text__), '~q', [O])")
+        orders = Counter(str(r["Text__"]) for r in rows)
+        if orders:
+            common = [f"{o} x{n}" for o, n in orders.most_common(3)]
+            out.append(Answer(title, goal, common, len(orders), "distinct orders"))
     return out
 
 
@@ -144,6 +218,8 @@ def _short(answer: Answer, limit: int = 20) -> str:
         return "none"
     shown = values[:limit]
     head = ", ".join(shown) + (", ..." if len(values) > limit else "")
+    if answer.unit == "states":
+        return "\n".join(values)
     if len(values) == 1 and (answer.of is None or answer.unit == "distinct orders"):
         return head
     return f"{head}  ({_count(answer, len(shown))})"
@@ -155,6 +231,8 @@ def _brief(answer: Answer) -> str:
         return answer.empty
     if answer.unit.startswith("episodes"):
         return _count(answer, len(answer.values))
+    if answer.unit == "states":  # link answers: one per line, each says what it counts
+        return "\n".join(answer.values) or "none"
     return _short(answer, limit=3)
 
 
@@ -341,11 +419,67 @@ def _print_answers(kb: Path | None, family: str, say: Any, table_type: Any, verb
     for answer in found:
         qt.add_row(show(answer.title), show(_short(answer) if verbose else _brief(answer)))
     say(qt)
+    if any(answer.unit == "states" for answer in found):
+        for line in LINK_NOTE:
+            say(line)
     say(f"  (answers from kb.pl; ask your own with neurosym query --rules {family})")
 
 
+FAITHFULNESS_COLUMNS = (
+    ("relations", "relations"),
+    ("world", "world"),
+    ("untrained_relations", "untrained"),
+    ("chance", "chance"),
+)
+"""faithfulness/5's feature sets -> the printed table's column"""
+
+
+def faithfulness_rows(table: Any) -> list[tuple[str, ...]]:
+    """The printed faithfulness rows (target, then a score per feature set, then the states) of
+    a faithfulness/5 table: what the KB holds, to two decimals (``-``: not measured)."""
+    rows = []
+    for target in dict.fromkeys(table["target"]):
+        mine = table[table["target"] == target]
+        scores = dict(zip(mine["features"], mine["score"], strict=True))
+        cells = [f"{scores[f]:.2f}" if f in scores else "-" for f, _ in FAITHFULNESS_COLUMNS]
+        rows.append((target.replace("_", " "), *cells, str(int(mine["states"].max()))))
+    return rows
+
+
+def _print_faithfulness(facts: Any, measured: Any, say: Any, table_type: Any) -> None:
+    """The faithfulness/5 facts in one table, with what they count and why a figure is missing."""
+    table = facts["faithfulness"]
+    notes = tuple(getattr(measured, "notes", ()))
+    if table.empty and not notes:
+        return
+    if not table.empty:
+        held = int(table["episodes"].max())
+        total = getattr(measured, "episodes", None)
+        of = f" of {total}" if total else ""
+        ft = table_type(
+            title=f"faithfulness (held out: {held}{of} episodes)",
+            show_edge=False,
+        )
+        for col in ("target", *(name for _, name in FAITHFULNESS_COLUMNS), "states"):
+            ft.add_column(col)
+        add_rows(ft, faithfulness_rows(table), whole=tuple(range(6)))
+        say(ft)
+        say(
+            "  (share of the held-out states whose next object or action a tree learned on the "
+            "other episodes predicts from: the relation facts, world facts, an untrained network's "
+            "relation facts on the same states; chance: a uniform pick, the commonest action)"
+        )
+    for note in notes:
+        say(f"  faithfulness: {show(note)}")
+
+
 def print_report(
-    rec: Any, facts: Any, written: dict[str, Path], kb: Path | None = None, verbose: bool = True
+    rec: Any,
+    facts: Any,
+    written: dict[str, Path],
+    kb: Path | None = None,
+    verbose: bool = True,
+    faithfulness: Any = None,
 ) -> None:
     """Print the summary of an extract run with rich (plain text when not a terminal).
 
@@ -356,6 +490,8 @@ def print_report(
     Without ``verbose`` it is the short report: the episodes in one line, the
     heads and the rule answers (episode lists as counts); ``verbose`` adds the
     episodes, fact counts, thresholds and relation tables and every answer.
+    The faithfulness table is ``facts``' faithfulness/5 (``faithfulness``, the
+    :class:`~neurosym.record.faithfulness.Faithfulness` measured, adds its notes).
     """
     from rich.console import Console
     from rich.table import Table
@@ -367,6 +503,7 @@ def print_report(
     _print_summary(rec, facts, console, Table, verbose)
     _print_heads(rec, say, Table, verbose)
     _print_relations(facts, say, Table, verbose)
+    _print_faithfulness(facts, faithfulness, say, Table)
     _print_answers(kb, env_family(str(rec.meta.get("env"))), say, Table, verbose)
     for path in written.values():
         say(f"wrote {show(path)}", soft_wrap=True)  # a path is never broken over two lines

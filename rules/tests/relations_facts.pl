@@ -3,10 +3,14 @@
     Two heads, two relations. holds/5 is what extract_facts writes for these
     relation/7 rows with the thresholds below (|value| > threshold, oriented
     so that the value is positive, one fact per (E, T, r(J), A, B)).
+    Episode 0 has 3 states the agent acted in, episode 1 one.
 */
 
 :- dynamic kb_meta/2, object/2, episode/4, step/4, at/5, holding/3, event/3,
            attends/8, relation/7, holds/5, threshold/2, attention/6.
+
+episode(0, 3, 0.0, timeout).
+episode(1, 1, 0.0, timeout).
 
 threshold(0, 0.3).
 threshold(1, 0.3).

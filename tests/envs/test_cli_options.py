@@ -98,7 +98,7 @@ def test_literal_choices() -> None:
 def test_eval_plays_classic_false_as_false(run_neurosym) -> None:  # noqa: ANN001
     import json
 
-    from conftest import REPO
+    from builders import REPO
 
     proc = run_neurosym(
         "eval", "--checkpoint", REPO / "checkpoints" / "rgw2-predinet.pt", "--episodes", 1,

@@ -123,20 +123,46 @@ def test_representational_rules_match_pandas(rgw: tuple) -> None:
     assert sorted(r.args[0] for r in values(kb, "orders_sword_before_enemy(R)", "R")) == orders
     direct = sorted({j for j, a, b in pairs if {a, b} == {"sword", "enemy"}})
     assert sorted(r.args[0] for r in values(kb, "sword_enemy_direct(L)", "L")) == direct
-    linked = {(a, b) for _, a, b in pairs} | {(b, a) for _, a, b in pairs}
-    types = {"agent"} | set(facts["object"]["type"])
-    via = {
-        x for x in types - {"sword", "enemy"} if ("sword", x) in linked and (x, "enemy") in linked
-    }
-    assert set(values(kb, "sword_enemy_via(X)", "X")) == via
-    link = kb.once("sword_enemy_link(A)")["A"]
-    if direct:
-        links = tuple(values(kb, "sword_enemy_direct(L)", "L"))
-        assert link == Term("direct", (links,))
-    elif via:
-        assert link.functor == "indirect" and set(link.args[0]) == via
+    near, apart, direct_link = _link_in_pandas(facts, "sword", "enemy")
+    assert [v.args[0] for v in near] == values(kb, "sword_enemy_via(X)", "X")
+    if direct_link is not None:
+        expected = direct_link
+    elif near:
+        expected = Term("indirect", (tuple(near),))
     else:
-        assert link == "none"
+        expected = Term("co_occurring", (tuple(apart),)) if apart else "none"
+    assert kb.once("sword_enemy_link(A)")["A"] == expected
+
+
+def _link_in_pandas(facts: FactSet, a: str, b: str) -> tuple[list[Term], list[Term], Term | None]:
+    """sword_enemy_link/1 from the holds table: (via/2 terms, apart/3 terms, the direct/2 term or
+    None). A link holds at states (episode, t); a third object is near when its links to the
+    two sides come within one step of each other in one episode."""
+    holds = facts["holds"]
+    d = int(facts["episode"]["steps"].sum())
+    both = pd.concat([holds.rename(columns={"a": "x", "b": "y"}),
+                      holds.rename(columns={"a": "y", "b": "x"})])  # fmt: skip
+    both = both.assign(state=list(zip(both["episode"], both["t"], strict=True)))
+    direct = both[(both.x == a) & (both.y == b)]
+    direct_link = None
+    if len(direct):
+        links = tuple(Term("r", (int(j),)) for j in dict.fromkeys(direct["j"]))
+        direct_link = Term("direct", (links, Term("share", (direct["state"].nunique(), d))))
+    types = {"agent"} | set(facts["object"]["type"])
+    near, apart = [], []
+    for z in sorted(types - {a, b}):
+        sa = set(both[(both.x == a) & (both.y == z)]["state"])
+        sb = set(both[(both.x == b) & (both.y == z)]["state"])
+        if not sa or not sb:
+            continue
+        close = {(e, t) for e, t in sa if any((e, t + k) in sb for k in (-1, 0, 1))}
+        close |= {(e, t) for e, t in sb if any((e, t + k) in sa for k in (-1, 0, 1))}
+        if close:
+            near.append((-len(close), z, Term("via", (z, Term("share", (len(close), d))))))
+        else:
+            share_a, share_b = Term("share", (len(sa), d)), Term("share", (len(sb), d))
+            apart.append(Term("apart", (z, share_a, share_b)))
+    return [v for _, _, v in sorted(near)], apart, direct_link
 
 
 def test_relation_statistics_match_pandas(rgw: tuple) -> None:

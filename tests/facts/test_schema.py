@@ -84,7 +84,7 @@ def test_an_extract_kb_documents_and_declares_each_predicate(tmp_path: Path, swi
     trace = schema.group(schema.TRACE)
     assert declared == [f":- dynamic {p.indicator}." for p in trace]
     assert documented == [schema.header_lines(p.name)[0] for p in trace]
-    assert text.endswith(":- dynamic attention/6.\n\nkb_meta(threshold,'quantile:0.9').\n")
+    assert text.endswith(":- dynamic faithfulness/5.\n\nkb_meta(threshold,'quantile:0.9').\n")
     with KnowledgeBase(path) as kb:  # the safe reader takes the header; no table raises
         assert kb.query("relation(_, _, _, _, _, _, _)") == []
     proc = subprocess.run(

@@ -128,7 +128,7 @@ def test_an_ssu_rule_appended_to_an_extracted_kb_never_runs(
 ) -> None:
     path = _rgw_kb(tmp_path)
     with KnowledgeBase(path, rules=[REPO / "rules" / "rgw.pl"]) as kb:  # the KB as written works
-        assert str(kb.once("sword_enemy_link(L)")["L"]) == "indirect([agent])"
+        assert str(kb.once("sword_enemy_link(L)")["L"]) == "indirect([via(agent,share(1,1))])"
     line = path.read_text().count("\n") + 1
     with path.open("a") as fh:
         fh.write(f"attention(_,_,_,_,_,_) => {_touch(marker)}, fail.\n")

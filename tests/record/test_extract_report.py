@@ -142,8 +142,8 @@ def test_report_lines_break_between_phrases(
     ]
     facts = next(i for i, line in enumerate(lines) if line.startswith("facts: "))
     assert lines[facts : facts + 3] == [
-        "facts: kb_meta 11, object 8, episode 5, grid 5, terrain 125, step 164, at 1308,",
-        "  holding 40, event 89, attends 656, relation 984, holds 98, threshold 3",
-        "  (3496 in all)",
+        "facts: kb_meta 11, object 8, episode 5, grid 5, terrain 125, optimal_visits 5,",
+        "  step 164, at 1308, holding 40, event 89, attends 656, relation 984, holds 98,",
+        "  threshold 3 (3501 in all)",
     ]
     assert lines[-1] == f"wrote {tmp_path / 'out' / 'recording'}"

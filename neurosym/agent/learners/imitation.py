@@ -22,12 +22,14 @@ critic is fitted to the planner's best return still to earn (times
 ``reward_scale``), so that a later RL run can start from it.
 
 Started and reporting as every learner (:mod:`neurosym.agent.learners.process`);
-one process, RGW only (Box-World has no planner here), no torchrun.
+one process, no torchrun. The planners: RGW's (:mod:`neurosym.envs.rgw_solver`) and
+Minigrid DoorKey's (:mod:`neurosym.envs.minigrid_solver`); Box-World has none here.
 """
 
 from __future__ import annotations
 
 import os
+from typing import Any
 
 import numpy as np
 import torch
@@ -51,10 +53,12 @@ from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 class LabelBuffer:
     """A ring of the latest labelled states: observations, optimal and safe action sets, values."""
 
-    def __init__(self, capacity: int, obs_shape: tuple[int, ...], obs_dtype: np.dtype) -> None:
+    def __init__(
+        self, capacity: int, obs_shape: tuple[int, ...], obs_dtype: np.dtype, n_actions: int = 4
+    ) -> None:
         self.obs = np.zeros((capacity, *obs_shape), dtype=obs_dtype)
-        self.optimal = np.zeros((capacity, 4), dtype=bool)
-        self.safe = np.ones((capacity, 4), dtype=bool)
+        self.optimal = np.zeros((capacity, n_actions), dtype=bool)
+        self.safe = np.ones((capacity, n_actions), dtype=bool)
         self.values = np.zeros(capacity, dtype=np.float32)
         self.size = 0
         self._next = 0
@@ -66,7 +70,7 @@ class LabelBuffer:
         values: np.ndarray,
         safe: np.ndarray | None = None,
     ) -> None:
-        """Append states; ``safe`` (n, 4) bool: actions that give no return up (default: all)."""
+        """Append states; ``safe`` (n, A) bool: actions that give no return up (default: all)."""
         if safe is None:
             safe = np.ones_like(optimal)
         for start in range(0, len(obs), len(self.obs)):  # a batch larger than the ring wraps
@@ -95,7 +99,7 @@ def imitation_loss(logits: torch.Tensor, optimal: torch.Tensor) -> torch.Tensor:
 
 
 def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """(n,) one of each row's optimal actions (an (n, 4) bool set), drawn uniformly."""
+    """(n,) one of each row's optimal actions (an (n, A) bool set), drawn uniformly."""
     return (rng.random(optimal.shape) * optimal).argmax(axis=1)
 
 
@@ -141,6 +145,19 @@ def imitation_update(
     return LossStats(*(totals / config.imitate.dagger_steps).tolist())
 
 
+def planner_for(env_name: str) -> Any:
+    """The optimal planner of an env's family (RGW's, or Minigrid DoorKey's)."""
+    from neurosym.envs.registration import env_family
+
+    if env_family(env_name) == "minigrid":
+        from neurosym.envs.minigrid_solver import DoorKeyPlanner as MinigridPlanner
+
+        return MinigridPlanner()
+    from neurosym.envs.rgw_solver import Planner
+
+    return Planner()
+
+
 def imitation_learner(ctx: LearnerContext) -> None:
     """The DAgger learner process: labelled rollouts and updates until ``ctx.stop`` is set.
 
@@ -149,7 +166,6 @@ def imitation_learner(ctx: LearnerContext) -> None:
     torch.set_num_threads(max(1, len(os.sched_getaffinity(0))))
     with learner_process(ctx.queue, ctx.rank):
         from neurosym.envs import make_batched
-        from neurosym.envs.rgw_solver import Planner
 
         config = ctx.train_config
         dev = distributed.learner_device(ctx.device, distributed.World())
@@ -159,9 +175,10 @@ def imitation_learner(ctx: LearnerContext) -> None:
         local, local_opt = private_copy(ctx.shared, ctx.optimizer, config, dev)
         venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
         obs, _ = venv.reset(seed=ctx.env_seed)
-        planner = Planner()
+        planner = planner_for(ctx.env_name)
         tracker = EpisodeTracker(venv.num_envs)
-        buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype)
+        n_actions = int(venv.single_action_space.n)
+        buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype, n_actions)
         safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
         frames = ctx.frames0
         parent = os.getppid()

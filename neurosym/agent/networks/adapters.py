@@ -219,6 +219,7 @@ class PrediNetAdapter(RelationalAdapter):
             config.query,
             config.keys,
             config.obs_shape[0],
+            getattr(config, "relation_bits", None),
         )
 
     @classmethod

@@ -40,6 +40,14 @@ Choices made here (docs/design.md leaves them open):
   projects them to Table 4's output size (26). It is linear so that the
   output is a plain read-out of R and the R vectors stay the only relational
   features.
+* ``relation_bits=tau`` (ModelConfig.relation_bits; None, the default, is off): the fact
+  bottleneck. The read-out then sees, per head, only [D_j > tau] and [D_j < -tau] (the two
+  orientations holds/5 writes with ``threshold(J, tau)``) and the observation of each
+  argument's argmax cell (what attends/8 names it by; on RGW it carries the held-sword
+  plane, so what the agent holds too): no relation values, no positions. The forward is
+  binary; the backward goes through sigmoid(+-D_j - tau) and the soft attention a @ cells
+  (straight-through). The bits are read from R^h's D part after its hook point, so a value
+  put in place of D^h or R^h is what the bits are taken of.
 
 How it is computed (same function, same parameters, cheaper on a CPU):
 
@@ -156,6 +164,7 @@ class PrediNet(nn.Module):
         query: str = "scene",
         keys: str = "entities",
         cell_size: int = 0,
+        relation_bits: float | None = None,
     ) -> None:
         super().__init__()
         assert entity_size > 2, "entities need features besides the 2 coordinates"
@@ -177,7 +186,12 @@ class PrediNet(nn.Module):
                 n_entities * entity_size, heads * key_size, bias=False
             )  # W_Q2^h
         self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
-        self.out = nn.Linear(heads * (relations + 4), output_size)
+        self.relation_bits = bits_threshold(relation_bits)
+        if self.relation_bits is not None:
+            assert cell_size > 0, "the fact bottleneck reads the attended cells' observations"
+            self.out = nn.Linear(heads * 2 * (relations + cell_size), output_size)
+        else:
+            self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
         # hook points (neurosym.agent.networks.hooks): the attention maps a1, a2 (B, H, N) and
         # the positions (B, H, 2) are read-only in effect (E1, E2 are computed with them inside
@@ -287,4 +301,36 @@ class PrediNet(nn.Module):
         pos1 = self.hook_positions1(e1[..., -2:])  # (B, H, 2)
         pos2 = self.hook_positions2(e2[..., -2:])
         r = self.hook_r(torch.cat([rel, pos1, pos2], dim=-1))  # (B, H, J + 4)
+        if self.relation_bits is not None:  # the fact bottleneck: what holds/5 says, nothing else
+            if cells is None:
+                raise ValueError("PrediNet with relation_bits needs the cells' observations")
+            return self.out(self.fact_bits(r[..., : self.relations], a, cells).reshape(B, -1))
         return self.out(r.reshape(B, H * (self.relations + 4)))  # (B, output_size)
+
+    def fact_bits(self, rel: torch.Tensor, a: torch.Tensor, cells: torch.Tensor) -> torch.Tensor:
+        """What the read-out sees under the fact bottleneck, (B, H, 2 J + 2 C): per head the
+        bits [D_j > tau], [D_j < -tau] (holds(r(J), A, B) and holds(r(J), B, A) with A, B the
+        head's arguments 1 and 2) and the observations of the argmax cells of a1 and a2.
+
+        Forward values are exactly 0/1 and the cells' own observations (``soft - soft.detach()
+        + hard`` adds an exact zero); gradients are the surrogates'."""
+        tau = self.relation_bits
+        assert tau is not None
+        up = _straight_through((rel > tau).to(rel.dtype), torch.sigmoid(rel - tau))
+        down = _straight_through((rel < -tau).to(rel.dtype), torch.sigmoid(-rel - tau))
+        C = cells.shape[-1]
+        index = a.argmax(-1, keepdim=True).expand(-1, -1, C)  # (B, 2H, C): first of ties
+        picked = _straight_through(torch.gather(cells, 1, index), a @ cells)  # (B, 2H, C)
+        H = self.heads
+        return torch.cat([up, down, picked[:, :H], picked[:, H:]], dim=-1)
+
+
+def bits_threshold(tau: float | None) -> float | None:
+    """The fact bottleneck's threshold as the forward compares it: rounded to float32 (the
+    relations' dtype), so extract's ``abs:tau`` keeps exactly the bits the policy read."""
+    return None if tau is None else float(torch.tensor(float(tau), dtype=torch.float32))
+
+
+def _straight_through(hard: torch.Tensor, soft: torch.Tensor) -> torch.Tensor:
+    """``hard`` in the forward (exactly: the zero is added to it last), ``soft``'s gradient."""
+    return (soft - soft.detach()) + hard

@@ -148,7 +148,13 @@ def report_context(
     from neurosym.reports.terminal import RULE_FILES
     from neurosym.reports.web.page import HEAD_COLOURS
     from neurosym.reports.web.player import entity_styles, finite, names_in, player_data
-    from neurosym.reports.web.tables import episode_rows, head_rows, rule_rows, strongest_rows
+    from neurosym.reports.web.tables import (
+        episode_rows,
+        faithfulness_rows,
+        head_rows,
+        rule_rows,
+        strongest_rows,
+    )
     from neurosym.viz.style import legend_text
 
     meta = rec.meta
@@ -181,6 +187,7 @@ def report_context(
         "strongest_note": _strongest_note(rec, facts),
         "thresholds": thresholds,
         "threshold_spec": str(facts.threshold),
+        "faithfulness": faithfulness_rows(facts, kb_path),
         "rules": rules,
         "rule_files": rule_files,
         "query_example": f"{query} 'GOAL'",

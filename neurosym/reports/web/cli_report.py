@@ -143,7 +143,6 @@ def _from_recording(args: ReportOptions, probes: Any, experiments: Any) -> Path:
 
 def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path:
     from neurosym.agent.agent import env_for, load_agent
-    from neurosym.facts.tables import DEFAULT_THRESHOLD
     from neurosym.publish import publish
     from neurosym.record.extraction import extract
     from neurosym.reports.web.build import identity, report_context
@@ -158,7 +157,7 @@ def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path
     got = extract(
         agent, env, env_kwargs, episodes=20 if args.episodes is None else args.episodes,
         seed=args.seed or 0, greedy=args.greedy, batch=args.batch, top_keys=args.top_keys,
-        threshold=args.threshold or DEFAULT_THRESHOLD,
+        threshold=args.threshold,
     )  # fmt: skip
     rec, facts = got.recording, got.facts
     card = agent_card(rec.meta, agent)

@@ -122,3 +122,51 @@ def rule_rows(kb_path: Path | None, family: str, episodes: set[int]) -> list[dic
             items.append({"text": text, "episode": e if e in episodes else None})
         rows.append({"title": title, "goal": goal, "answers": items, "per_episode": per_episode})
     return rows
+
+
+FAITHFULNESS_GOAL = (
+    "catch(faithfulness(Target, Features, Score, States, Episodes), "
+    "error(existence_error(_, _), _), fail)"
+)
+"""the KB's faithfulness/5 facts (a KB written before the predicate existed has none)"""
+
+
+def faithfulness_table(facts: Any, kb_path: Path | None) -> pd.DataFrame:
+    """The faithfulness/5 facts: ``facts``' table, else (facts re-extracted from a recording
+    hold none) the KB's, numbers checked (a fact that is not one is left out)."""
+    table = facts["faithfulness"]
+    if not table.empty or kb_path is None:
+        return table
+    from neurosym.prolog.knowledge_base import KnowledgeBase
+
+    with KnowledgeBase(kb_path) as kb:
+        found = kb.query_df(FAITHFULNESS_GOAL)
+    if found.empty:
+        return table
+    found.columns = [c.lower() for c in found.columns]
+    number = found["score"].map(lambda v: isinstance(v, float | int) and not isinstance(v, bool))
+    whole = found[["states", "episodes"]].map(lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0)
+    keep = number & whole.all(axis=1)
+    return found.loc[keep, list(table.columns)].astype({"target": str, "features": str}).reset_index(drop=True)
+
+
+def faithfulness_rows(facts: Any, kb_path: Path | None) -> list[dict[str, Any]]:
+    """One row per target: its score per feature set (None: not measured), held-out states and episodes."""
+    from neurosym.reports.terminal import FAITHFULNESS_COLUMNS
+
+    table = faithfulness_table(facts, kb_path)
+    rows = []
+    for target in dict.fromkeys(table["target"]):
+        mine = table[table["target"] == target]
+        scores = dict(zip(mine["features"], mine["score"], strict=True))
+        rows.append(
+            {
+                "target": str(target).replace("_", " "),
+                "scores": [
+                    None if f not in scores else float(scores[f]) for f, _ in FAITHFULNESS_COLUMNS
+                ],
+                "states": int(mine["states"].max()),
+                "episodes": int(mine["episodes"].max()),
+            }
+        )
+    return rows
