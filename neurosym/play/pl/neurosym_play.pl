@@ -76,7 +76,8 @@ decide_item_(M, Limit, Fallback, [E, T, State, Prev, Extra, Seen], Out) :-
     decide(M, E, T, State, Prev, Extra, Limit, Seen, Fallback, Out).
 
 %!  decide(+M, +E, +T, +State, +Prev, +Extra, +Limit, +Seen, +Fallback, -Out) is det.
-%   Assert state T's at/5 and holding/3, the previous transition's step/4 and event/3,
+%   Assert state T's at/5 and holding/3 (State [Ats, Held], or on Minigrid [Ats, Held,
+%   Dir, Doors]: facing/3 and door_state/4 too), the previous transition's step/4 and event/3,
 %   and Extra (the network's holds/5, attends/8 or attention/6 facts of state T), then
 %   ask goal(E, T, G) (first answer) and route(E, T, G, A). Out is
 %   [Decider, Why, Goal, Action]: [strategy, none, G, A] when both answer. Else Why is
