@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 from minigrid_scripted import DOORKEY, doorkey_recording
+from test_strategy_features import check_features_agree
 
 from neurosym.facts.tables import extract_facts
 from neurosym.induce.strategy_data import candidates, labels, load_trace
@@ -51,12 +52,13 @@ def test_door_features(kb: Path) -> None:
 
 def test_a_learned_minigrid_strategy_plays_its_level(neurosym_main, kb: Path, tmp_path: Path) -> None:
     """Learned from the one episode (all of it: no held-out share), the strategy chooses every
-    state's next object, and played through route.pl it solves the level in fewer steps than
+    state's next object, its features' Prolog agrees with their Python, and played through route.pl it solves the level in fewer steps than
     the script's 9 (the script bumps twice)."""
     out = tmp_path / "strategy.pl"
     ran = neurosym_main("induce", "strategy", "--kb", kb, "--holdout", kb, "--out", out)
     assert ran.returncode == 0, ran.stderr
     assert "% Scores: fidelity 1.0000 on 9 held-out states" in out.read_text()
+    assert check_features_agree(kb, out, "world") >= 20  # the door features among them, in SWI
     report = score_strategy(out, DOORKEY, 1, seed=1, fallback="none")
     assert report["outcomes"] == {"goal": 1} and report["fallback_steps"] == 0
     assert report["mean_length"] == 7
