@@ -113,8 +113,8 @@ def print_table(agents: list[dict[str, Any]]) -> None:
     print("\n".join(line.rstrip() for line in out.get().splitlines()))
 
 
-WIDTH = 132
-"""columns the table is laid out in at least (its rows are about 120 characters)"""
+WIDTH = 148
+"""columns the table is laid out in at least (its rows are about 135 characters)"""
 
 
 def run(args: AgentsOptions) -> int:

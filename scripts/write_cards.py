@@ -87,6 +87,7 @@ CARDS: dict[str, tuple[str, str, str, dict[str, Any]]] = {
     "bw1-mhdpa": ("thesis agent", "bw1", "", bw(300, 284)),
     "bw2-mhdpa": ("thesis agent", "bw2", "", bw(293, 226)),
     "bw3-mhdpa": ("thesis agent", "bw3", "", bw(300, 257)),
+    "doorkey8-predinet": ("Minigrid DoorKey-8x8 PrediNet", "MiniGrid-DoorKey-8x8-v0", "", bw(300, 290)),
 }
 
 
