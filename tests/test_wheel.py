@@ -126,8 +126,10 @@ def test_the_wheel_carries_the_rule_files_and_the_agents(wheel: Path) -> None:
     assert "lib/kb_common.pl" in {p.relative_to(REPO / "rules").as_posix() for p in shipped}
     assert rules == {f"neurosym/rules/{p.relative_to(REPO / 'rules').as_posix()}" for p in shipped}
     modules = {n for n in names if n.endswith(".pl") and not n.startswith("neurosym/rules/")}
-    assert modules == {  # the package's Prolog modules (their .plt files stay behind, see below)
-        f"neurosym/{p.relative_to(REPO / 'neurosym')}" for p in (REPO / "neurosym").glob("*/pl/*.pl")
+    assert modules == {  # the package's Prolog modules and play's shipped strategies (their
+        # .plt files stay behind, see below)
+        f"neurosym/{p.relative_to(REPO / 'neurosym')}"
+        for p in [*(REPO / "neurosym").glob("*/pl/*.pl"), *(REPO / "neurosym").glob("play/strategies/*.pl")]
     }
     agents = {n for n in names if n.endswith(".pt")}
     assert agents == {f"neurosym/checkpoints/{p.name}" for p in (REPO / "checkpoints").glob("*.pt")}

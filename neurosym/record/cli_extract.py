@@ -95,13 +95,19 @@ def run(args: ExtractOptions) -> int:
     from neurosym.agent.agent import env_for, load_agent
     from neurosym.facts.thresholds import parse_threshold
     from neurosym.publish import check_out
-    from neurosym.record.extraction import check_extract_options, extract, write_outputs
+    from neurosym.record.extraction import (
+        check_extract_options,
+        check_top_keys,
+        extract,
+        write_outputs,
+    )
 
     formats = parse_formats(args.format)
     if args.threshold is not None:
         parse_threshold(args.threshold)  # a bad spec is refused before the agent is read
     check_extract_options(args.episodes, args.seed, args.batch, args.top_keys)
     agent = load_agent(args.checkpoint, play_env=args.env)
+    check_top_keys(agent, args.top_keys)
     env, overrides = env_choice(args, agent.env_name)
     env, env_kwargs = env_for(agent, env, overrides)
     # checked here, once, before anything is recorded: the default folder needs the env

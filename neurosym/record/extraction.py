@@ -58,6 +58,19 @@ def check_extract_options(
         raise ConfigError(f"--top-keys must be at least 1, got {top_keys}")
 
 
+def check_top_keys(agent: Any, top_keys: int | None) -> None:
+    """Refuse, in one line, ``top_keys`` for a module without attention/6 facts."""
+    from neurosym.agent.networks.adapters import adapter_class
+
+    adapter = adapter_class(agent.config.module)
+    if top_keys is not None and not adapter.has("attention"):
+        facts = " and ".join(_FACTS[name] for name in adapter.tables if name in _FACTS)
+        raise ConfigError(
+            f"--top-keys is for MHDPA checkpoints (attention/6 facts); {agent.path} is a "
+            f"{agent.config.module} (its facts are {facts})"
+        )
+
+
 def extract(
     agent: Any,
     env: str | None = None,
@@ -86,7 +99,6 @@ def extract(
     facts on the same states (:mod:`neurosym.record.faithfulness`; needs 2 episodes).
     """
     from neurosym.agent.agent import env_for, load_agent
-    from neurosym.agent.networks.adapters import adapter_class
     from neurosym.facts.tables import extract_facts
     from neurosym.facts.thresholds import parse_threshold
     from neurosym.record.recorder import record
@@ -96,13 +108,9 @@ def extract(
         parse_threshold(threshold)  # a bad spec is refused before anything is played
     if isinstance(agent, str | Path):
         agent = load_agent(agent)
-    adapter = adapter_class(agent.config.module)
-    if top_keys is not None and not adapter.has("attention"):
-        facts = " and ".join(_FACTS[name] for name in adapter.tables if name in _FACTS)
-        raise ConfigError(
-            f"--top-keys is for MHDPA checkpoints (attention/6 facts); {agent.path} is a "
-            f"{agent.config.module} (its facts are {facts})"
-        )
+    check_top_keys(agent, top_keys)
+    if threshold is None:
+        threshold = model_threshold(agent.config)
     env, env_kwargs = env_for(agent, env, env_kwargs)
     options = dict(
         env=env, episodes=episodes, seed=seed, greedy=greedy, batch=batch,
