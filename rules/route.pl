@@ -14,7 +14,10 @@
 
 Background knowledge for a Prolog agent, written by hand, not learned: the
 first action of a cheapest path from the agent to an object, in
-Relational-Grid-World and Box-World. A strategy (strategy.pl, goal(E, T,
+Relational-Grid-World and Box-World; in Minigrid and BabyAI (states with
+facing/3) the first action of a cheapest path over (cell, direction)
+states, turning as it goes, then the interaction with the object (the
+Minigrid section at the end). A strategy (strategy.pl, goal(E, T,
 Object), learned by `neurosym induce strategy` or written by hand) says which
 object the agent goes for next; route/4 says how to get there. `neurosym play`
 loads it beside the strategy. Load it beside a neurosym knowledge base or live
@@ -30,6 +33,8 @@ Reads the facts of docs/design.md for state T of episode E:
     holding(E, T, Item)        sword, or key(C)
     terrain(E, Type, Row, Col) wall, mountain (cells that hold no object)
     grid(E, Rows, Cols)        the map's size
+    facing(E, T, Dir)          Minigrid: the agent's direction (east, south, ...)
+    door_state(E, T, Id, S)    Minigrid: a door's state (open, closed, locked)
 
 A module whose helpers stay inside it, so it loads beside the other rule
 files and beside a strategy (whose own helpers may be called anything but the
@@ -93,7 +98,7 @@ forgets an episode.
 %   (routes, moves, adjacency), named after it when it loads.
 :- prolog_load_context(module, M),
    retractall(cache_key_(_, _)),
-   forall(member(Kind, [routes, moves, adjacency]),
+   forall(member(Kind, [routes, moves, adjacency, turns]),
           ( format(atom(Key), '$route ~w ~w', [M, Kind]),
             assertz(cache_key_(Kind, Key)) )).
 
@@ -146,7 +151,7 @@ route(E, T, Goal, Action, Cost) :-
 route_forget(E) :-
     retractall(grid_(E, _, _, _)),
     retractall(searched_(E, _, _, _, _)),
-    forall(( member(Kind, [routes, moves]),
+    forall(( member(Kind, [routes, moves, turns]),
              cache_key_(Kind, K),
              nb_current(K, V),
              compound(V), arg(1, V, E0), E0 == E ),
@@ -177,6 +182,10 @@ route_exists(E, T, Goal) :-
 %   into a cell inside the grid holding no wall and no object: a harmless move
 %   for when there is nowhere to go.
 
+safe_step(E, T, Action) :-
+    kb_facing_(E, T, _),
+    !,
+    mg_safe_step_(E, T, Action).
 safe_step(E, T, Action) :-
     at(E, T, agent, R, C),
     kb_grid_(E, Rows, Cols),
@@ -361,6 +370,10 @@ bfs_visit_([J|Js], D, Cells, Next0, Next) :-
 % --------------------------------------------------------------- routes
 
 %   search_route_(+E, +T, ?Goal, -Action, -Cost): route/5 without memory.
+search_route_(E, T, Goal, Action, Cost) :-
+    kb_facing_(E, T, _),
+    !,
+    mg_route_(E, T, Goal, Action, Cost).
 search_route_(E, T, Goal, Action, Cost) :-
     at(E, T, agent, R0, C0),
     at(E, T, Goal, GR, GC),
@@ -711,6 +724,9 @@ kb_object_(Id, Type) :- current_predicate(_, object(_, _)), object(Id, Type).
 kb_holding_(E, T, Item) :- current_predicate(_, holding(_, _, _)), holding(E, T, Item).
 kb_terrain_(E, Type, R, C) :- current_predicate(_, terrain(_, _, _, _)), terrain(E, Type, R, C).
 kb_grid_(E, Rows, Cols) :- current_predicate(_, grid(_, _, _)), grid(E, Rows, Cols).
+kb_facing_(E, T, Dir) :- current_predicate(_, facing(_, _, _)), facing(E, T, Dir), !.
+kb_door_state_(E, T, Id, S) :-
+    current_predicate(_, door_state(_, _, _, _)), door_state(E, T, Id, S).
 
 % --------------------------------------------------------------- default goal
 
@@ -727,6 +743,12 @@ kb_grid_(E, Rows, Cols) :- current_predicate(_, grid(_, _, _)), grid(E, Rows, Co
 %       ?- default_goal(0, 0, G).
 %       G = terminal.
 
+default_goal(E, T, Goal) :-
+    kb_facing_(E, T, _),
+    !,
+    mg_default_(E, T, Goal),
+    route_exists(E, T, Goal),
+    !.
 default_goal(E, T, Goal) :-
     default_(E, T, Goal),
     route_exists(E, T, Goal),
@@ -783,3 +805,185 @@ loose_(E, T, Key) :-
     at(E, T, Key, R, C),
     Right is C + 1,
     \+ ( at(E, T, X, R, Right), kb_object_(X, lock(_)) ).
+
+% --------------------------------------------------------------- Minigrid
+
+%   Minigrid and BabyAI (a state with facing/3): the agent has a direction
+%   and acts by turning (left, right) and stepping ahead (forward), so a
+%   route is a path over (cell, direction) states, each action costing one
+%   step, to a state next to the goal object and facing it, then the
+%   interaction: pickup for a key, ball or box; toggle for a closed or
+%   locked door (a locked one opens with the held key of its colour);
+%   forward for an open door and the goal. Cost: the path's actions plus
+%   the interaction. A path may not enter a wall, lava, or a cell of an
+%   object other than an open door (keys, balls, boxes and closed doors
+%   block; the goal ends the episode). Ties go to the first action in the
+%   order left, right, forward. One breadth-first search from the agent's
+%   (cell, direction) per state answers for every object
+%   (mg_search_/3, remembered for the state last asked).
+%
+%   Directions: facing/3's east, south, west, north (Minigrid's 0..3);
+%   ahead of the agent is its column + 1, row + 1, column - 1, row - 1.
+
+mg_dir_(east, 0).
+mg_dir_(south, 1).
+mg_dir_(west, 2).
+mg_dir_(north, 3).
+
+mg_ahead_(0, 0, 1).
+mg_ahead_(1, 1, 0).
+mg_ahead_(2, 0, -1).
+mg_ahead_(3, -1, 0).
+
+%   mg_route_(+E, +T, +Goal, -Action, -Cost)
+mg_route_(E, T, Goal, Action, Cost) :-
+    at(E, T, Goal, GR, GC),
+    Goal \== agent,
+    \+ at(E, T, agent, GR, GC),
+    mg_search_(E, T, search(Rows, Cols, Dist)),
+    findall(D-AI, ( mg_ahead_(Dir, DR, DC),
+                    R is GR - DR, C is GC - DC,
+                    inside_(R-C, Rows, Cols),
+                    I is (R * Cols + C) * 4 + Dir + 1,
+                    arg(I, Dist, V), nonvar(V), V = D-AI ),
+            Found),
+    msort(Found, [D-AI|_]),
+    (   D =:= 0
+    ->  mg_interaction_(E, T, Goal, Action)
+    ;   nth0(AI, [left, right, forward], Action)
+    ),
+    Cost is D + 1.
+
+%   mg_interaction_(+E, +T, +Goal, -Action): what the agent does facing Goal.
+mg_interaction_(E, T, Goal, Action) :-
+    (   kb_object_(Goal, Type), compound(Type)
+    ->  functor(Type, Kind, _)
+    ;   kb_object_(Goal, Kind)
+    ->  true
+    ;   Kind = Goal
+    ),
+    (   memberchk(Kind, [key, ball, box])
+    ->  Action = pickup
+    ;   Kind == door, \+ kb_door_state_(E, T, Goal, open)
+    ->  Action = toggle
+    ;   Action = forward
+    ).
+
+%   mg_search_(+E, +T, -Search): search(Rows, Cols, Dist), Dist a term with
+%   one argument per (cell, direction), (Row * Cols + Col) * 4 + Dir + 1,
+%   bound to Moves-FirstActionIndex (0 left, 1 right, 2 forward) for each
+%   state the agent reaches; remembered for the state last asked.
+mg_search_(E, T, Search) :-
+    cache_key_(turns, K),
+    (   nb_current(K, turns(E0, T0, S0)), E0 == E, T0 == T
+    ->  Search = S0
+    ;   mg_new_search_(E, T, Search),
+        nb_setval(K, turns(E, T, Search))
+    ).
+
+mg_new_search_(E, T, search(Rows, Cols, Dist)) :-
+    kb_grid_(E, Rows, Cols),
+    at(E, T, agent, R0, C0),
+    kb_facing_(E, T, Facing),
+    mg_dir_(Facing, Dir0),
+    !,
+    mg_free_(E, T, Rows, Cols, Free),
+    N is Rows * Cols * 4,
+    functor(Dist, dist, N),
+    Cell0 is R0 * Cols + C0,
+    S0 is Cell0 * 4 + Dir0 + 1,
+    nb_setarg(S0, Dist, 0-none),
+    mg_first_(Cell0, Dir0, Rows, Cols, Free, Dist, Frontier),
+    mg_bfs_(Frontier, 1, Rows, Cols, Free, Dist).
+
+%   mg_free_(+E, +T, +Rows, +Cols, -Free): a term with one argument per
+%   cell, bound (to x) for a cell a path may not enter.
+mg_free_(E, T, Rows, Cols, Free) :-
+    N is Rows * Cols,
+    functor(Free, free, N),
+    forall(( kb_terrain_(E, Type, R, C), Type \== floor, inside_(R-C, Rows, Cols) ),
+           ( I is R * Cols + C + 1, nb_setarg(I, Free, x) )),
+    forall(( at(E, T, Id, R, C), Id \== agent, inside_(R-C, Rows, Cols),
+             \+ kb_door_state_(E, T, Id, open) ),
+           ( I is R * Cols + C + 1, nb_setarg(I, Free, x) )).
+
+%   mg_next_(+Cell, +Dir, +AI, +Rows, +Cols, +Free, -Cell1, -Dir1): the
+%   state action AI (0 left, 1 right, 2 forward) leads to; fails for a
+%   forward into a closed cell or off the grid.
+mg_next_(Cell, Dir, 0, _, _, _, Cell, Dir1) :- Dir1 is (Dir + 3) mod 4.
+mg_next_(Cell, Dir, 1, _, _, _, Cell, Dir1) :- Dir1 is (Dir + 1) mod 4.
+mg_next_(Cell, Dir, 2, Rows, Cols, Free, Cell1, Dir) :-
+    mg_ahead_(Dir, DR, DC),
+    R is Cell // Cols + DR, C is Cell mod Cols + DC,
+    inside_(R-C, Rows, Cols),
+    Cell1 is R * Cols + C,
+    I is Cell1 + 1,
+    arg(I, Free, V),
+    var(V).
+
+%   mg_first_: the start's successors, each keeping its own action as the
+%   first action (Frontier: Cell-Dir-AI, in the order left, right, forward).
+mg_first_(Cell0, Dir0, Rows, Cols, Free, Dist, Frontier) :-
+    findall(Cell-Dir-AI,
+            ( member(AI, [0, 1, 2]),
+              mg_next_(Cell0, Dir0, AI, Rows, Cols, Free, Cell, Dir) ),
+            Steps),
+    mg_mark_(Steps, 1, Dist, Frontier).
+
+mg_mark_([], _, _, []).
+mg_mark_([Cell-Dir-AI|Steps], D, Dist, Frontier) :-
+    I is Cell * 4 + Dir + 1,
+    arg(I, Dist, V),
+    (   var(V)
+    ->  nb_setarg(I, Dist, D-AI),
+        Frontier = [Cell-Dir-AI|Frontier1]
+    ;   Frontier = Frontier1
+    ),
+    mg_mark_(Steps, D, Dist, Frontier1).
+
+%   mg_bfs_(+Frontier, +D, ...): Frontier's states are D actions away;
+%   mark their unmarked successors D + 1 with the first action of the
+%   state they extend, in queue order.
+mg_bfs_([], _, _, _, _, _) :- !.
+mg_bfs_(Frontier, D, Rows, Cols, Free, Dist) :-
+    D1 is D + 1,
+    findall(Cell1-Dir1-AI,
+            ( member(Cell-Dir-AI, Frontier),
+              member(A, [0, 1, 2]),
+              mg_next_(Cell, Dir, A, Rows, Cols, Free, Cell1, Dir1) ),
+            Steps),
+    mg_mark_(Steps, D1, Dist, Next),
+    mg_bfs_(Next, D1, Rows, Cols, Free, Dist).
+
+%   mg_safe_step_(+E, +T, -Action): forward into a free cell ahead, else a
+%   left turn (a harmless action for when there is nowhere to go).
+mg_safe_step_(E, T, Action) :-
+    (   kb_grid_(E, Rows, Cols),
+        at(E, T, agent, R, C),
+        kb_facing_(E, T, Facing),
+        mg_dir_(Facing, Dir),
+        mg_free_(E, T, Rows, Cols, Free),
+        Cell is R * Cols + C,
+        mg_next_(Cell, Dir, 2, Rows, Cols, Free, _, _)
+    ->  Action = forward
+    ;   Action = left
+    ).
+
+%   mg_default_(+E, +T, -Goal): Minigrid's default strategy: the key of a
+%   locked door's colour while not held, then a door that is not open
+%   (locked: with its key held), then the goal.
+mg_default_(E, T, Key) :-
+    kb_object_(Door, door(C)),
+    kb_door_state_(E, T, Door, locked),
+    \+ kb_holding_(E, T, key(C)),
+    kb_object_(Key, key(C)),
+    at(E, T, Key, _, _).
+mg_default_(E, T, Door) :-
+    kb_object_(Door, door(C)),
+    kb_door_state_(E, T, Door, State),
+    (   State == closed
+    ->  true
+    ;   State == locked, kb_holding_(E, T, key(C))
+    ).
+mg_default_(E, T, goal) :-
+    at(E, T, goal, _, _).

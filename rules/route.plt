@@ -168,4 +168,45 @@ test(exports_only, Visible == [default_goal/3, route/4, route/5, route_distance/
                    functor(H, N, A) ), Visible0),
     sort(Visible0, Visible).
 
+% Minigrid (episode 10): a route over (cell, direction) states. Facing north,
+% one right turn and one step forward face the key: then pickup (cost 3).
+test(minigrid_turn_then_forward, A-C == right-3) :-
+    route(10, 0, key_yellow, A, C).
+
+test(minigrid_pickup_facing_a_key, A-C == pickup-1) :-
+    route(10, 1, key_yellow, A, C).
+
+% The wall and the key close the short ways: down the left column (two
+% turns, the tie going to left), along the bottom row, a left turn to face
+% the door from below, then toggle: 8 actions and the toggle.
+test(minigrid_around_to_the_door, A-C == left-9) :-
+    route(10, 0, door_yellow, A, C).
+
+test(minigrid_toggle_facing_a_locked_door, A-C == toggle-1) :-
+    route(10, 2, door_yellow, A, C).
+
+test(minigrid_forward_into_an_open_door, A-C == forward-1) :-
+    route(10, 3, door_yellow, A, C).
+
+test(minigrid_turn_to_the_goal, A-C == right-2) :-
+    route(10, 3, goal, A, C).
+
+% The locked door blocks: the only way to the goal is round the left and
+% bottom (the agent at (0,0) facing north).
+test(minigrid_goal_around, A-C == left-8) :-
+    route(10, 0, goal, A, C).
+
+% Ahead is off the grid: a left turn, never a move of RGW's.
+test(minigrid_safe_step, A == left) :-
+    safe_step(10, 0, A).
+
+test(minigrid_default_goal_key, G == key_yellow) :-
+    default_goal(10, 0, G).
+
+test(minigrid_default_goal_door_with_its_key, G == door_yellow) :-
+    default_goal(10, 2, G).
+
+test(minigrid_default_goal_goal_once_open, G == goal) :-
+    default_goal(10, 3, G).
+
 :- end_tests(route).

@@ -5,13 +5,16 @@ in that state (``at/5`` facts other than the agent's), in the standard order
 of their ids (the order the learned file's ``strategy_candidate/3`` gives).
 Its *label* (the next object) is the object of the first contact at T' >= T:
 the object in the cell that the action at T' moves into, on a step whose
-events include a contact (:data:`CONTACTS`). States after the last contact
+events include a contact (:data:`CONTACTS`); in Minigrid (states with
+``facing/3``) the object ahead of the agent on a forward, pickup or toggle
+whose events include one of :data:`AHEAD_CONTACTS` (``picked(key(C))``,
+``unlocked(door(C))``, ``opened(door(C))``, ``reached(goal)``). States after the last contact
 have no label and are left out.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +45,17 @@ CONTACTS = frozenset(
 
 MOVES = {"up": (-1, 0), "right": (0, 1), "down": (1, 0), "left": (0, -1)}
 """Action -> (row, col) offset of the cell it moves into."""
+
+# Minigrid and BabyAI (states with facing/3): the agent acts on the cell ahead of it
+AHEAD_CONTACTS = frozenset({"picked", "unlocked", "opened", "reached"})
+"""Minigrid: event functors that are a contact with the object ahead (``picked(key(C))``,
+``unlocked(door(C))``, ``opened(door(C))`` or ``opened(box(C))``, ``reached(goal)``)"""
+
+AHEAD_ACTIONS = frozenset({"forward", "pickup", "toggle"})
+"""Minigrid: the actions that act on the cell ahead (forward moves into it)"""
+
+AHEAD = {"east": (0, 1), "south": (1, 0), "west": (0, -1), "north": (-1, 0)}
+"""Minigrid: facing/3's direction -> (row, col) offset of the cell ahead"""
 
 _KIND = "( compound({x}) -> functor({x}, Kind, _) ; Kind = {x} )"
 """binds Kind to the kind of a type or item, as the learned file's object_kind/2 derives it"""
@@ -89,6 +103,8 @@ TABLES: dict[str, str] = dict(
             "terrain", "term_to_atom(Ty0, Ty)", old=True, episode="E", type="Ty0", row="R", col="C"
         ),
         _table("grid", old=True, episode="E", rows="Rows", cols="Cols"),
+        _table("facing", old=True, episode="E", t="T", direction="Dir"),
+        _table("door_state", old=True, episode="E", t="T", id="O", state="S"),
     )
 )
 """The goal that reads each table, compound terms as their Prolog text: types, items and
@@ -112,6 +128,12 @@ class Trace:
     terrain: pd.DataFrame
     grid: pd.DataFrame
     meta: dict[str, str]
+    facing: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["E", "T", "Dir"]))
+    """Minigrid: the agent's direction per state (none for the other families)"""
+    door_state: pd.DataFrame = field(
+        default_factory=lambda: pd.DataFrame(columns=["E", "T", "O", "S"])
+    )
+    """Minigrid: each door's state (open, closed, locked) per state"""
 
     def episodes(self) -> list[int]:
         """The episode ids that have states, sorted."""
@@ -239,10 +261,13 @@ def check_count(trace: Trace, key: str, present: int, facts: str) -> None:
         )
 
 
-def _contact(events: list[str], target: str | None, types: dict[str, str]) -> bool:
-    """Whether a step with these events is a contact with ``target`` (the object moved into)."""
+def _contact(events: list[str], target: str | None, types: dict[str, str], ahead: bool = False) -> bool:
+    """Whether a step with these events is a contact with ``target`` (the object moved into; with
+    ``ahead``, Minigrid's object ahead of the agent)."""
     if target is None:
         return False
+    if ahead:
+        return any(ev.partition("(")[0] in AHEAD_CONTACTS for ev in events)
     kind = types.get(target, "")
     for ev in events:
         if ev in CONTACTS:
@@ -262,14 +287,18 @@ def labels(trace: Trace) -> pd.DataFrame:
     events: dict[tuple[int, int], list[str]] = {}
     for e, t, ev in trace.event.itertuples(index=False):
         events.setdefault((e, t), []).append(ev)
+    facing = {(e, t): d for e, t, d in trace.facing.itertuples(index=False)}
     contacts: dict[int, list[tuple[int, str]]] = {}
     for e, t, a in trace.step.sort_values(["E", "T"]).itertuples(index=False):
-        if (e, t) not in events or (e, t) not in agent or a not in MOVES:
+        if (e, t) not in events or (e, t) not in agent:
+            continue
+        ahead = (e, t) in facing
+        offset = (AHEAD.get(facing[(e, t)]) if a in AHEAD_ACTIONS else None) if ahead else MOVES.get(a)
+        if offset is None:
             continue
         r, c = agent[(e, t)]
-        dr, dc = MOVES[a]
-        target = cells.get((e, t, r + dr, c + dc))
-        if _contact(events[(e, t)], target, types):
+        target = cells.get((e, t, r + offset[0], c + offset[1]))
+        if _contact(events[(e, t)], target, types, ahead):
             contacts.setdefault(e, []).append((t, target))
     rows = []
     states = trace.at[["E", "T"]].drop_duplicates().sort_values(["E", "T"])

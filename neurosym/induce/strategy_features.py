@@ -14,9 +14,11 @@ Feature sets:
 
 * ``world``: the object's kind, the agent's distance to it (Manhattan), whether
   it is the nearest of its kind or of all, what the agent holds, which kinds
-  are on the map, and Box-World's key/lock facts (the lock of the held key, a
+  are on the map, Box-World's key/lock facts (the lock of the held key, a
   loose key that has a lock, a box holding the gem or a key that opens another
-  lock). Read from ``at/5``, ``holding/3``, ``object/2``.
+  lock) and Minigrid's doors (open, locked, the door of the held key, the key
+  of a locked door). Read from ``at/5``, ``holding/3``, ``object/2``,
+  ``door_state/4``.
 * ``relations``: PrediNet, whether head H's argument A attends the object's
   cell (``attends/8``, the cell mapped to the object through ``at/5``) and
   whether relation J holds with the object's entity as first or second
@@ -178,8 +180,11 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
     add("nearest_object", goal_term("nearest_object", E_, T_, O_), lambda e, t, o, r, c: nearest(e, t, o, r, c, False))
     if not trace.grid.empty:
         _routes(trace, pairs, types, kinds, add)
-    if any(_kind(types[o]) in ("key", "lock") for o in pairs["O"].unique()):
+    minigrid = not trace.facing.empty
+    if not minigrid and any(_kind(types[o]) in ("key", "lock") for o in pairs["O"].unique()):
         _box_world(add, types, holding, at_cell, locks, content)
+    if minigrid and any(_kind(types[o]) == "door" for o in pairs["O"].unique()):
+        _minigrid(trace, add, types, holding, by_state)
     return feats, np.array([cols[f.name] for f in feats], dtype=float).T
 
 
@@ -256,7 +261,7 @@ def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: lis
 
 
 def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: ignore[no-untyped-def]
-    """Box-World's key and lock features (only where the KB has keys or locks)."""
+    """Box-World's key and lock features (only where the KB has keys or locks, and no facing/3)."""
     add(
         "lock_of_held_key",
         goal_term("lock_of_held_key", E_, T_, O_),
@@ -285,6 +290,38 @@ def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: i
     add("loose", goal_term("loose", E_, T_, O_), loose)
     add("box_holds_gem", goal_term("box_holds_gem", E_, T_, O_), gem_box)
     add("box_holds_useful_key", goal_term("box_holds_useful_key", E_, T_, O_), useful_box)
+
+
+def _minigrid(trace: Trace, add, types, holding, by_state) -> None:  # type: ignore[no-untyped-def]
+    """Minigrid's door features (where the KB has facing/3 and doors): a door's state (door_state/4),
+    the door of the held key's colour, the key of a locked door on the map."""
+    doors = {(e, t, o): s for e, t, o, s in trace.door_state.itertuples(index=False)}
+
+    def door_is(state: str) -> Callable[..., float]:
+        return lambda e, t, o, r, c: float(
+            _kind(types[o]) == "door" and doors.get((e, t, o)) == state
+        )
+
+    add("door_open", goal_term("door_open", E_, T_, O_), door_is("open"))
+    add("door_locked", goal_term("door_locked", E_, T_, O_), door_is("locked"))
+    add(
+        "door_of_held_key",
+        goal_term("door_of_held_key", E_, T_, O_),
+        lambda e, t, o, r, c: float(
+            _kind(types[o]) == "door" and (e, t, f"key({_colour(types[o])})") in holding
+        ),
+    )
+    add(
+        "key_of_locked_door",
+        goal_term("key_of_locked_door", E_, T_, O_),
+        lambda e, t, o, r, c: float(
+            _kind(types[o]) == "key"
+            and any(
+                types[o2] == f"door({_colour(types[o])})" and doors.get((e, t, o2)) == "locked"
+                for o2, _, _ in by_state[(e, t)]
+            )
+        ),
+    )
 
 
 def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:

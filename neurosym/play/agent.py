@@ -7,6 +7,11 @@ object to go for and ``route(E, T, Object, Action)`` (rules/route.pl, loaded
 as code beside the strategy) the action. The Prolog side is
 :mod:`neurosym.play.prolog`: one call per sub-env and step.
 
+On Minigrid and BabyAI the state also has ``facing/3`` and ``door_state/4``
+(:func:`neurosym.play.live.minigrid_rows`, as the recorder writes them), route/4
+answers Minigrid's actions (left, right, forward, pickup, toggle: the env's
+``action_names``), and a state is its positions, held items, direction and doors.
+
 The strategy leaves a state undecided when goal/3 has no answer
 (``no_goal``), when route/4 finds no path to its object (``no_route``: the
 route planner refuses it), or when the episode has been in this very state
@@ -16,8 +21,9 @@ What happens then is the agent's ``fallback``:
 
 * ``default`` (the default): route.pl's ``default_goal/3`` (a hand-written
   strategy: RGW the sword, then enemies, then the terminal; Box-World the
-  held key's lock, else a loose key) decides, else ``safe_step/3`` (the first
-  move into a free cell), else ``up``;
+  held key's lock, else a loose key; Minigrid the key of a locked door, the
+  door, the goal) decides, else ``safe_step/3`` (the first move into a free
+  cell; Minigrid: forward into a free cell, else left), else ``up``;
 * ``none``: nothing decides for the strategy, and the episode ends there as
   a failure. The env is stepped once more (a batched env steps every
   sub-env), but nothing of that step counts: its reward is 0, it has no
@@ -59,8 +65,6 @@ INFERENCE_LIMIT = 10_000_000
 
 SCHEMA = tuple(group(TRACE))
 """every predicate of the KB schema (:mod:`neurosym.facts.schema`), declared dynamic in the agent's module"""
-
-_ACTION_INDEX = {name: i for i, name in enumerate(ACTION_NAMES)}
 
 FALLBACKS = ("default", "none")
 """what decides a state the strategy leaves undecided: route.pl's default_goal/3, safe_step/3
@@ -192,15 +196,16 @@ class PrologAgent:
 
     def _item(self, venv: _Watched, i: int, extra: list[Any]) -> list[Any]:
         """decide_all/5's item for sub-env i: [E, T, State, Prev, Extra, Seen]."""
-        ats, held = venv.state[i]
-        key = (tuple(ats), tuple(held))
+        ats, held, minigrid = venv.state[i]
+        key = (tuple(ats), tuple(held), minigrid and (minigrid[0], tuple(minigrid[1])))
         seen = key in venv.visited[i]
         venv.visited[i].add(key)
         prev, venv.prev[i] = venv.prev[i], []
+        state = [[list(a) for a in ats], [live.encode(h) for h in held]]
+        if minigrid is not None:
+            state += [minigrid[0], [list(d) for d in minigrid[1]]]
         return [
-            int(venv.episode[i]), int(venv.t[i]),
-            [[list(a) for a in ats], [live.encode(h) for h in held]],
-            prev, extra, "true" if seen else "false",
+            int(venv.episode[i]), int(venv.t[i]), state, prev, extra, "true" if seen else "false",
         ]  # fmt: skip
 
     def _taken(self, venv: _Watched, i: int, e: int, t: int, out: Any) -> int:
@@ -216,17 +221,17 @@ class PrologAgent:
             venv.ended[i] = str(why)
             self.last = (decider, str(goal), "none")
             return 0
-        if action not in _ACTION_INDEX:
+        if action not in venv.action_index:
             raise PrologError(
                 f"{self.policy.path}: route/4 answered {_shown(action)} for {_shown(goal)} in "
-                f"state {t} of episode {e}; an action is one of {', '.join(ACTION_NAMES)} "
+                f"state {t} of episode {e}; an action is one of {', '.join(venv.action_names)} "
                 "(a strategy may not redefine route.pl's predicates)"
             )
         self.last = (decider, str(goal), action)
         if decider == "strategy":
             self.chosen += 1
         self.goals[str(goal)] += 1
-        return _ACTION_INDEX[action]
+        return venv.action_index[action]
 
     def _query(self, goal: str, inputs: dict[str, Any]) -> Any:
         """One janus call of the agent's Prolog side; Ctrl-C stops it, a Prolog error is one line."""
@@ -340,6 +345,8 @@ class _Watched:
         n = venv.num_envs
         self.num_envs = n
         self.names = tuple(venv.entity_names)
+        self.action_names: tuple[str, ...] = tuple(getattr(venv, "action_names", ACTION_NAMES))
+        self.action_index = {name: i for i, name in enumerate(self.action_names)}
         self.episode = np.zeros(n, dtype=np.int64)
         self.t = np.zeros(n, dtype=np.int64)
         self.running = np.zeros(n, dtype=bool)
@@ -365,7 +372,7 @@ class _Watched:
             d = self.venv.decode_info(info, i)
             e = int(seed[i]) - self.first_seed
             self.episode[i], self.t[i], self.running[i] = e, 0, True
-            self.state[i] = live.state_rows(d)
+            self.state[i] = (*live.state_rows(d), live.minigrid_rows(d))
             self.prev[i] = []
             self.visited[i] = set()
             self.agent.begin(e, live.episode_facts(d, np.asarray(grids[i]), self.names))
@@ -385,9 +392,9 @@ class _Watched:
                 self.agent.end(int(self.episode[i]))
                 continue
             self.t[i] += 1
-            self.state[i] = live.state_rows(d)
+            self.state[i] = (*live.state_rows(d), live.minigrid_rows(d))
             self.prev[i] = [
-                ACTION_NAMES[int(actions[i])],
+                self.action_names[int(actions[i])],
                 float(reward[i]),
                 [live.encode(ev) for ev in d["events"]],
             ]

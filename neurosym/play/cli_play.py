@@ -75,7 +75,7 @@ class PlayOptions(EnvChoice, Episodes, Json):
     no_goal, no_route or loop"""
     compare: str | None = option(None, metavar="LIST")
     """also play the same levels with these strategies, comma-separated, and print one table:
-    trivial (RGW goal(_, _, terminal), Box-World the gem), handwritten (shipped for the env's
+    trivial (RGW goal(_, _, terminal), Box-World the gem, Minigrid the goal), handwritten (shipped for the env's
     family) or strategy files"""
     json: bool = False
     """print one JSON object"""
@@ -158,11 +158,16 @@ def compare_file(name: str, env: str) -> Path:
 
     if name not in SHIPPED:
         return Path(name)
-    family = "rgw" if env.startswith("rgw") else "boxworld" if env.startswith("bw") else None
+    from neurosym.envs.registration import env_family
+
+    try:
+        family = env_family(env)
+    except ConfigError:
+        family = None
     if family is None:
         raise ConfigError(
-            f"--compare {name}: neurosym ships {' and '.join(SHIPPED)} strategies for rgw* and "
-            f"bw* envs, not {env}; give a strategy file instead"
+            f"--compare {name}: neurosym ships {' and '.join(SHIPPED)} strategies for rgw*, bw* "
+            f"and Minigrid envs, not {env}; give a strategy file instead"
         )
     return Path(__file__).with_name("strategies") / f"{family}_{name}.pl"
 

@@ -7,7 +7,8 @@ writes for the state being played: for episode E and state T
   ``terrain(E, Type, Row, Col)`` for every non-empty cell of the entity grid
   that holds no object and is not the agent, ``grid(E, Rows, Cols)``;
 * per state: ``at(E, T, Id, Row, Col)`` for the agent and every object still
-  on the map, ``holding(E, T, Item)``;
+  on the map, ``holding(E, T, Item)``; Minigrid's ``facing(E, T, Dir)`` and
+  ``door_state(E, T, Id, State)`` (:func:`minigrid_rows`);
 * per step: ``step(E, T, Action, Reward)`` and ``event(E, T, Event)`` for
   the transition from T to T + 1.
 
@@ -89,3 +90,11 @@ def state_rows(info: dict[str, Any]) -> tuple[list[tuple[str, int, int]], list[s
     """at/5 rows (id, row, col), agent first, and holding/3 items of a decoded info."""
     ats = [(str(i), int(r), int(c)) for i, _, r, c in state_objects(info)]
     return ats, [str(h) for h in info["holding"]]
+
+
+def minigrid_rows(info: dict[str, Any]) -> tuple[str, list[tuple[str, str]]] | None:
+    """facing/3's direction and door_state/4's (id, state) rows of a decoded info; None for an
+    env without a direction (RGW, Box-World)."""
+    if "direction" not in info:
+        return None
+    return str(info["direction"]), [(str(i), str(s)) for i, s in info["doors"]]

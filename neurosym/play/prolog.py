@@ -9,7 +9,8 @@ and the strategy, as code):
 * ``begin_episode(M, E, Objects, Terrain, Grid)`` asserts ``object/2`` (once
   per id), ``terrain/4`` and ``grid/3`` of episode E;
 * ``decide(M, E, T, State, Prev, Extra, Limit, Seen, Fallback, Out)`` asserts
-  state T's ``at/5`` and ``holding/3``, the previous transition's ``step/4``
+  state T's ``at/5`` and ``holding/3`` (State ``[Ats, Held]``; on Minigrid
+  ``[Ats, Held, Dir, Doors]`` adds ``facing/3`` and ``door_state/4``), the previous transition's ``step/4``
   and ``event/3``, and Extra (the network's ``holds/5``, ``attends/8`` or
   ``attention/6`` facts of state T), then asks ``goal(E, T, G)`` (first
   answer) and ``route(E, T, G, A)``. Out is ``[Decider, Why, Goal, Action]``:

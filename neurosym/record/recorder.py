@@ -143,9 +143,10 @@ class _SymbolicColumns:
         self.keys.append((episode, t))
         self.objects.append(live.state_objects(info))
         self.held.append(tuple(info["holding"]))
-        if "direction" in info:  # Minigrid's agent direction and door states
-            self.facing.append((episode, t, str(info["direction"])))
-            self.doors.extend((episode, t, str(i), str(s)) for i, s in info["doors"])
+        minigrid = live.minigrid_rows(info)  # Minigrid's agent direction and door states
+        if minigrid is not None:
+            self.facing.append((episode, t, minigrid[0]))
+            self.doors.extend((episode, t, i, s) for i, s in minigrid[1])
 
     def transition(self, episode: int, t: int, info: dict[str, Any]) -> None:
         """Events of the step taken in state t."""

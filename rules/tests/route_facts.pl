@@ -20,10 +20,19 @@
       r2   A  .  W  X  .
     Episode 5 (RGW, 1 x 4): A S . T, the sword between the agent and the
     terminal.
+    Episode 10 (Minigrid, 3 x 4): the agent has a direction (facing/3);
+    a locked yellow door, its key, the goal.
+          c0 c1 c2 c3
+      r0   A  .  k  .       A agent (state 0 facing north), k key(yellow)
+      r1   .  W  D  .       W wall, D door(yellow) (locked; open in state 3)
+      r2   .  .  .  G       G goal
+    State 1: the agent at (0,1) facing east (the key ahead). State 2: at
+    (2,2) facing north (the door ahead), holding key(yellow). State 3: the
+    same, the door open.
 */
 
-:- dynamic object/2, at/5, holding/3, terrain/4, grid/3.
-:- discontiguous at/5, holding/3, terrain/4, grid/3.
+:- dynamic object/2, at/5, holding/3, terrain/4, grid/3, facing/3, door_state/4.
+:- discontiguous at/5, holding/3, terrain/4, grid/3, facing/3, door_state/4.
 
 object(sword, sword).
 object(enemy, enemy).
@@ -34,6 +43,9 @@ object(teleport_2, teleport).
 object(key_blue, key(blue)).
 object(lock_red, lock(red)).
 object(gem, gem).
+object(key_yellow, key(yellow)).
+object(door_yellow, door(yellow)).
+object(goal, goal).
 
 grid(0, 4, 5).
 grid(1, 4, 5).
@@ -85,3 +97,31 @@ grid_(0, 1, 1, cells(wall)).
 grid_(4, 1, 1, cells(wall)).
 cache_key_(routes, nowhere).
 cache_key_(moves, nowhere).
+
+% Episode 10: Minigrid, 3 x 4.
+grid(10, 3, 4).
+terrain(10, wall, 1, 1).
+at(10, 0, agent, 0, 0).
+at(10, 0, key_yellow, 0, 2).
+at(10, 0, door_yellow, 1, 2).
+at(10, 0, goal, 2, 3).
+facing(10, 0, north).
+door_state(10, 0, door_yellow, locked).
+at(10, 1, agent, 0, 1).
+at(10, 1, key_yellow, 0, 2).
+at(10, 1, door_yellow, 1, 2).
+at(10, 1, goal, 2, 3).
+facing(10, 1, east).
+door_state(10, 1, door_yellow, locked).
+at(10, 2, agent, 2, 2).
+at(10, 2, door_yellow, 1, 2).
+at(10, 2, goal, 2, 3).
+facing(10, 2, north).
+holding(10, 2, key(yellow)).
+door_state(10, 2, door_yellow, locked).
+at(10, 3, agent, 2, 2).
+at(10, 3, door_yellow, 1, 2).
+at(10, 3, goal, 2, 3).
+facing(10, 3, north).
+holding(10, 3, key(yellow)).
+door_state(10, 3, door_yellow, open).

@@ -3,8 +3,9 @@
     `neurosym induce strategy` copies the text below this comment,
     byte for byte, into every learned strategy file (then the text of
     strategy_route.pl): the world features (kinds, Manhattan distances,
-    Box-World's keys and locks) and the network's relation features. They
-    read at/5, holding/3, object/2, attends/8, holds/5 and attention/6.
+    Box-World's keys and locks, Minigrid's doors) and the network's relation
+    features. They read at/5, holding/3, object/2, door_state/4, attends/8,
+    holds/5 and attention/6.
 */
 
 %!  goal_candidate(?E, ?T, -O) is nondet.
@@ -83,6 +84,25 @@ box_holds_gem(E, T, O) :- box_content(E, T, O, X), object_kind(X, gem).
 box_holds_useful_key(E, T, O) :-
     box_content(E, T, O, X), object_kind(X, key), object_colour(X, C),
     once(( goal_candidate(E, T, L), L \== O, object(L, lock(C)) )).
+
+%!  door_open(+E, +T, +O) is semidet.
+%   Minigrid: O is a door that is open in state T (door_state/4).
+door_open(E, T, O) :- object_kind(O, door), door_state(E, T, O, open), !.
+
+%!  door_locked(+E, +T, +O) is semidet.
+%   Minigrid: O is a door that is locked in state T.
+door_locked(E, T, O) :- object_kind(O, door), door_state(E, T, O, locked), !.
+
+%!  door_of_held_key(+E, +T, +O) is semidet.
+%   Minigrid: O is a door of the colour of the key the agent holds.
+door_of_held_key(E, T, O) :-
+    object_kind(O, door), object_colour(O, C), holding(E, T, key(C)), !.
+
+%!  key_of_locked_door(+E, +T, +O) is semidet.
+%   Minigrid: O is a key and a locked door of its colour is on the map.
+key_of_locked_door(E, T, O) :-
+    object_kind(O, key), object_colour(O, C),
+    once(( goal_candidate(E, T, D), object(D, door(C)), door_state(E, T, D, locked) )).
 
 %!  attended_by(+E, +T, ?H, ?Arg, +O) is nondet.
 %   PrediNet: head H's argument Arg attends the cell of object O (the cell mapped through at/5).

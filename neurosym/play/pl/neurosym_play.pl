@@ -37,6 +37,8 @@ end_episode(M, E) :-
     retractall(M:event(E, _, _)),
     retractall(M:terrain(E, _, _, _)),
     retractall(M:grid(E, _, _)),
+    retractall(M:facing(E, _, _)),
+    retractall(M:door_state(E, _, _, _)),
     retractall(M:holds(E, _, _, _, _)),
     retractall(M:attends(E, _, _, _, _, _, _, _)),
     retractall(M:attention(E, _, _, _, _, _)).
@@ -45,9 +47,15 @@ extra_(holds, 5).
 extra_(attends, 8).
 extra_(attention, 6).
 
-assert_state_(M, E, T, [Ats, Held], Prev, Extra) :-
+assert_state_(M, E, T, [Ats, Held|Minigrid], Prev, Extra) :-
     forall(member([Id, R, C], Ats), assertz(M:at(E, T, Id, R, C))),
     forall(member(I0, Held), ( term_(I0, I), assertz(M:holding(E, T, I)) )),
+    (   Minigrid = [Dir, Doors]
+    ->  atom(Dir),
+        assertz(M:facing(E, T, Dir)),
+        forall(member([Id, S], Doors), ( atom(Id), atom(S), assertz(M:door_state(E, T, Id, S)) ))
+    ;   Minigrid == []
+    ),
     (   Prev = [Action, Reward, Events]
     ->  T0 is T - 1,
         assertz(M:step(E, T0, Action, Reward)),
@@ -68,7 +76,8 @@ decide_item_(M, Limit, Fallback, [E, T, State, Prev, Extra, Seen], Out) :-
     decide(M, E, T, State, Prev, Extra, Limit, Seen, Fallback, Out).
 
 %!  decide(+M, +E, +T, +State, +Prev, +Extra, +Limit, +Seen, +Fallback, -Out) is det.
-%   Assert state T's at/5 and holding/3, the previous transition's step/4 and event/3,
+%   Assert state T's at/5 and holding/3 (State [Ats, Held], or on Minigrid [Ats, Held,
+%   Dir, Doors]: facing/3 and door_state/4 too), the previous transition's step/4 and event/3,
 %   and Extra (the network's holds/5, attends/8 or attention/6 facts of state T), then
 %   ask goal(E, T, G) (first answer) and route(E, T, G, A). Out is
 %   [Decider, Why, Goal, Action]: [strategy, none, G, A] when both answer. Else Why is
