@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from neurosym.errors import ConfigError, FactError
-from neurosym.induce.strategy_data import Trace, candidates, labels, load_trace
+from neurosym.induce.strategy_data import KBTables, candidates, labels, load_trace
 from neurosym.induce.strategy_features import FEATURE_SETS, Feature, features
 from neurosym.induce.strategy_tree import DecisionList
 from neurosym.terms import parse_term
@@ -42,7 +42,7 @@ class Table:
     states: pd.DataFrame  # E, T, Goal
 
 
-def table(trace: Trace, which: str, names: list[Feature] | None = None) -> tuple[list[Feature], Table]:
+def table(trace: KBTables, which: str, names: list[Feature] | None = None) -> tuple[list[Feature], Table]:
     """The labelled states' pairs and features; with ``names``, columns aligned to them (absent: 0)."""
     states = labels(trace)
     pairs = candidates(trace).merge(states, on=["E", "T"], how="inner")
@@ -85,7 +85,7 @@ class Strategy:
     max_clauses: int = MAX_CLAUSES
     meta: dict[str, str] = field(default_factory=dict)
 
-    def predict(self, trace: Trace) -> pd.DataFrame:
+    def predict(self, trace: KBTables) -> pd.DataFrame:
         """The chosen object of every labelled state of ``trace``: columns E, T, Goal, Choice."""
         _, tab = table(trace, self.features, self.model.features)
         chosen = self.model.choose(tab.x, tab.state)
@@ -128,7 +128,7 @@ def _learn(
     return max(scored, key=lambda ms: (ms[1][0], -len(ms[0].clauses)))
 
 
-def family(trace: Trace) -> str:
+def family(trace: KBTables) -> str:
     """The env family of a trace (``rgw`` or ``boxworld``), as ``induce world`` tells it."""
     from neurosym.induce.examples import env_family
 
@@ -140,9 +140,9 @@ def family(trace: Trace) -> str:
     return env_family([str(t) for t in trace.object["Ty"]], str(name))
 
 
-def _split(trace: Trace, holdout: str | Path | Trace | None, share: float) -> tuple[Trace, Trace, str]:
+def _split(trace: KBTables, holdout: str | Path | KBTables | None, share: float) -> tuple[KBTables, KBTables, str]:
     if holdout is not None:
-        test = holdout if isinstance(holdout, Trace) else load_trace(holdout)
+        test = holdout if isinstance(holdout, KBTables) else load_trace(holdout)
         mine, theirs = family(trace), family(test)
         if theirs != mine:
             raise ConfigError(
@@ -165,10 +165,10 @@ def _split(trace: Trace, holdout: str | Path | Trace | None, share: float) -> tu
 
 
 def induce_strategy(
-    kb: str | Path | Trace,
+    kb: str | Path | KBTables,
     features: str = "world",
     *,
-    holdout: str | Path | Trace | None = None,
+    holdout: str | Path | KBTables | None = None,
     holdout_share: float = 0.3,
     max_clauses: int = MAX_CLAUSES,
     learner: str = "best",
@@ -186,7 +186,7 @@ def induce_strategy(
     if not 1 <= max_clauses <= MAX_CLAUSES:
         raise ConfigError(f"max_clauses must be 1 to {MAX_CLAUSES}, got {max_clauses}")
     start = time.perf_counter()
-    trace = kb if isinstance(kb, Trace) else load_trace(kb)
+    trace = kb if isinstance(kb, KBTables) else load_trace(kb)
     train, test, held = _split(trace, holdout, holdout_share)
     names, tab = table(train, features)
     if not len(tab.states) or not tab.y.any():

@@ -14,6 +14,7 @@ have no label and are left out.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -68,12 +69,27 @@ _FORMAT = "format(atom({x}), '~k', [{x}0])"
 """binds {x} to the canonical text of the term {x}0"""
 
 
+COLUMNS: dict[str, dict[str, str]] = {}
+"""Table -> {its schema column: the KBTables column it becomes}: filled by :func:`_table` from
+the same declarations as :data:`TABLES` (``Ty0`` read then formatted becomes ``Ty``; ``r(J)``
+becomes ``J``)."""
+
+
+def _trace_column(variable: str) -> str:
+    """The KBTables column a goal variable ends up in: ``Ty0`` -> ``Ty``, ``r(J)`` -> ``J``."""
+    inner = re.fullmatch(r"\w+\((\w+)\)", variable)
+    if inner:
+        return inner.group(1)
+    return variable[:-1] if variable.endswith("0") and len(variable) > 1 else variable
+
+
 def _table(name: str, *then: str, old: bool = False, **variables: str) -> tuple[str, str]:
     """``(name, goal)``: the schema's goal for ``name`` binding ``variables`` (by column), then ``then``.
 
     ``old``: KBs written before the predicate existed lack its declaration; a goal
     on it reads no rows there instead of raising.
     """
+    COLUMNS[name] = {column: _trace_column(v) for column, v in variables.items()}
     goal = SCHEMA[name].goal(**variables)
     if old:
         goal = f"catch({goal}, error(existence_error(_, _), _), fail)"
@@ -113,7 +129,7 @@ entities canonical (``write_canonical``: quoted, no operators), which
 
 
 @dataclass
-class Trace:
+class KBTables:
     """A KB's tables (DataFrames, columns named as the goals' variables in :data:`TABLES`)."""
 
     path: Path
@@ -139,7 +155,7 @@ class Trace:
         """The episode ids that have states, sorted."""
         return sorted(int(e) for e in self.at["E"].unique())
 
-    def subset(self, episodes: list[int]) -> Trace:
+    def subset(self, episodes: list[int]) -> KBTables:
         """The same tables restricted to ``episodes``."""
         keep = set(episodes)
         parts = {
@@ -147,7 +163,7 @@ class Trace:
             for name in TABLES
             if SCHEMA[name].columns[0] == "episode"
         }
-        return Trace(self.path, self.object, meta=self.meta, **parts)
+        return KBTables(self.path, self.object, meta=self.meta, **parts)
 
 
 def _columns(df: pd.DataFrame) -> pd.DataFrame:
@@ -155,7 +171,7 @@ def _columns(df: pd.DataFrame) -> pd.DataFrame:
     return df[[c for c in df.columns if not c.endswith("0")]]
 
 
-def load_trace(path: str | Path) -> Trace:
+def load_trace(path: str | Path) -> KBTables:
     """Read a KB file's trace and relation facts (as data: nothing in it runs)."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
 
@@ -172,7 +188,7 @@ def load_trace(path: str | Path) -> Trace:
                 KINDS[text] = format_value(kind)
         tables[name] = table.drop(columns="Kind")
     meta = dict(zip(tables["kb_meta"]["Key"], tables["kb_meta"]["V"], strict=True))
-    trace = Trace(path, meta=meta, **{k: v for k, v in tables.items() if k != "kb_meta"})
+    trace = KBTables(path, meta=meta, **{k: v for k, v in tables.items() if k != "kb_meta"})
     if trace.at.empty:
         raise ConfigError(f"{path} has no at/5 facts; pass a KB of recorded episodes (neurosym extract)")
     check_types(trace)
@@ -205,7 +221,7 @@ def _whole(value: object) -> bool:
     return isinstance(value, int | np.integer) and not isinstance(value, bool)
 
 
-def check_types(trace: Trace) -> None:
+def check_types(trace: KBTables) -> None:
     """Every object placed by at/5 has a type in object/2 (the features read it)."""
     untyped = sorted(set(trace.at["O"]) - set(trace.object["O"]), key=str)
     if untyped:
@@ -215,7 +231,7 @@ def check_types(trace: Trace) -> None:
         )
 
 
-def check_grids(trace: Trace) -> None:
+def check_grids(trace: KBTables) -> None:
     """Refuse a ``grid/3`` fact far larger than the cells the KB's ``at/5`` and ``terrain/4`` reach.
 
     Route features search every cell of the grid for every state, so the
@@ -239,7 +255,7 @@ def check_grids(trace: Trace) -> None:
             )
 
 
-def check_count(trace: Trace, key: str, present: int, facts: str) -> None:
+def check_count(trace: KBTables, key: str, present: int, facts: str) -> None:
     """Refuse a ``kb_meta(key, N)`` (heads, relations) that is no count or exceeds what the facts name.
 
     The count sizes the relation features (a column per head and argument),
@@ -279,7 +295,7 @@ def _contact(events: list[str], target: str | None, types: dict[str, str], ahead
     return False
 
 
-def labels(trace: Trace) -> pd.DataFrame:
+def labels(trace: KBTables) -> pd.DataFrame:
     """The next object of every labelled state: columns E, T, Goal, sorted by (E, T)."""
     types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
     cells = {(e, t, r, c): o for e, t, o, r, c in trace.at.itertuples(index=False) if o != "agent"}
@@ -309,7 +325,7 @@ def labels(trace: Trace) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["E", "T", "Goal"])
 
 
-def candidates(trace: Trace) -> pd.DataFrame:
+def candidates(trace: KBTables) -> pd.DataFrame:
     """Every (state, object on the map) pair but the agent: columns E, T, O, R, C, ordered by (E, T, O)."""
     pairs = trace.at[trace.at["O"] != "agent"]
     return pairs.sort_values(["E", "T", "O"], kind="stable").reset_index(drop=True)

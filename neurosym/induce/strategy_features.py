@@ -40,7 +40,7 @@ import pandas as pd
 from neurosym.agent.networks.adapters import module_has
 from neurosym.errors import ConfigError, FactError
 from neurosym.induce.prolog_text import pl_text
-from neurosym.induce.strategy_data import KINDS, Trace
+from neurosym.induce.strategy_data import KINDS, KBTables
 from neurosym.induce.strategy_route import UNREACHABLE, shortcuts, trace_routes
 from neurosym.terms import Term, TermArg, Var, atom_text, format_value, parse_term
 
@@ -100,7 +100,7 @@ def _kind(ty: str) -> str:
 
 
 def _kind_of(ty: str) -> str:
-    """The kind of a type's canonical text not read by :func:`load_trace` (a Trace built by hand)."""
+    """The kind of a type's canonical text not read by :func:`load_trace` (a KBTables built by hand)."""
     try:
         value = parse_term(ty)
     except FactError:
@@ -119,7 +119,7 @@ def _colour(ty: str) -> str | None:
     return ty[ty.index("(") + 1 : -1] if "(" in ty else None
 
 
-def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
+def world_features(trace: KBTables, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
     """The world feature columns of ``pairs`` (E, T, O, R, C rows) and their Prolog goals."""
     types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
     kinds = sorted({_kind(types[o]) for o in pairs["O"].unique()})
@@ -188,7 +188,7 @@ def world_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np
     return feats, np.array([cols[f.name] for f in feats], dtype=float).T
 
 
-def _routes(trace: Trace, pairs: pd.DataFrame, types: dict[str, str], kinds: list[str], add) -> None:  # type: ignore[no-untyped-def]
+def _routes(trace: KBTables, pairs: pd.DataFrame, types: dict[str, str], kinds: list[str], add) -> None:  # type: ignore[no-untyped-def]
     """Route features (:mod:`neurosym.induce.strategy_route`): reachable, route length, nearest reachable."""
     routes = trace_routes(trace)
     cuts: dict[tuple[int, int, str], set[str]] = {}
@@ -292,7 +292,7 @@ def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: i
     add("box_holds_useful_key", goal_term("box_holds_useful_key", E_, T_, O_), useful_box)
 
 
-def _minigrid(trace: Trace, add, types, holding, by_state) -> None:  # type: ignore[no-untyped-def]
+def _minigrid(trace: KBTables, add, types, holding, by_state) -> None:  # type: ignore[no-untyped-def]
     """Minigrid's door features (where the KB has facing/3 and doors): a door's state (door_state/4),
     the door of the held key's colour, the key of a locked door on the map."""
     doors = {(e, t, o): s for e, t, o, s in trace.door_state.itertuples(index=False)}
@@ -324,7 +324,7 @@ def _minigrid(trace: Trace, add, types, holding, by_state) -> None:  # type: ign
     )
 
 
-def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
+def relation_features(trace: KBTables, pairs: pd.DataFrame) -> tuple[list[Feature], np.ndarray]:
     """The network's relation columns: PrediNet attends/holds, MHDPA attention."""
     types = dict(zip(trace.object["O"], trace.object["Ty"], strict=True))
     heads = int(trace.meta.get("heads", 0))
@@ -362,7 +362,7 @@ def relation_features(trace: Trace, pairs: pd.DataFrame) -> tuple[list[Feature],
     return feats, matrix
 
 
-def features(trace: Trace, pairs: pd.DataFrame, which: str) -> tuple[list[Feature], np.ndarray]:
+def features(trace: KBTables, pairs: pd.DataFrame, which: str) -> tuple[list[Feature], np.ndarray]:
     """The columns of feature set ``which`` (``world``, ``relations`` or ``both``)."""
     parts = []
     if which in ("world", "both"):

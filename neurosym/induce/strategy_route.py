@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from importlib import resources
 
 from neurosym.induce.prolog_text import pl_text
-from neurosym.induce.strategy_data import Trace
+from neurosym.induce.strategy_data import KBTables
 
 UNREACHABLE = 999
 """The route length of an object no route reaches."""
@@ -44,7 +44,7 @@ class Routes:
         return self.direct.get((e, t, o), UNREACHABLE)
 
 
-def trace_routes(trace: Trace) -> Routes:
+def trace_routes(trace: KBTables) -> Routes:
     """Every state's route lengths, from rules/route.pl over the trace's facts (asserted in a KB of their own)."""
     from neurosym.prolog.knowledge_base import KnowledgeBase
 

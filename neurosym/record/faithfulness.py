@@ -166,34 +166,24 @@ def record_control(
 
 # ------------------------------------------------------------------ the tables the learners read
 
-_TRACE_COLUMNS: dict[str, dict[str, str]] = {
-    "object": {"id": "O", "type": "Ty"},
-    "at": {"episode": "E", "t": "T", "id": "O", "row": "R", "col": "C"},
-    "step": {"episode": "E", "t": "T", "action": "A"},
-    "event": {"episode": "E", "t": "T", "event": "Ev"},
-    "holding": {"episode": "E", "t": "T", "item": "I"},
-    "attends": {"episode": "E", "t": "T", "head": "H", "arg": "Arg", "row": "R", "col": "C"},
-    "holds": {"episode": "E", "t": "T", "j": "J", "a": "X", "b": "Y"},
-    "attention": {"episode": "E", "t": "T", "head": "H", "query": "Q", "key": "K"},
-    "terrain": {"episode": "E", "type": "Ty", "row": "R", "col": "C"},
-    "grid": {"episode": "E", "rows": "Rows", "cols": "Cols"},
-}
-"""fact table -> {column: the strategy trace's column} (the variables of strategy_data.TABLES)"""
+
 
 
 def trace_from_facts(facts: Any, relations: Any = None) -> Any:
-    """The strategy learner's :class:`~neurosym.induce.strategy_data.Trace` of a FactSet, in memory.
+    """The strategy learner's :class:`~neurosym.induce.strategy_data.KBTables` of a FactSet, in memory.
 
     What :func:`~neurosym.induce.strategy_data.load_trace` reads from the written
     KB, without writing and loading it. ``relations``: another FactSet of the same
-    states whose relation tables (attends, holds, attention) replace ``facts``'
-    (the untrained control's).
+    states (the untrained control's, whose world tables are the agent's: its recording is
+    checked to hold the same positions, steps and episodes) read instead of ``facts``.
     """
-    from neurosym.induce.strategy_data import Trace
+    from neurosym.induce.strategy_data import COLUMNS, KBTables
 
     tables = {}
-    for name, columns in _TRACE_COLUMNS.items():
-        source = relations if relations is not None and name in RELATION_TABLES else facts
+    for name, columns in COLUMNS.items():
+        if name == "kb_meta" or name not in facts.tables:
+            continue
+        source = facts if relations is None else relations  # the same world tables (checked)
         tables[name] = (
             source[name].loc[:, list(columns)].rename(columns=columns).reset_index(drop=True)
         )
@@ -201,11 +191,7 @@ def trace_from_facts(facts: Any, relations: Any = None) -> Any:
         k: format_value(v)  # as load_trace reads them: Prolog text ('rgw-random' quoted)
         for k, v in zip(facts["kb_meta"]["key"], facts["kb_meta"]["value"], strict=True)
     }
-    return Trace(Path("the extracted facts"), meta=meta, **tables)
-
-
-RELATION_TABLES = ("attends", "holds", "attention")
-"""the tables of a network's relation facts (what the control replaces)"""
+    return KBTables(Path("the extracted facts"), meta=meta, **tables)
 
 
 def split(episodes: list[int], share: float = HOLDOUT_SHARE) -> tuple[list[int], list[int]]:
