@@ -18,6 +18,7 @@ from neurosym.lazy import lazy_attributes
 _API = {
     "PrologAgent": "neurosym.play.agent",
     "score_strategy": "neurosym.play.evaluate",
+    "StrategyPlay": "neurosym.play.evaluate",
     "read_policy": "neurosym.play.policy",
     "Policy": "neurosym.play.policy",
     "episode_facts": "neurosym.play.live",

@@ -110,7 +110,7 @@ def run(args: PlayOptions) -> int:
     report = score_strategy(
         args.policy, env, args.episodes, args.seed, options, checkpoint=checkpoint, kb=args.kb,
         fallback=args.fallback,
-    )  # fmt: skip
+    ).as_dict()  # fmt: skip
     if names:
         report["compare"] = {
             name: score_strategy(
@@ -121,7 +121,7 @@ def run(args: PlayOptions) -> int:
                 report["env_kwargs"],
                 fallback=args.fallback,
                 refuse_undecided=False,
-            )  # fmt: skip
+            ).as_dict()  # fmt: skip
             for name in names
         }
     if args.json:

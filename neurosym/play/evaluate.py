@@ -12,13 +12,66 @@ from __future__ import annotations
 
 import os
 import time
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from neurosym.errors import ConfigError
 from neurosym.seeds import check_seed
 
+if TYPE_CHECKING:
+    from neurosym.agent.evaluation import Scores
+
 BATCH = 64
 """episodes played side by side (sub-envs of one batched env)"""
+
+
+@dataclass(frozen=True)
+class StrategyPlay:
+    """A strategy's :func:`score_strategy`: what was played, eval's :class:`Scores`, and who
+    decided the steps."""
+
+    policy: str
+    features: str
+    checkpoint: str | None
+    env: str
+    env_kwargs: dict[str, Any]
+    episodes: int
+    seed: int
+    scores: Scores
+    fallback: str
+    fallbacks: dict[str, int]
+    """undecided steps by cause: no_goal, no_route, loop"""
+    deciders: dict[str, int]
+    """steps by what decided them: strategy, default_goal, safe_step, up, none"""
+    goals: dict[str, int]
+    """steps per object chosen"""
+    steps: int
+    steps_per_s: float | None
+    """env steps per second of the whole loop: facts, Prolog, env"""
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain values: what ``neurosym play --json`` prints, in its order."""
+        decided = sum(self.deciders.values())
+        return {
+            "policy": self.policy,
+            "features": self.features,
+            "checkpoint": self.checkpoint,
+            "env": self.env,
+            "env_kwargs": self.env_kwargs,
+            "episodes": self.episodes,
+            "seed": self.seed,
+            **self.scores.as_dict(),
+            "fallback": self.fallback,
+            "fallbacks": dict(self.fallbacks),
+            "fallback_steps": int(sum(self.fallbacks.values())),
+            "deciders": dict(self.deciders),
+            "decider_shares": {
+                d: n / decided if decided else 0.0 for d, n in self.deciders.items()
+            },
+            "goals": dict(self.goals),
+            "steps": self.steps,
+            "steps_per_s": self.steps_per_s,
+        }
 
 
 def score_strategy(
@@ -32,8 +85,8 @@ def score_strategy(
     kb: str | os.PathLike[str] | None = None,
     fallback: str = "default",
     refuse_undecided: bool = True,
-) -> dict[str, Any]:
-    """Play ``episodes`` episodes of the strategy ``policy`` on ``env``; a dict of plain values.
+) -> StrategyPlay:
+    """Play ``episodes`` episodes of the strategy ``policy`` on ``env``.
 
     ``checkpoint``: the network whose relation facts the strategy reads
     (needed for ``features: relations`` or ``both``); its env is the default
@@ -44,14 +97,11 @@ def score_strategy(
     default_goal/3, safe_step/3, up; ``none``, nothing: the episode ends as a
     failure, its outcome the cause). ``refuse_undecided``: ConfigError when the strategy
     chose nothing in any step (:func:`check_decided`; off for the strategies a run is compared
-    with, whose failing everywhere is a figure). Keys: those of ``neurosym eval --json``
-    that do not describe a network (mean_return ... outcomes), plus
-    ``policy``, ``features``, ``fallback``, ``fallbacks`` (undecided steps by
-    cause: no_goal, no_route, loop), ``fallback_steps``, ``deciders`` (steps
-    by what decided them: strategy, default_goal, safe_step, up, none) and
-    ``decider_shares`` (the same as shares of all steps), ``goals`` (steps per
-    object chosen), ``steps`` and ``steps_per_s`` (env steps per second of the
-    whole loop: facts, Prolog, env).
+    with, whose failing everywhere is a figure). ``.as_dict()`` has the keys of ``neurosym
+    eval --json`` that do not describe a network (mean_return ... outcomes), plus ``policy``,
+    ``features``, ``fallback``, ``fallbacks``, ``fallback_steps``, ``deciders``,
+    ``decider_shares`` (the deciders as shares of all steps), ``goals``, ``steps`` and
+    ``steps_per_s``.
     """
     from neurosym.agent.evaluation import play_scored, scores_of
     from neurosym.envs import canonical_name
@@ -93,26 +143,22 @@ def score_strategy(
         if refuse_undecided:
             check_decided(agent, env)
         steps = int(sum(done.lengths))
-        return {
-            "policy": str(spec.path),
-            "features": spec.features,
-            "checkpoint": str(checkpoint) if checkpoint is not None else None,
-            "env": env,
-            "env_kwargs": kwargs,
-            "episodes": episodes,
-            "seed": seed,
-            **scores_of(done).as_dict(),
-            "fallback": fallback,
-            "fallbacks": dict(sorted(agent.fallbacks.items())),
-            "fallback_steps": int(sum(agent.fallbacks.values())),
-            "deciders": {d: agent.deciders[d] for d in DECIDERS},
-            "decider_shares": {
-                d: agent.deciders[d] / agent.decisions if agent.decisions else 0.0 for d in DECIDERS
-            },
-            "goals": dict(sorted(agent.goals.items())),
-            "steps": steps,
-            "steps_per_s": steps / seconds if seconds > 0 else None,
-        }
+        return StrategyPlay(
+            policy=str(spec.path),
+            features=spec.features,
+            checkpoint=str(checkpoint) if checkpoint is not None else None,
+            env=env,
+            env_kwargs=kwargs,
+            episodes=episodes,
+            seed=seed,
+            scores=scores_of(done),
+            fallback=fallback,
+            fallbacks=dict(sorted(agent.fallbacks.items())),
+            deciders={d: agent.deciders[d] for d in DECIDERS},
+            goals=dict(sorted(agent.goals.items())),
+            steps=steps,
+            steps_per_s=steps / seconds if seconds > 0 else None,
+        )
 
 
 MAX_RELATIONS = 1 << 16

@@ -59,6 +59,6 @@ def test_a_learned_minigrid_strategy_plays_its_level(neurosym_main, kb: Path, tm
     assert ran.returncode == 0, ran.stderr
     assert "% Scores: fidelity 1.0000 on 9 held-out states" in out.read_text()
     assert check_features_agree(kb, out, "world") >= 20  # the door features among them, in SWI
-    report = score_strategy(out, DOORKEY, 1, seed=1, fallback="none")
+    report = score_strategy(out, DOORKEY, 1, seed=1, fallback="none").as_dict()
     assert report["outcomes"] == {"goal": 1} and report["fallback_steps"] == 0
     assert report["mean_length"] == 7

@@ -23,7 +23,7 @@ def _policy(tmp_path: Path, text: str) -> Path:
 
 
 def test_the_report_has_evals_names_and_figures() -> None:
-    report = score_strategy(RGW, "rgw2", 2)
+    report = score_strategy(RGW, "rgw2", 2).as_dict()
     planner = score(Planner(), "rgw2", 2).as_dict()
     assert set(planner) <= set(report)
     assert report["mean_return"] == pytest.approx(10.7) and report["optimal_rate"] == 1.0
@@ -33,7 +33,7 @@ def test_the_report_has_evals_names_and_figures() -> None:
 
 def test_the_hand_written_strategy_is_optimal_where_the_planner_is() -> None:
     """rgw-random seed 1000: the planner earns every optimal return (tests/agent/test_evaluation.py)."""
-    report = score_strategy(RGW, "rgw-random", 12, seed=1000)
+    report = score_strategy(RGW, "rgw-random", 12, seed=1000).as_dict()
     assert report["success_rate"] == 1.0 and report["sword_first_guarded"] == 1.0
     assert report["optimal_rate"] >= 0.9
 
@@ -41,7 +41,7 @@ def test_the_hand_written_strategy_is_optimal_where_the_planner_is() -> None:
 def test_no_answer_of_goal_falls_back_to_the_default_goal(tmp_path: Path) -> None:
     """route.pl's default_goal/3 plays instead: the sword, the enemy, the terminal."""
     policy = _policy(tmp_path, "goal(_, 0, sword).\n")
-    report = score_strategy(policy, "rgw2", 1)
+    report = score_strategy(policy, "rgw2", 1).as_dict()
     assert report["fallbacks"] == {"no_goal": report["steps"] - 1}
     assert list(report["goals"]) == ["enemy", "sword", "terminal"]
     assert report["mean_return"] == pytest.approx(10.7) and report["outcomes"] == {"terminal": 1}
@@ -54,14 +54,14 @@ def test_a_state_seen_before_goes_to_the_default_goal(tmp_path: Path) -> None:
         tmp_path,
         "goal(E, T, O) :- at(E, T, agent, R, C), ( 0 is (R + C) mod 2 -> O = sword ; O = terminal ).\n",
     )
-    report = score_strategy(flip, "rgw-random", 1, seed=12)
+    report = score_strategy(flip, "rgw-random", 1, seed=12).as_dict()
     assert report["fallbacks"].get("loop", 0) > 0
     assert report["outcomes"] == {"terminal": 1}
 
 
 def test_a_goal_off_the_map_counts_as_no_route(tmp_path: Path) -> None:
     policy = _policy(tmp_path, "goal(_, T, unicorn) :- T > 0.\ngoal(_, 0, sword).\n")
-    report = score_strategy(policy, "rgw1", 1)
+    report = score_strategy(policy, "rgw1", 1).as_dict()
     assert report["fallbacks"] == {"no_route": report["steps"] - 1}
 
 
@@ -70,7 +70,7 @@ def test_fallback_none_ends_the_episode_where_the_strategy_has_no_answer(tmp_pat
     no_goal; that step counts in its length, with reward 0 and no events (rgw2: no sword taken
     on the way), and what decided each step is counted."""
     policy = _policy(tmp_path, "goal(_, 0, sword).\n")
-    report = score_strategy(policy, "rgw2", 2, fallback="none")
+    report = score_strategy(policy, "rgw2", 2, fallback="none").as_dict()
     assert report["outcomes"] == {"no_goal": 2} and report["success_rate"] == 0.0
     assert report["mean_length"] == 2 and report["mean_return"] == 0.0
     assert report["optimal_rate"] == 0.0 and report["sword_first_guarded"] == 0.0
@@ -83,7 +83,7 @@ def test_fallback_none_ends_the_episode_where_the_strategy_has_no_answer(tmp_pat
 
 def test_fallback_none_ends_the_episode_where_the_goal_routes_nowhere(tmp_path: Path) -> None:
     policy = _policy(tmp_path, "goal(_, T, unicorn) :- T > 0.\ngoal(_, 0, sword).\n")
-    report = score_strategy(policy, "rgw1", 1, fallback="none")
+    report = score_strategy(policy, "rgw1", 1, fallback="none").as_dict()
     assert report["outcomes"] == {"no_route": 1} and report["mean_length"] == 2
     assert report["deciders"]["none"] == 1 and report["fallbacks"] == {"no_route": 1}
 
@@ -91,7 +91,7 @@ def test_fallback_none_ends_the_episode_where_the_goal_routes_nowhere(tmp_path: 
 def test_deciders_with_the_default_fallback(tmp_path: Path) -> None:
     """The same strategy under the default fallback: default_goal/3 decides from state 1 on."""
     policy = _policy(tmp_path, "goal(_, 0, sword).\n")
-    report = score_strategy(policy, "rgw2", 1)
+    report = score_strategy(policy, "rgw2", 1).as_dict()
     steps = report["steps"]
     assert report["deciders"] == {
         "strategy": 1, "default_goal": steps - 1, "safe_step": 0, "up": 0, "none": 0,
@@ -298,5 +298,23 @@ def test_a_strategy_may_define_library_predicate_names(tmp_path: Path) -> None:
         "reachable(E, T, O) :- route_exists(E, T, O).\n"
         "goal(E, T, O) :- member(O, [sword, terminal]), reachable(E, T, O).\n",
     )
-    report = score_strategy(policy, "rgw2", 1)
+    report = score_strategy(policy, "rgw2", 1).as_dict()
     assert report["fallback_steps"] == 0 and report["outcomes"] == {"terminal": 1}
+
+
+def test_the_typed_result_is_what_play_json_prints(neurosym_main) -> None:
+    """score_strategy's StrategyPlay: eval's Scores, deciders that count every step, and
+    as_dict() is play --json's object but for the speed."""
+    import json
+
+    played = score_strategy(RGW, "rgw2", 1)
+    assert played.scores.success_rate == 1.0 and played.scores.levels is not None
+    assert sum(played.deciders.values()) == played.steps == 21
+    proc = neurosym_main("play", "--policy", RGW, "--env", "rgw2", "--episodes", "1", "--json")
+    assert proc.returncode == 0, proc.stderr
+    printed = json.loads(proc.stdout)
+    mine = played.as_dict()
+    assert list(mine) == list(printed)
+    assert {k: v for k, v in mine.items() if k != "steps_per_s"} == {
+        k: v for k, v in printed.items() if k != "steps_per_s"
+    }

@@ -56,7 +56,7 @@ def test_the_trivial_strategy_has_no_route_through_the_locked_door() -> None:
     trivial = compare_file("trivial", DOORKEY)
     assert trivial.name == "minigrid_trivial.pl"
     assert compare_file("handwritten", "BabyAI-GoToRedBall-v0").name == "minigrid_handwritten.pl"
-    report = score_strategy(trivial, DOORKEY, 1, seed=1)
+    report = score_strategy(trivial, DOORKEY, 1, seed=1).as_dict()
     assert report["outcomes"] == {"goal": 1} and report["fallbacks"] == {"no_route": 3}
     assert report["deciders"]["strategy"] == 4 and report["deciders"]["default_goal"] == 3
 
