@@ -12,7 +12,9 @@ The top-level names are imported lazily so that ``import neurosym`` (and the
 
 The commands' pipelines are library functions returning typed results:
 ``neurosym.extract(checkpoint, env, ...)`` -> Extraction (recording and fact tables),
-``neurosym.evaluate(agent, env, ...)`` -> Evaluation (``.as_dict()`` is ``eval --json``).
+``neurosym.evaluate(agent, env, ...)`` -> Evaluation (``.as_dict()`` is ``eval --json``),
+``neurosym.score_strategy(policy, env, ...)`` -> StrategyPlay (``play --json``),
+``neurosym.report_agent(agent, ...)`` / ``report_recording(folder)`` -> ReportPage.
 """
 
 from __future__ import annotations
@@ -35,6 +37,9 @@ _LAZY = {
     "evaluate": "neurosym.agent.evaluation",
     "Evaluation": "neurosym.agent.evaluation",
     "score_strategy": "neurosym.play.evaluate",
+    "StrategyPlay": "neurosym.play.evaluate",
+    "report_agent": "neurosym.reports.web.pages",
+    "report_recording": "neurosym.reports.web.pages",
     "KnowledgeBase": "neurosym.prolog.knowledge_base",
     "NeurosymError": "neurosym.errors",
     "PrologError": "neurosym.errors",

@@ -12,5 +12,6 @@ embedded in the page as JSON; the page needs no network and no server.
 * :mod:`neurosym.reports.web.card` -- the agent's card from the checkpoint;
 * :mod:`neurosym.reports.web.extras` -- probe and experiment folders;
 * :mod:`neurosym.reports.web.page` -- the Jinja2 template rendered and written atomically;
+* :mod:`neurosym.reports.web.pages` -- :func:`report_recording`, :func:`report_agent`: the pipeline;
 * :mod:`neurosym.reports.web.cli_report` -- the command.
 """

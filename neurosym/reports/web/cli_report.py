@@ -112,64 +112,29 @@ def run(args: ReportOptions) -> int:
 
 
 def _from_recording(args: ReportOptions, probes: Any, experiments: Any) -> Path:
-    from neurosym.reports.web.build import (
-        load_agent_or_note,
-        load_extract,
-        report_context,
-        stale_page,
-        write_beside,
-        write_report,
-    )
-    from neurosym.reports.web.card import agent_card
+    from neurosym.reports.web.pages import report_recording
 
-    extract = load_extract(Path(args.recording), args.threshold)
-    rec = extract.rec
-    agent, note = load_agent_or_note(rec.meta.get("checkpoint"), rec.meta)
-    card = agent_card(rec.meta, agent, note)
-    context = report_context(
-        rec, extract.facts, extract.kb_path, card, probes, experiments,
-        source=f"the recording in {extract.folder}", identity=extract.identity,
-    )  # fmt: skip
-    if args.out is None:
-        return write_beside(extract, context)
-    stale = stale_page(extract.folder, extract.identity)
-    if stale and not args.quiet:
+    page = report_recording(
+        args.recording, args.out, threshold=args.threshold, probes=probes, experiments=experiments
+    )
+    if page.stale and not args.quiet:
         print(
-            f"note: {stale}; `neurosym report --recording {extract.folder}` rebuilds it",
+            f"note: {page.stale}; `neurosym report --recording {page.folder}` rebuilds it",
             file=sys.stderr,
         )
-    return write_report(Path(args.out), context)
+    return page.path
 
 
 def _from_checkpoint(args: ReportOptions, probes: Any, experiments: Any) -> Path:
-    from neurosym.agent.agent import env_for, load_agent
-    from neurosym.publish import publish
-    from neurosym.record.extraction import extract
-    from neurosym.reports.web.build import identity, report_context
-    from neurosym.reports.web.card import agent_card
-    from neurosym.reports.web.page import render
+    from neurosym.agent.agent import load_agent
+    from neurosym.reports.web.pages import report_agent
 
     agent = load_agent(args.checkpoint, play_env=args.env)
     env, overrides = env_choice(args, agent.env_name)
-    env, env_kwargs = env_for(agent, env, overrides)
-    out = Path(args.out) if args.out else Path("kb_out") / env
-    check_out(out)
-    got = extract(
-        agent, env, env_kwargs, episodes=20 if args.episodes is None else args.episodes,
+    page = report_agent(
+        agent, env, overrides, args.out, episodes=20 if args.episodes is None else args.episodes,
         seed=args.seed or 0, greedy=args.greedy, batch=args.batch, top_keys=args.top_keys,
-        threshold=args.threshold,
+        threshold=args.threshold, probes=probes, experiments=experiments,
+        source=f"{args.checkpoint}",
     )  # fmt: skip
-    rec, facts = got.recording, got.facts
-    card = agent_card(rec.meta, agent)
-
-    def write(stage: Path) -> None:
-        facts.to_prolog(stage / "kb.pl")
-        rec.save(stage / "recording")
-        context = report_context(
-            rec, facts, stage / "kb.pl", card, probes, experiments, source=f"{args.checkpoint}",
-            identity=identity(stage / "recording", stage / "kb.pl"),
-        )  # fmt: skip
-        (stage / "index.html").write_text(render(context), encoding="utf-8")
-
-    written = publish(out, write, folders=("recording",), prefix=".report-")
-    return written["index.html"]
+    return page.path
