@@ -150,6 +150,7 @@ def read_out_inputs(model: ActorCritic, obs: torch.Tensor) -> torch.Tensor:
     return seen[0].view(obs.shape[0], model.config.heads, -1), logits
 
 
+@pytest.mark.expensive
 def test_extract_writes_holds_facts_that_are_the_bits_the_policy_read(
     tmp_path: Path, neurosym_main
 ) -> None:

@@ -15,6 +15,8 @@ from neurosym.induce import induce_world
 from neurosym.induce.background import FAMILIES
 from neurosym.record.recorder import record
 
+pytestmark = pytest.mark.expensive  # world rules searched over 30-100 recorded episodes
+
 CASES = {  # env -> (env options, episodes)
     # 30 random episodes of 100 steps on seed 0 unlock the door 7 times, close it twice and
     # reach the goal twice
