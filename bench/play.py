@@ -43,8 +43,8 @@ from neurosym.cli import parse_env_options  # noqa: E402
 from neurosym.play import PrologAgent  # noqa: E402
 
 EXAMPLES = [
-    (ROOT / "examples" / "play" / "rgw_strategy.pl", "rgw-random"),
-    (ROOT / "examples" / "play" / "boxworld_strategy.pl", "bw2"),
+    (ROOT / "neurosym" / "play" / "strategies" / "rgw_handwritten.pl", "rgw-random"),
+    (ROOT / "neurosym" / "play" / "strategies" / "boxworld_handwritten.pl", "bw2"),
 ]
 
 
@@ -77,7 +77,7 @@ def play_once(
 
 
 def bench_route(calls: int) -> None:
-    policy = ROOT / "examples" / "play" / "rgw_strategy.pl"
+    policy = ROOT / "neurosym" / "play" / "strategies" / "rgw_handwritten.pl"
     with PrologAgent(policy) as agent:
         venv = agent.make_venv("rgw-random", 1, 7)
         obs, _ = venv.reset(seed=[7])

@@ -121,7 +121,7 @@ def test_play_plays_a_map_file(capsys: pytest.CaptureFixture[str], tmp_path: Pat
     """--map, as eval, extract and report take it: rgw2 (by default) on the user's map."""
     layout = tmp_path / "map.txt"
     layout.write_text((REPO / "neurosym" / "envs" / "maps" / "rgw1.txt").read_text())
-    policy = str(REPO / "examples" / "play" / "rgw_strategy.pl")
+    policy = str(REPO / "neurosym" / "play" / "strategies" / "rgw_handwritten.pl")
     code = main(["play", "--policy", policy, "--map", str(layout), "--episodes", "1", "--json"])
     report = json.loads(capsys.readouterr().out)
     assert code == 0 and (report["env"], report["env_kwargs"]) == ("rgw2", {"map": str(layout)})

@@ -97,7 +97,7 @@ class PrologAgent:
     the envs :meth:`make_venv` makes, so that the agent sees their infos;
     close it (or use ``with``) when done.
 
-        >>> with PrologAgent("examples/play/rgw_strategy.pl") as agent:
+        >>> with PrologAgent("neurosym/play/strategies/rgw_handwritten.pl") as agent:
         ...     venv = agent.make_venv("rgw2", 1, seed=0)
         ...     obs, _ = venv.reset(seed=[0])
         ...     agent.act(obs, venv)

@@ -13,7 +13,7 @@ from neurosym.errors import ConfigError, PrologError
 from neurosym.play import PrologAgent, read_policy, score_strategy
 
 ROOT = Path(__file__).resolve().parents[2]
-RGW = ROOT / "examples" / "play" / "rgw_strategy.pl"
+RGW = ROOT / "neurosym" / "play" / "strategies" / "rgw_handwritten.pl"
 
 
 def _policy(tmp_path: Path, text: str) -> Path:

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-RGW = "examples/play/rgw_strategy.pl"
+RGW = "neurosym/play/strategies/rgw_handwritten.pl"
 
 
 @pytest.fixture(autouse=True)

@@ -14,7 +14,7 @@ from neurosym.play import PrologAgent, score_strategy
 from neurosym.play.cli_play import compare_file
 
 ROOT = Path(__file__).resolve().parents[2]
-HANDWRITTEN = ROOT / "examples" / "play" / "minigrid_strategy.pl"
+HANDWRITTEN = ROOT / "neurosym" / "play" / "strategies" / "minigrid_handwritten.pl"
 
 
 def _play(agent: PrologAgent, venv: Any, seed: int) -> tuple[list[tuple], str | None]:

@@ -114,6 +114,6 @@ def test_following_the_route_reaches_the_sword_and_nothing_else(
 
 
 def test_box_world_key_then_lock(tmp_path: Path) -> None:
-    report = score_strategy(ROOT / "examples" / "play" / "boxworld_strategy.pl", "bw3", 4, seed=5).as_dict()
+    report = score_strategy(ROOT / "neurosym" / "play" / "strategies" / "boxworld_handwritten.pl", "bw3", 4, seed=5).as_dict()
     assert report["success_rate"] == 1.0 and report["fallback_steps"] == 0
     assert report["mean_return"] == 12.0  # two boxes on the way (+1 each) and the gem (+10)

@@ -1,6 +1,7 @@
 /*  boxworld_handwritten.pl -- the hand-written Box-World strategy that
-    `neurosym play --compare handwritten` plays beside a strategy (not
-    learned; the learned ones come from `neurosym induce strategy`).
+    `neurosym play --policy` plays, and `--compare handwritten` beside a
+    strategy (not learned; the learned ones come from
+    `neurosym induce strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. A lock is worth opening when its box holds the
@@ -8,6 +9,7 @@
     lock right of it). Uses route.pl's route_exists/3, which `neurosym play`
     loads beside it.
 
+        neurosym play --policy neurosym/play/strategies/boxworld_handwritten.pl --env bw2
         neurosym play --policy strategy.pl --env bw2 --compare handwritten
 */
 %! features: world

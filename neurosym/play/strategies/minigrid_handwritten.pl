@@ -1,6 +1,6 @@
 /*  minigrid_handwritten.pl -- the hand-written Minigrid strategy (DoorKey and
-    the like) that `neurosym play --compare handwritten` plays beside a
-    strategy (not learned; the learned ones come from `neurosym induce
+    the like) that `neurosym play --policy` plays, and `--compare handwritten`
+    beside a strategy (not learned; the learned ones come from `neurosym induce
     strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
@@ -8,6 +8,7 @@
     loads beside it, turns the agent, walks it there and does the
     interaction (pickup a key, toggle a door, forward onto the goal).
 
+        neurosym play --policy neurosym/play/strategies/minigrid_handwritten.pl --env MiniGrid-DoorKey-8x8-v0
         neurosym play --policy strategy.pl --env MiniGrid-DoorKey-8x8-v0 --compare handwritten
 */
 %! features: world

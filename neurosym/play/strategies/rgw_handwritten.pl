@@ -1,11 +1,13 @@
 /*  rgw_handwritten.pl -- the hand-written Relational-Grid-World strategy
-    that `neurosym play --compare handwritten` plays beside a strategy (not
-    learned; the learned ones come from `neurosym induce strategy`).
+    that `neurosym play --policy` plays, and `--compare handwritten` beside a
+    strategy (not learned; the learned ones come from
+    `neurosym induce strategy`).
 
     goal(E, T, Object): the object to go for next in state T of episode E;
     the first answer counts. It uses route.pl's route_exists/3 and
     route_distance/4, which `neurosym play` loads beside it.
 
+        neurosym play --policy neurosym/play/strategies/rgw_handwritten.pl --env rgw-random
         neurosym play --policy strategy.pl --env rgw-random --compare handwritten
 */
 %! features: world
