@@ -420,13 +420,19 @@ def build_model(
     """The model of a validated payload with its weights loaded (strict).
 
     ``keys``: build it with that ModelConfig.keys instead (``--init-from`` switching an agent's
-    attention keys): W_K starts afresh, every other weight is the payload's."""
+    attention keys): W_K starts afresh, every other weight is the payload's; from cells to
+    cells_xy W_K keeps the cells' columns and the coordinates' start at zero (the same
+    attention)."""
     config = payload["model_config"]
     state = payload["state_dict"]
     if keys is not None and keys != config.keys:
+        old = config.keys
         config = replace(config, keys=keys)
         fresh = ActorCritic(config).state_dict()
         state = {**state, **{k: fresh[k] for k in RESTARTED_BY_KEYS}}
+        if (old, keys) == ("cells", "cells_xy"):
+            w = payload["state_dict"]["relational.key.weight"]
+            state["relational.key.weight"] = torch.cat([w, torch.zeros(len(w), 2, dtype=w.dtype)], 1)
     try:
         model = ActorCritic(config)
     except (RuntimeError, MemoryError) as exc:  # a config that passed _check_sizes, yet too large

@@ -55,7 +55,7 @@ OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
 QUERIES = ("scene", "learned")
-KEYS = ("entities", "cells")
+KEYS = ("entities", "cells", "cells_xy")
 
 
 @dataclass(frozen=True)
@@ -347,9 +347,12 @@ class ModelConfig:
     by what it holds, so its two arguments are what it chose to compare, even when the
     encoder's view is wider than the map. The entity it reads still sees the encoder's window.
     Cells that hold the same thing get the same weight (a head on several cells of a kind
-    reads their mean; the recorded argument is the first in row-major order).
-    ``--init-from`` may switch an agent to cells: W_K starts afresh, every other weight is
-    copied."""
+    reads their mean; the recorded argument is the first in row-major order) unless the keys
+    also read each cell's two coordinates (cells_xy: a head can then tell one teleport end
+    from the other).
+    ``--init-from`` may switch an agent's keys: W_K starts afresh (from cells to cells_xy it
+    keeps the cells' columns and the coordinates' start at zero: the same attention), every
+    other weight is copied."""
     relation_bits: float | None = field(default=None, metadata=bounded("[0, 1000]"))
     """PrediNet's fact bottleneck: None (off) or the threshold tau of every relation. On, the
     policy and value read only which relations hold between which attended cells, exactly as
@@ -495,6 +498,10 @@ class ImitationConfig:
     augment: bool = field(default=False, metadata=FLAG)
     """fit each minibatch turned by a random quarter turn or mirrored (RGW's rules and its
     planner are symmetric), so that the network does not memorise its labelled states"""
+    attend_coef: float = field(default=0.0, metadata=flag("[0, 100]", metavar="C"))
+    """weight of a loss that PrediNet head 0's second argument attends the next key object on
+    the planner's route (RGW; 0: none): with the fact bottleneck its KB then names the goal
+    its policy steers by (attends/8)"""
 
     def __post_init__(self) -> None:
         check_ranges(self)

@@ -226,7 +226,7 @@ def _candidates(
     # The terminal in a pocket: walls on every side but one, the door.
     free = ~wall
     terminal, ok = _pick(free & side_b, uniform(keys, 5, N))
-    target, border = rules._geometry(H, W)  # (4, N) each
+    target, border = rules.cell_geometry(H, W)  # (4, N) each
     nb = target[:, terminal].T  # (B, 4) neighbour cells
     open_nb = ~border[:, terminal].T & free[lvl[:, None], nb]
     door_k = np.argmin(np.where(open_nb, uniform(keys, 6, 4), 2.0), axis=1)

@@ -252,7 +252,7 @@ def compile_moves(
     cell is a teleport end (so bumping while standing on one teleports too).
     """
     S, N = cells.shape
-    target, border = _geometry(height, width)  # (4, N) each
+    target, border = cell_geometry(height, width)  # (4, N) each
     base = (np.arange(S, dtype=np.intp) * N)[:, None]  # flat offset of each level
     flat_cells = cells.reshape(-1)
     is_tele = (flat_cells == TELEPORT) | (flat_cells == TELEPORT_MOUNTAIN)
@@ -283,7 +283,7 @@ def compile_moves(
 _GEOMETRY: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
 
-def _geometry(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
+def cell_geometry(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
     """(4, N) clipped target cell of each action and (4, N) whether it hits the border."""
     key = (height, width)
     if key not in _GEOMETRY:

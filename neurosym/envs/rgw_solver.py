@@ -434,6 +434,12 @@ def solve_levels(
     return Solution(best, solvable)
 
 
+CONTACT_CELLS = frozenset(
+    {rules.SWORD, rules.ENEMY, rules.TERMINAL, rules.TELEPORT, rules.TELEPORT_MOUNTAIN, rules.PIT}
+)
+"""cell codes of the key objects a move contacts (a teleport standing on a mountain too)"""
+
+
 class Plan:
     """Every layer of the search for a batch of levels: optimal actions from any state.
 
@@ -452,6 +458,10 @@ class Plan:
         if not converged:
             raise ValueError("no finite optimal return: the search did not settle")
         self.cells_per_level = height * width
+        self.cells = cells
+        self.removable = rules.removable_bits(cells)
+        self.entered, _ = rules.cell_geometry(height, width)  # (4, N) the cell a move enters
+        self._contacts: dict[tuple[int, int, int, int], int] = {}
 
     def value(self, b: int, pos: int, removed: int, remaining: int) -> float:
         """Best return from that state with ``remaining`` steps left."""
@@ -491,6 +501,47 @@ class Plan:
         after = self.layers[min(left - 1, last)]  # V_{remaining - 1}, not the layer before last
         q = g.reward[:, s] + after.take(g.nxt[:, s])
         return (int(self.layers[min(left, last)][s]) - q).astype(np.float32) / 10.0
+
+    def next_contact(self, b: int, pos: int, removed: int, remaining: int) -> int:
+        """The cell of the first key object (:data:`CONTACT_CELLS`) that :meth:`action`'s route
+        from that state moves into, -1 when it meets none (the episode ends first).
+
+        The cell moved into, before a teleport end moves the agent on: the object the agent
+        contacts, as neurosym induce labels a state's next object. Every state the walk
+        passes shares its answer, so a whole route is walked once (cached).
+        """
+        key = (b, pos, removed, remaining)
+        found = self._contacts.get(key)
+        if found is not None:
+            return found
+        walked = [key]
+        cell = -1
+        N = self.cells_per_level
+        base = b * self.graph.states
+        while remaining > 0:
+            a = self.action(b, pos, removed, remaining)
+            enter = int(self.entered[a, pos])
+            if (
+                enter != pos
+                and self.cells[b, enter] in CONTACT_CELLS
+                and not int(self.removable[b, enter]) & removed
+            ):
+                cell = enter
+                break
+            s = int(self.graph.nxt[a, base + removed * N + pos]) - base
+            if s >= self.graph.states - 1:  # the sink: the episode is over
+                break
+            removed, pos = divmod(s, N)
+            remaining -= 1
+            key = (b, pos, removed, remaining)
+            known = self._contacts.get(key)
+            if known is not None:
+                cell = known
+                break
+            walked.append(key)
+        for k in walked:
+            self._contacts[k] = cell
+        return cell
 
     def _q(self, b: int, pos: int, removed: int, remaining: int) -> np.ndarray:
         """(4,) action values toward the best return, on the fewest-step plan that earns it."""
@@ -554,6 +605,13 @@ class Planner:
             np.stack(sets),
             np.asarray(values, dtype=np.float32),
             np.stack(regrets) if regret else None,
+        )
+
+    def next_contacts(self, venv: object) -> np.ndarray:
+        """(n,) int16 per sub-env the cell (row-major) of the first key object on the planner's
+        route from the current state (:meth:`Plan.next_contact`), -1 where it meets none."""
+        return np.array(
+            [plan.next_contact(0, *state) for plan, state in self._states(venv)], dtype=np.int16
         )
 
     def _states(self, venv: object) -> list[tuple[Plan, tuple[int, int, int]]]:

@@ -340,3 +340,28 @@ def test_switching_keys_keeps_every_weight_but_w_k() -> None:
             torch.testing.assert_close(new[name], weight, rtol=0, atol=0)
     same = build_model(payload, "source.pt", keys="entities")  # no switch: a plain load
     torch.testing.assert_close(same.relational.key.weight, source.relational.key.weight)
+
+
+def test_cells_xy_keys_tell_two_cells_of_one_kind_apart_and_start_as_cell_keys() -> None:
+    """ModelConfig.keys "cells_xy": W_K reads each cell's planes and its two coordinates, so a
+    head can weigh two teleport ends differently; switched from cell keys (build_model), the
+    coordinates' columns start at zero: the same attention and the same outputs."""
+    from neurosym.agent.checkpoint import build_model
+
+    torch.manual_seed(2)
+    source = make("predinet", keys="cells", conv_channels=(8, 8, 8), kernel_size=3)
+    payload = {"model_config": source.config, "state_dict": source.state_dict()}
+    switched = build_model(payload, "source.pt", keys="cells_xy")
+    assert switched.relational.key.weight.shape == (32, RGW[0][0] + 2)
+    obs = torch.zeros((2, *RGW[0]), dtype=torch.uint8)
+    obs[:, 1] = 1
+    obs[:, 1, 7, 7] = obs[:, 1, 5, 1] = obs[:, 1, 2, 3] = 0
+    obs[:, 0, 2, 3] = 1
+    obs[:, 4, 7, 7] = obs[:, 4, 5, 1] = 1  # two teleport ends
+    with torch.no_grad():
+        before, after = source(obs, introspect=True), switched(obs, introspect=True)
+        torch.testing.assert_close(after[0], before[0])
+        torch.testing.assert_close(after[2].attention2, before[2].attention2)
+        switched.relational.key.weight[:, -2:].normal_()  # now the coordinates count
+        a = switched(obs, introspect=True)[2].attention2[0].reshape(-1, 10, 10)
+    assert not torch.allclose(a[:, 7, 7], a[:, 5, 1])

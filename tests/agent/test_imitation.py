@@ -300,3 +300,120 @@ def test_augmented_safe_sets_turn_with_the_optimal_sets() -> None:
         o, s = moved.unbind(-1)
         assert (o.sum(1) == 1).all() and (s.sum(1) == safe.sum(1)).all()
         assert (s | ~o).all()  # the fastest action stays inside the safe set
+
+
+def test_next_contact_walks_the_route_object_by_object() -> None:
+    """Sword, enemy, the teleport end entered (not the one landed on), then the terminal."""
+    from neurosym.envs.rgw_maps import parse_map
+    from neurosym.envs.rgw_solver import Plan, Rules
+
+    level = parse_map("A.S.\nWWW.\nO..E\nWWWW\nT..O\n")
+    plan = Plan(level.cells, np.array([level.start]), level.height, level.width, Rules())
+    assert plan.next_contact(0, level.start, 0, 100) == 2  # the sword
+    assert plan.next_contact(0, 2, 0b01, 98) == 11  # holding it: the enemy
+    assert plan.next_contact(0, 11, 0b11, 94) == 8  # then the teleport end it walks into
+    assert plan.next_contact(0, 19, 0b11, 91) == 16  # landed on the other end: the terminal
+    assert plan.next_contact(0, 19, 0b11, 2) == -1  # too few steps left to reach anything
+
+
+def test_next_contacts_name_the_cell_of_every_contact_the_planner_makes() -> None:
+    from neurosym.envs import rgw_rules as rules
+
+    contact = (
+        rules.EV_TELEPORTED | rules.EV_PICKED | rules.EV_DEFEATED | rules.EV_HURT
+        | rules.EV_PIT | rules.EV_TERMINAL
+    )  # fmt: skip
+    venv = make_batched("rgw-random", 16, seed=8)
+    venv.reset(seed=8)
+    planner = Planner()
+    env = venv.unwrapped
+    entered, _ = rules.cell_geometry(env.height, env.width)
+    checked = 0
+    for _ in range(60):
+        targets = planner.next_contacts(venv)
+        assert targets.dtype == np.int16 and targets.shape == (16,)
+        pos = env.agent_states()[0].copy()
+        actions = planner(None, venv)
+        _, _, _, _, info = venv.step(actions)
+        for i in np.flatnonzero(info["events"] & contact):
+            assert targets[i] == entered[actions[i], pos[i]]
+            checked += 1
+    assert checked > 40
+
+
+def test_the_attention_target_moves_with_the_augmented_level() -> None:
+    from neurosym.agent.learners.imitation import augment_with_targets
+
+    obs = torch.zeros(64, 2, 5, 5, dtype=torch.uint8)
+    targets = torch.randint(-1, 25, (64,))
+    has = targets >= 0
+    obs[:, 1].view(64, -1)[has.nonzero()[:, 0], targets[has]] = 1  # mark them
+    assert int(obs.sum()) == int(has.sum())
+    sets = torch.zeros(64, 4, 2, dtype=torch.bool)
+    seen = set()
+    for seed in range(12):
+        g = torch.Generator().manual_seed(seed)
+        turned, _, moved = augment_with_targets(obs, sets, targets, g)
+        assert turned.shape == obs.shape and ((moved >= 0) == (targets >= 0)).all()
+        flat = turned[:, 1].reshape(64, -1)
+        assert (flat[has, moved[has]] == 1).all()  # the mark went where the target went
+        seen.add(tuple(moved.tolist()))
+    assert len(seen) > 2  # the levels were turned
+
+
+def test_attention_target_loss_is_the_mean_nll_of_the_rows_with_a_target() -> None:
+    from neurosym.agent.learners.imitation import attention_target_nll
+
+    a = torch.tensor([[0.5, 0.25, 0.25], [0.1, 0.1, 0.8], [1 / 3, 1 / 3, 1 / 3]])
+    got = attention_target_nll(a, torch.tensor([0, -1, 2]))
+    assert got.item() == pytest.approx((np.log(2) + np.log(3)) / 2)
+    assert attention_target_nll(a, torch.tensor([-1, -1, -1])).item() == 0.0
+
+
+@pytest.mark.expensive
+def test_attend_coef_teaches_head_0_to_attend_the_next_object() -> None:
+    """With the attention target, head 0's second argument moves onto the planner's next
+    object (cell keys with coordinates tell two teleport ends apart); without it, it does not."""
+    venv = make_batched("rgw-random", 32, seed=11)
+    obs, _ = venv.reset(seed=11)
+    planner = Planner()
+    buf = LabelBuffer(256, obs.shape[1:], obs.dtype)
+    rng = np.random.default_rng(0)
+    for _ in range(8):
+        sets, values = planner.action_sets(venv)
+        buf.add(obs, sets, values, targets=planner.next_contacts(venv))
+        obs, *_ = venv.step(rng.integers(0, 4, 32))
+    assert (buf.targets >= 0).mean() > 0.9
+    hits = {}
+    for coef in (0.0, 1.0):
+        torch.manual_seed(0)
+        cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs.shape[1:]), keys="cells_xy",
+                                     entity_norm=True, attention_gain=8.0)  # fmt: skip
+        model = ActorCritic(cfg)
+        train = TrainConfig.for_family("rgw", algo="imitate", dagger_batch=256, dagger_steps=10,
+                                       attend_coef=coef)  # fmt: skip
+        opt = torch.optim.Adam(model.parameters(), lr=2e-3)
+        step_rng = np.random.default_rng(0)
+        for _ in range(8):
+            imitation_update(model, opt, buf, train, step_rng, torch.device("cpu"))
+        with torch.no_grad():
+            _, _, intro = model(torch.from_numpy(buf.obs), introspect=True)
+        picked = intro.attention2[:, 0].argmax(-1).numpy()
+        has = buf.targets >= 0
+        hits[coef] = float((picked[has] == buf.targets[has]).mean())
+    assert hits[1.0] > 0.8 and hits[0.0] < 0.5, hits
+
+
+def test_attend_coef_needs_a_predinet_on_rgw(
+    train_refused: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
+    for env, module in (("rgw-random", "mhdpa"), ("MiniGrid-DoorKey-5x5-v0", "predinet")):
+        proc = train_refused("train", "--env", env, "--module", module, "--algo", "imitate",
+                             "--attend-coef", "1", "--out", tmp_path / env)  # fmt: skip
+        family = "rgw" if env == "rgw-random" else "minigrid"
+        assert proc.returncode != 0
+        lines = [line for line in proc.stderr.splitlines() if line.strip()]
+        assert lines == [
+            f"neurosym train: error: --attend-coef teaches PrediNet head 0 the RGW planner's "
+            f"next object; this run is {module} on {family} (leave it at 0)"
+        ]

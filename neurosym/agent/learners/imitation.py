@@ -21,6 +21,15 @@ miss its optimum, which the fastest-route loss weighs like any other. The
 critic is fitted to the planner's best return still to earn (times
 ``reward_scale``), so that a later RL run can start from it.
 
+With ``attend_coef`` C > 0 (RGW, PrediNet) the loss adds ``C * -log a(target)``:
+PrediNet head 0's second attention on the cell of the next key object on the
+planner's route (:meth:`Planner.next_contacts`). Under the fact bottleneck
+(``ModelConfig.relation_bits``) the policy sees only what the heads attend and
+the bits between them, so this names its current goal in its own facts
+(``attends/8`` of head 0, argument 2), as a concept-bottleneck model is taught
+its concepts; without the term the heads attend what serves the actions, which
+a reader of the KB cannot name.
+
 Started and reporting as every learner (:mod:`neurosym.agent.learners.process`);
 one process, no torchrun. The planners: RGW's (:mod:`neurosym.envs.rgw_solver`) and
 Minigrid DoorKey's (:mod:`neurosym.envs.minigrid_solver`); Box-World has none here.
@@ -60,6 +69,7 @@ class LabelBuffer:
         self.optimal = np.zeros((capacity, n_actions), dtype=bool)
         self.safe = np.ones((capacity, n_actions), dtype=bool)
         self.values = np.zeros(capacity, dtype=np.float32)
+        self.targets = np.full(capacity, -1, dtype=np.int16)  # next contact's cell, -1 none
         self.size = 0
         self._next = 0
 
@@ -69,27 +79,35 @@ class LabelBuffer:
         optimal: np.ndarray,
         values: np.ndarray,
         safe: np.ndarray | None = None,
+        targets: np.ndarray | None = None,
     ) -> None:
-        """Append states; ``safe`` (n, A) bool: actions that give no return up (default: all)."""
+        """Append states; ``safe`` (n, A) bool: actions that give no return up (default: all);
+        ``targets`` (n,) the cell of the next key object on the planner's route (default: -1)."""
         if safe is None:
             safe = np.ones_like(optimal)
+        if targets is None:
+            targets = np.full(len(obs), -1, dtype=np.int16)
         for start in range(0, len(obs), len(self.obs)):  # a batch larger than the ring wraps
-            o, m, v, s = (x[start : start + len(self.obs)] for x in (obs, optimal, values, safe))
+            o, m, v, s, g = (
+                x[start : start + len(self.obs)] for x in (obs, optimal, values, safe, targets)
+            )
             idx = (self._next + np.arange(len(o))) % len(self.obs)
             self.obs[idx], self.optimal[idx], self.values[idx], self.safe[idx] = o, m, v, s
+            self.targets[idx] = g
             self._next = int((self._next + len(o)) % len(self.obs))
             self.size = min(self.size + len(o), len(self.obs))
 
     def sample(
         self, n: int, rng: np.random.Generator
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``n`` states drawn uniformly: obs, optimal sets, values, safe sets."""
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``n`` states drawn uniformly: obs, optimal sets, values, safe sets, target cells."""
         idx = rng.integers(0, self.size, n)
         return (
             torch.from_numpy(self.obs[idx]),
             torch.from_numpy(self.optimal[idx]),
             torch.from_numpy(self.values[idx]),
             torch.from_numpy(self.safe[idx]),
+            torch.from_numpy(self.targets[idx].astype(np.int64)),
         )
 
 
@@ -110,6 +128,30 @@ def expert_share(frames: int, beta_frames: int) -> float:
     return max(0.0, 1.0 - frames / beta_frames)
 
 
+def attention_target_nll(attention: torch.Tensor, targets: torch.Tensor) -> torch.Tensor:
+    """Mean of ``-log attention[b, targets[b]]`` over the rows with a target; (B, N), (B,) long
+    with -1 for none (0 when no row has one)."""
+    has = targets >= 0
+    if not has.any():
+        return attention.sum() * 0.0
+    picked = attention[has].gather(1, targets[has, None]).squeeze(1)
+    return -torch.log(picked.clamp_min(1e-8)).mean()
+
+
+def augment_with_targets(
+    obs: torch.Tensor, sets: torch.Tensor, targets: torch.Tensor, generator: torch.Generator | None
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """:func:`augment_batch` that moves each row's target cell (-1: none) with its level: the
+    cell rides along as one more observation plane."""
+    B, C, H, W = obs.shape
+    plane = torch.zeros(B, 1, H * W, dtype=obs.dtype)
+    has = targets >= 0
+    plane[has, 0, targets[has]] = 1
+    turned, sets = augment_batch(torch.cat([obs, plane.view(B, 1, H, W)], dim=1), sets, generator)
+    flat = turned[:, C].reshape(B, -1)
+    return turned[:, :C].contiguous(), sets, torch.where(has, flat.argmax(1), -1)
+
+
 def imitation_update(
     model: ActorCritic,
     optimizer: torch.optim.Optimizer,
@@ -121,28 +163,59 @@ def imitation_update(
 ) -> LossStats:
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
-    for _ in range(config.imitate.dagger_steps):
-        obs, optimal, values, safe = buffer.sample(config.imitate.dagger_batch, rng)
-        if config.imitate.augment:  # the level turned or mirrored; the return still to earn is the same
-            obs, sets = augment_batch(obs, torch.stack((optimal, safe), dim=-1), generator)
-            optimal, safe = sets.unbind(-1)
-        obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
-        logits, value = model(obs)
-        policy_loss = imitation_loss(logits, optimal)
-        if config.imitate.safe_coef:
-            policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(logits, safe.to(device))
-        value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
-        loss = policy_loss + config.value_coef * value_loss
-        optimizer.zero_grad(set_to_none=True)
-        loss.backward()
-        norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
-        check_finite(norm, loss)
-        optimizer.step()
-        with torch.no_grad():
-            logp = torch.log_softmax(logits, dim=-1)
-            entropy = -(logp.exp() * logp).sum(-1).mean()
-        totals += [policy_loss.item(), value_loss.item(), entropy.item(), float(norm)]
+    attend = config.imitate.attend_coef
+    seen: list[torch.Tensor] = []
+    hook = (
+        model.relational.hook_attention2.register_forward_hook(lambda m, i, out: seen.append(out))
+        if attend
+        else None
+    )
+    try:
+        for _ in range(config.imitate.dagger_steps):
+            totals += _imitation_step(model, optimizer, buffer, config, rng, device, generator, seen)
+    finally:
+        if hook is not None:
+            hook.remove()
     return LossStats(*(totals / config.imitate.dagger_steps).tolist())
+
+
+def _imitation_step(
+    model: ActorCritic,
+    optimizer: torch.optim.Optimizer,
+    buffer: LabelBuffer,
+    config: TrainConfig,
+    rng: np.random.Generator,
+    device: torch.device,
+    generator: torch.Generator | None,
+    seen: list[torch.Tensor],
+) -> list[float]:
+    """One minibatch's gradient step: policy, safe, attention and value losses."""
+    obs, optimal, values, safe, targets = buffer.sample(config.imitate.dagger_batch, rng)
+    if config.imitate.augment:  # the level turned or mirrored; the return still to earn is the same
+        obs, sets, targets = augment_with_targets(
+            obs, torch.stack((optimal, safe), dim=-1), targets, generator
+        )
+        optimal, safe = sets.unbind(-1)
+    obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
+    seen.clear()
+    logits, value = model(obs)
+    policy_loss = imitation_loss(logits, optimal)
+    if config.imitate.safe_coef:
+        policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(logits, safe.to(device))
+    if config.imitate.attend_coef:  # head 0's second argument on the next object's cell
+        nll = attention_target_nll(seen[-1][:, 0], targets.to(device))
+        policy_loss = policy_loss + config.imitate.attend_coef * nll
+    value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
+    loss = policy_loss + config.value_coef * value_loss
+    optimizer.zero_grad(set_to_none=True)
+    loss.backward()
+    norm = torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
+    check_finite(norm, loss)
+    optimizer.step()
+    with torch.no_grad():
+        logp = torch.log_softmax(logits, dim=-1)
+        entropy = -(logp.exp() * logp).sum(-1).mean()
+    return [policy_loss.item(), value_loss.item(), entropy.item(), float(norm)]
 
 
 def planner_for(env_name: str) -> Any:
@@ -180,6 +253,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
         n_actions = int(venv.single_action_space.n)
         buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype, n_actions)
         safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
+        attend = config.imitate.attend_coef > 0  # next contacts only where the loss reads them
         frames = ctx.frames0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:
@@ -188,6 +262,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
             steps = 0
             for _ in range(config.n_steps):
                 optimal, values, regret = planner.labels(venv, regret=safe_loss)
+                targets = planner.next_contacts(venv) if attend else None
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
@@ -196,7 +271,10 @@ def imitation_learner(ctx: LearnerContext) -> None:
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end
                 safe = None if regret is None else regret[real] <= 0
-                buffer.add(obs[real], optimal[real], values[real], safe)
+                buffer.add(
+                    obs[real], optimal[real], values[real], safe,
+                    None if targets is None else targets[real],
+                )
                 obs, reward, terminated, truncated, info = venv.step(actions)
                 obs = np.ascontiguousarray(obs)
                 valid, done = tracker.step(venv, reward, terminated, truncated, info)

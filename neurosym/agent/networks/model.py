@@ -88,7 +88,7 @@ class ActorCritic(nn.Module):
             )
         x = obs.to(torch.float32) * self.config.obs_scale  # (B, C, H, W)
         entities = self.encoder(x)  # (B, N, F)
-        if self.config.keys == "cells" or self.config.relation_bits is not None:
+        if self.config.keys != "entities" or self.config.relation_bits is not None:
             # keys from what each cell holds (ModelConfig.keys), or the fact bottleneck's cells
             B, C, H, W = x.shape
             cells = x.permute(0, 2, 3, 1).reshape(B, H * W, C)  # (B, N, C), row-major

@@ -35,7 +35,9 @@ Choices made here (docs/design.md leaves them open):
   K = c W_K with c the (B, N, C) cells' own observation vectors, so a head
   addresses a cell by what it holds; the attended entities are still L's.
   Computed with autograd (the hand-written attention below assumes one L for
-  keys and values) and without recorded queries.
+  keys and values) and without recorded queries. ``keys="cells_xy"``: the keys
+  read each cell's observation and its two coordinates (L's last two features),
+  so a head can single out one of two cells that hold the same thing.
 * The heads' R vectors are concatenated, (B, H * (J + 4)), and a linear layer
   projects them to Table 4's output size (26). It is linear so that the
   output is a plain read-out of R and the R vectors stay the only relational
@@ -172,7 +174,7 @@ class PrediNet(nn.Module):
         self.heads, self.key_size, self.relations = heads, key_size, relations
         self.query_mode = query
         self.keys = keys
-        key_input = entity_size if keys == "entities" else cell_size
+        key_input = {"entities": entity_size, "cells": cell_size, "cells_xy": cell_size + 2}[keys]
         self.key = nn.Linear(key_input, key_size, bias=False)  # W_K, shared
         if query == "learned":
             # Q1^h, Q2^h of every head as one (2H D) vector; std 1 gives a fresh attention about
@@ -259,6 +261,8 @@ class PrediNet(nn.Module):
         else:
             w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
             q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, self.key_size)  # (B, 2H, D)
+        if self.keys == "cells_xy":  # what each cell holds and where it is
+            cells = torch.cat([cells, L[..., -2:]], dim=-1)
         scores = (q @ self.key.weight) @ cells.transpose(1, 2)  # (B, 2H, N)
         a = torch.softmax(scores * self.scale, dim=-1)
         return a, a @ L
@@ -273,7 +277,7 @@ class PrediNet(nn.Module):
         """(out, None), or (out, :class:`PrediNetIntrospection` of the cached hook values) with
         ``introspect``. ``queries``: a record of this module's own earlier forwards over the
         first rows of ``L``, used only while the weights are unchanged (else recomputed).
-        ``cells``: (B, N, C) each cell's observation, the keys' input when ``keys="cells"``
+        ``cells``: (B, N, C) each cell's observation, the keys' input when ``keys`` is a cells one
         (needed then)."""
         if not introspect:
             return self._forward(L, queries, cells), None
@@ -284,7 +288,7 @@ class PrediNet(nn.Module):
     ) -> torch.Tensor:
         B, N, F = L.shape
         H = self.heads
-        if self.keys == "cells":
+        if self.keys != "entities":
             if cells is None:
                 raise ValueError("PrediNet with keys='cells' needs the cells' observations")
             a, e = self._cell_attention(L, cells)

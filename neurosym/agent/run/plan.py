@@ -302,9 +302,16 @@ def _new(
 
 
 def _check_learner(plan: RunPlan) -> None:
-    """Refuse a learner that cannot run distributed under torchrun."""
+    """Refuse a learner that cannot run distributed under torchrun, and an attention target
+    without the PrediNet and RGW planner it needs."""
     if plan.world.distributed and plan.train_config.algo != "ppo":
         raise ConfigError(
             "torchrun trains the synchronous learner: pass --algo ppo "
             "(A3C's workers share one machine's memory)"
+        )
+    attend = plan.train_config.algo == "imitate" and plan.train_config.imitate.attend_coef > 0
+    if attend and (plan.family != "rgw" or plan.model_config.module != "predinet"):
+        raise ConfigError(
+            f"--attend-coef teaches PrediNet head 0 the RGW planner's next object; this run "
+            f"is {plan.model_config.module} on {plan.family} (leave it at 0)"
         )
