@@ -107,6 +107,7 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
         import torch
         from stable_baselines3 import PPO
         from stable_baselines3.common.callbacks import BaseCallback
+        from stable_baselines3.common.logger import Logger
         from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
         from stable_baselines3.common.vec_env import DummyVecEnv
     except ImportError:
@@ -167,6 +168,7 @@ def run_sb3(env_name: str, frames: int, args: argparse.Namespace) -> dict:
         policy_kwargs={"features_extractor_class": SmallCNN, "normalize_images": False},
     )  # fmt: skip
     callback = Success()
+    model.set_logger(Logger(folder=None, output_formats=[]))  # no SB3-* folder in /tmp
     model.learn(total_timesteps=frames, callback=callback)
     recent = list(callback.recent)
     return {

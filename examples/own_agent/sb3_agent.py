@@ -11,6 +11,7 @@ import argparse
 
 from stable_baselines3 import PPO
 from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.logger import Logger
 
 from neurosym.envs import make
 
@@ -25,6 +26,7 @@ def main() -> None:
     venv = make_vec_env(lambda: make(args.env), n_envs=4, seed=args.seed)
     model = PPO("MlpPolicy", venv, n_steps=64, batch_size=64, seed=args.seed, device="cpu",
                 policy_kwargs={"net_arch": [64, 64]})  # fmt: skip
+    model.set_logger(Logger(folder=None, output_formats=[]))  # no SB3-* folder in /tmp
     model.learn(total_timesteps=args.steps)
     model.save(args.out)
     print(f"wrote {args.out} ({model.num_timesteps} steps of PPO on {args.env})")

@@ -18,6 +18,7 @@ import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.logger import Logger
 
 from neurosym.envs import make
 
@@ -67,6 +68,7 @@ def main() -> None:
                 ent_coef=0.01, gamma=0.99, seed=args.seed, device="cpu",
                 policy_kwargs={"net_arch": [128, 128]})  # fmt: skip
     start = time.monotonic()
+    model.set_logger(Logger(folder=None, output_formats=[]))  # no SB3-* folder in /tmp
     model.learn(total_timesteps=args.steps, callback=Budget(args.minutes * 60))
     minutes = (time.monotonic() - start) / 60
     model.save(args.out)
