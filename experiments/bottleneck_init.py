@@ -13,6 +13,8 @@ afresh instead (the untrained control of the same shape). Train it with
 from __future__ import annotations
 
 import argparse
+import shlex
+import sys
 from dataclasses import replace
 
 import torch
@@ -25,12 +27,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("source")
     parser.add_argument("out")
-    parser.add_argument("--tau", type=float, default=0.25)
+    parser.add_argument(
+        "--tau",
+        type=float,
+        default=None,
+        help="threshold (default: the source's relation_bits, else 0.25)",
+    )
     parser.add_argument("--fresh", action="store_true", help="every weight afresh (control)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--env-option", action="append", default=[], metavar="KEY=INT")
     args = parser.parse_args()
     source = read_checkpoint(args.source)
+    if args.tau is None:
+        args.tau = getattr(source["model_config"], "relation_bits", None) or 0.25
     config = replace(source["model_config"], relation_bits=args.tau)
     torch.manual_seed(args.seed)
     model = ActorCritic(config)
@@ -53,7 +62,20 @@ def main() -> None:
         env_name=source["env"],
         env_kwargs=env_kwargs,
         train_config=None,
-        command=f"python experiments/bottleneck_init.py ({how}, relation_bits={args.tau})",
+        command=" && ".join(
+            filter(
+                None,
+                [
+                    None
+                    if args.fresh
+                    else source.get("command"),  # the source's history, then this
+                    "python "
+                    + " ".join(
+                        shlex.quote(a) for a in ["experiments/bottleneck_init.py", *sys.argv[1:]]
+                    ),
+                ],
+            )
+        ),
     )
     print(f"wrote {args.out}: relation_bits={config.relation_bits}, {how}")
 
