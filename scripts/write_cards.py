@@ -50,6 +50,12 @@ CARDS: dict[str, tuple[str, str, str, dict[str, Any]]] = {
         " --env-option num_mountains=6",
         rgw((98.7, 93.3, 100.0, 98.0), (92.3, 90.3, 97.3, 92.1)),
     ),
+    "rgw-random-predinet-bottleneck": (
+        "fact bottleneck: best relater",
+        "rgw-random",
+        " --env-option num_mountains=6",
+        rgw((97.0, 88.67, 97.99, 96.03), (82.33, 80.33, 94.63, 79.47)),
+    ),
     "rgw-random-mhdpa": (
         "general MHDPA: best player",
         "rgw-random",
