@@ -211,7 +211,7 @@ def test_the_bottleneck_predinet_names_its_next_object_in_the_facts_its_policy_r
     10.7, when shipped; greedily it loops after the sword)."""
     from neurosym.agent.evaluation import evaluate
     from neurosym.facts.tables import extract_facts
-    from neurosym.induce.strategy_data import load_trace, labels
+    from neurosym.induce.strategy_data import labels, load_trace
     from neurosym.record.extraction import model_threshold
     from neurosym.record.recorder import record
 

@@ -18,6 +18,7 @@ from typing import Any
 from neurosym.agent.checkpoint import read_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.learners import distributed
+from neurosym.agent.networks.adapters import module_has
 from neurosym.agent.run.options import RunOptions
 from neurosym.errors import CheckpointError, ConfigError
 
@@ -310,7 +311,8 @@ def _check_learner(plan: RunPlan) -> None:
             "(A3C's workers share one machine's memory)"
         )
     attend = plan.train_config.algo == "imitate" and plan.train_config.imitate.attend_coef > 0
-    if attend and (plan.family != "rgw" or plan.model_config.module != "predinet"):
+    # a module whose recordings have attends/8 has the two attended arguments the loss teaches
+    if attend and (plan.family != "rgw" or not module_has(plan.model_config.module, "attends")):
         raise ConfigError(
             f"--attend-coef teaches PrediNet head 0 the RGW planner's next object; this run "
             f"is {plan.model_config.module} on {plan.family} (leave it at 0)"
