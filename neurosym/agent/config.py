@@ -498,10 +498,10 @@ class ImitationConfig:
     augment: bool = field(default=False, metadata=FLAG)
     """fit each minibatch turned by a random quarter turn or mirrored (RGW's rules and its
     planner are symmetric), so that the network does not memorise its labelled states"""
-    attend_coef: float = field(default=0.0, metadata=flag("[0, 100]", metavar="C"))
+    attend_coef: float = field(default=0.0, metadata=bounded("[0, 100]"))
     """weight of a loss that PrediNet head 0's second argument attends the next key object on
-    the planner's route (RGW; 0: none): with the fact bottleneck its KB then names the goal
-    its policy steers by (attends/8)"""
+    the planner's route (RGW; 0: none; ``--set attend_coef=C``): with the fact bottleneck its
+    KB then names the goal its policy steers by (attends/8)"""
 
     def __post_init__(self) -> None:
         check_ranges(self)

@@ -409,11 +409,11 @@ def test_attend_coef_needs_a_predinet_on_rgw(
 ) -> None:
     for env, module in (("rgw-random", "mhdpa"), ("MiniGrid-DoorKey-5x5-v0", "predinet")):
         proc = train_refused("train", "--env", env, "--module", module, "--algo", "imitate",
-                             "--attend-coef", "1", "--out", tmp_path / env)  # fmt: skip
+                             "--set", "attend_coef=1", "--out", tmp_path / env)  # fmt: skip
         family = "rgw" if env == "rgw-random" else "minigrid"
         assert proc.returncode != 0
         lines = [line for line in proc.stderr.splitlines() if line.strip()]
         assert lines == [
-            f"neurosym train: error: --attend-coef teaches PrediNet head 0 the RGW planner's "
+            f"neurosym train: error: attend_coef teaches PrediNet head 0 the RGW planner's "
             f"next object; this run is {module} on {family} (leave it at 0)"
         ]

@@ -385,7 +385,7 @@ def test_train_init_from_switches_to_cell_keys_and_resumes(neurosym, tmp_path: P
         ),
         (
             ("--env", "rgw2", "--module", "predinet", "--set", "critic_warmup=5"),
-            "--set wants NAME=VALUE with NAME a setting (adam_eps, attention_gain,",
+            "--set wants NAME=VALUE with NAME a setting (adam_eps, attend_coef, attention_gain,",
         ),
         (
             ("--env", "rgw2", "--module", "predinet", "--set", "gae_lambda=high"),

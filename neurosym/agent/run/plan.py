@@ -314,6 +314,6 @@ def _check_learner(plan: RunPlan) -> None:
     # a module whose recordings have attends/8 has the two attended arguments the loss teaches
     if attend and (plan.family != "rgw" or not module_has(plan.model_config.module, "attends")):
         raise ConfigError(
-            f"--attend-coef teaches PrediNet head 0 the RGW planner's next object; this run "
+            f"attend_coef teaches PrediNet head 0 the RGW planner's next object; this run "
             f"is {plan.model_config.module} on {plan.family} (leave it at 0)"
         )
