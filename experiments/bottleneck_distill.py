@@ -43,6 +43,7 @@ def main() -> None:
     parser.add_argument("--beta-frames", type=int, default=200_000)
     parser.add_argument("--lr", type=float, default=5e-4)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--student", help="continue this earlier student (its weights) instead")
     args = parser.parse_args()
     torch.set_num_threads(1)
     torch.manual_seed(args.seed)
@@ -59,6 +60,11 @@ def main() -> None:
             if not k.startswith("relational.out.")
         }
     )
+    history = source.get("command")
+    if args.student:
+        earlier = read_checkpoint(args.student)
+        state.update({k: v.float() for k, v in earlier["state_dict"].items()})
+        history = earlier.get("command")
     student.load_state_dict(state)
     opt = torch.optim.Adam(student.parameters(), lr=args.lr)
     venv = make_batched(teacher.env_name, args.envs, seed=args.seed, **teacher.env_kwargs)
@@ -67,6 +73,8 @@ def main() -> None:
     ring_p = np.zeros((args.buffer, int(venv.single_action_space.n)), dtype=np.float32)
     ring_v = np.zeros(args.buffer, dtype=np.float32)
     size = nxt = frames = 0
+    if args.student:
+        frames = int(earlier.get("frames", 0))  # beta goes on from there
     done_eps: list[bool] = []
     start = last = time.monotonic()
     while time.monotonic() - start < args.minutes * 60:
@@ -112,7 +120,7 @@ def main() -> None:
             )
             last = time.monotonic()
     command = " && ".join(filter(None, [
-        source.get("command"),
+        history,
         "python " + " ".join(shlex.quote(a) for a in ["experiments/bottleneck_distill.py", *sys.argv[1:]]),
     ]))  # fmt: skip
     save_checkpoint(args.out, model=student, config=config, env_name=teacher.env_name,
