@@ -25,6 +25,7 @@ import torch
 
 from neurosym.agent.agent import load_agent
 from neurosym.agent.checkpoint import read_checkpoint, save_checkpoint
+from neurosym.agent.learners.imitation import expert_share
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
 
@@ -78,7 +79,7 @@ def main() -> None:
     done_eps: list[bool] = []
     start = last = time.monotonic()
     while time.monotonic() - start < args.minutes * 60:
-        beta = max(0.0, 1.0 - frames / args.beta_frames)
+        beta = expert_share(frames, args.beta_frames)
         for _ in range(args.n_steps):
             x = torch.from_numpy(obs)
             with torch.no_grad():

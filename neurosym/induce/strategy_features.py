@@ -260,14 +260,21 @@ def _routes(trace: KBTables, pairs: pd.DataFrame, types: dict[str, str], kinds: 
         )
 
 
+def _of_held_key(
+    kind: str, types: dict[str, str], holding: set[tuple[int, int, str]]
+) -> Callable[..., float]:
+    """The feature "O is a ``kind`` (lock, door) of the held key's colour"."""
+    return lambda e, t, o, r, c: float(
+        _kind(types[o]) == kind and (e, t, f"key({_colour(types[o])})") in holding
+    )
+
+
 def _box_world(add, types, holding, at_cell, locks, content) -> None:  # type: ignore[no-untyped-def]
     """Box-World's key and lock features (only where the KB has keys or locks, and no facing/3)."""
     add(
         "lock_of_held_key",
         goal_term("lock_of_held_key", E_, T_, O_),
-        lambda e, t, o, r, c: float(
-            _kind(types[o]) == "lock" and (e, t, f"key({_colour(types[o])})") in holding
-        ),
+        _of_held_key("lock", types, holding),
     )
     add(
         "key_fits_lock",
@@ -307,9 +314,7 @@ def _minigrid(trace: KBTables, add, types, holding, by_state) -> None:  # type: 
     add(
         "door_of_held_key",
         goal_term("door_of_held_key", E_, T_, O_),
-        lambda e, t, o, r, c: float(
-            _kind(types[o]) == "door" and (e, t, f"key({_colour(types[o])})") in holding
-        ),
+        _of_held_key("door", types, holding),
     )
     add(
         "key_of_locked_door",

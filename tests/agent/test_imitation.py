@@ -88,8 +88,9 @@ def test_label_buffer_keeps_the_latest_states() -> None:
     assert sorted(buf.obs[:, 0].tolist()) == [12, 13, 14, 15, 16]
 
 
-def labelled_buffer() -> tuple[LabelBuffer, np.random.Generator]:
-    """256 labelled states of rgw-random (8 random steps of 32 levels), and the rng that drew them."""
+def labelled_buffer(targets: bool = False) -> tuple[LabelBuffer, np.random.Generator]:
+    """256 labelled states of rgw-random (8 random steps of 32 levels), and the rng that drew them;
+    with ``targets``, each state's next contact on the planner's route too."""
     venv = make_batched("rgw-random", 32, seed=11)
     obs, _ = venv.reset(seed=11)
     planner = Planner()
@@ -97,7 +98,7 @@ def labelled_buffer() -> tuple[LabelBuffer, np.random.Generator]:
     rng = np.random.default_rng(0)
     for _ in range(8):
         sets, values = planner.action_sets(venv)
-        buf.add(obs, sets, values)
+        buf.add(obs, sets, values, targets=planner.next_contacts(venv) if targets else None)
         obs, *_ = venv.step(rng.integers(0, 4, 32))
     return buf, rng
 
@@ -374,20 +375,12 @@ def test_attention_target_loss_is_the_mean_nll_of_the_rows_with_a_target() -> No
 def test_attend_coef_teaches_head_0_to_attend_the_next_object() -> None:
     """With the attention target, head 0's second argument moves onto the planner's next
     object (cell keys with coordinates tell two teleport ends apart); without it, it does not."""
-    venv = make_batched("rgw-random", 32, seed=11)
-    obs, _ = venv.reset(seed=11)
-    planner = Planner()
-    buf = LabelBuffer(256, obs.shape[1:], obs.dtype)
-    rng = np.random.default_rng(0)
-    for _ in range(8):
-        sets, values = planner.action_sets(venv)
-        buf.add(obs, sets, values, targets=planner.next_contacts(venv))
-        obs, *_ = venv.step(rng.integers(0, 4, 32))
+    buf, _ = labelled_buffer(targets=True)
     assert (buf.targets >= 0).mean() > 0.9
     hits = {}
     for coef in (0.0, 1.0):
         torch.manual_seed(0)
-        cfg = ModelConfig.for_family("rgw", "predinet", tuple(obs.shape[1:]), keys="cells_xy",
+        cfg = ModelConfig.for_family("rgw", "predinet", tuple(buf.obs.shape[1:]), keys="cells_xy",
                                      entity_norm=True, attention_gain=8.0)  # fmt: skip
         model = ActorCritic(cfg)
         train = TrainConfig.for_family("rgw", algo="imitate", dagger_batch=256, dagger_steps=10,
