@@ -50,7 +50,8 @@ FAMILIES = ("rgw", "boxworld", "minigrid")
 PRESETS = ("default", "thesis")
 ALGOS = ("a3c", "ppo", "imitate")
 IMITATE_FAMILIES = ("rgw", "minigrid")
-"""families with a planner for ``--algo imitate`` (Minigrid's: DoorKey levels)"""
+"""families with a planner for ``--algo imitate`` (Minigrid's: DoorKey levels); any family
+imitates a trained agent (``--set teacher=CHECKPOINT``)"""
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
@@ -481,7 +482,8 @@ class PPOConfig:
 
 @dataclass(frozen=True)
 class ImitationConfig:
-    """DAgger's own settings (``--algo imitate``): imitation of the RGW planner."""
+    """DAgger's own settings (``--algo imitate``): imitation of the env's planner, or of a
+    trained agent (``teacher``)."""
 
     dagger_beta_frames: int = field(default=200_000, metadata=bounded("[0, 1e12]"))
     """frames over which the chance of following the planner falls from 1 to 0"""
@@ -502,6 +504,11 @@ class ImitationConfig:
     """weight of a loss that PrediNet head 0's second argument attends the next key object on
     the planner's route (RGW; 0: none; ``--set attend_coef=C``): with the fact bottleneck its
     KB then names the goal its policy steers by (attends/8)"""
+    teacher: str = ""
+    """a trained agent whose policy labels the states instead of the planner (a checkpoint,
+    a shipped agent's name or an SB3 .zip; ``--set teacher=CHECKPOINT``): the loss is the KL
+    from its action probabilities and the critic fits its value (0 for an agent without one).
+    Any family, Box-World too; e.g. a fact-bottleneck PrediNet taught a shipped agent's policy"""
 
     def __post_init__(self) -> None:
         check_ranges(self)
@@ -526,7 +533,7 @@ class TrainConfig:
 
     algo: str = "a3c"
     """learner: "a3c" (asynchronous workers, the mission's algorithm), "ppo" (synchronous) or
-    "imitate" (DAgger from the RGW planner)"""
+    "imitate" (DAgger from the env's planner or a trained agent)"""
     preset: str = "default"
     """the preset these settings started from ("default", "thesis"), recorded for the reader"""
     optimizer: str = "adam"
@@ -646,10 +653,10 @@ class TrainConfig:
         """A preset's settings for an env family and learner, then the overrides that are not None."""
         _check_family(family)
         _check_preset(preset)
-        if algo == "imitate" and family not in IMITATE_FAMILIES:
+        if algo == "imitate" and family not in IMITATE_FAMILIES and not overrides.get("teacher"):
             raise ConfigError(
                 f"--algo imitate learns from an env's planner (RGW's, Minigrid DoorKey's); "
-                f"{family} has none (use a3c or ppo)"
+                f"{family} has none (use a3c or ppo, or a trained agent: --set teacher=CHECKPOINT)"
             )
         if algo == "imitate" and family == "minigrid" and overrides.get("augment"):
             raise ConfigError(

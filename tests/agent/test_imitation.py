@@ -132,8 +132,8 @@ def test_augmented_updates_fit_the_turned_levels_too() -> None:
 
     buf, _ = labelled_buffer()
     turned_obs = transform_grid(torch.from_numpy(buf.obs), 1, False).contiguous()
-    turned_sets = torch.empty(buf.optimal.shape, dtype=torch.bool)
-    turned_sets[:, list(action_permutation(1, False, 10, 10))] = torch.from_numpy(buf.optimal)
+    turned_sets = torch.empty(buf.policy.shape, dtype=torch.bool)
+    turned_sets[:, list(action_permutation(1, False, 10, 10))] = torch.from_numpy(buf.policy > 0)
     losses = {}
     for augment in (False, True):
         torch.manual_seed(0)
@@ -156,7 +156,7 @@ def test_imitate_needs_a_planner() -> None:
     with pytest.raises(
         ConfigError,
         match=r"^--algo imitate learns from an env's planner \(RGW's, Minigrid DoorKey's\); "
-        r"boxworld has none \(use a3c or ppo\)$",
+        r"boxworld has none \(use a3c or ppo, or a trained agent: --set teacher=CHECKPOINT\)$",
     ):
         TrainConfig.for_family("boxworld", algo="imitate")
     with pytest.raises(ConfigError, match="thesis is A3C"):
@@ -206,7 +206,8 @@ def test_train_imitate_on_box_world_is_one_line(
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     assert lines == [
         "neurosym train: error: --algo imitate learns from an env's planner (RGW's, Minigrid "
-        "DoorKey's); boxworld has none (use a3c or ppo)"
+        "DoorKey's); boxworld has none (use a3c or ppo, or a trained agent: --set "
+        "teacher=CHECKPOINT)"
     ], proc.stderr
 
 

@@ -30,6 +30,10 @@ the bits between them, so this names its current goal in its own facts
 its concepts; without the term the heads attend what serves the actions, which
 a reader of the KB cannot name.
 
+With ``teacher`` (:mod:`neurosym.agent.learners.teacher`) a trained agent labels the
+states instead: its action probabilities (the loss is the KL from them) and its value; its
+sampled actions are the expert's. Any family, Box-World too.
+
 Started and reporting as every learner (:mod:`neurosym.agent.learners.process`);
 one process, no torchrun. The planners: RGW's (:mod:`neurosym.envs.rgw_solver`) and
 Minigrid DoorKey's (:mod:`neurosym.envs.minigrid_solver`); Box-World has none here.
@@ -55,18 +59,20 @@ from neurosym.agent.learners.process import (
     learner_process,
     report_update,
 )
+from neurosym.agent.learners.teacher import Teacher, load_teacher, teacher_choice
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
 
 class LabelBuffer:
-    """A ring of the latest labelled states: observations, optimal and safe action sets, values."""
+    """A ring of the latest labelled states: observations, action targets (the planner's
+    optimal set as 1s and 0s, or a teacher's probabilities), safe action sets, values."""
 
     def __init__(
         self, capacity: int, obs_shape: tuple[int, ...], obs_dtype: np.dtype, n_actions: int = 4
     ) -> None:
         self.obs = np.zeros((capacity, *obs_shape), dtype=obs_dtype)
-        self.optimal = np.zeros((capacity, n_actions), dtype=bool)
+        self.policy = np.zeros((capacity, n_actions), dtype=np.float32)
         self.safe = np.ones((capacity, n_actions), dtype=bool)
         self.values = np.zeros(capacity, dtype=np.float32)
         self.targets = np.full(capacity, -1, dtype=np.int16)  # next contact's cell, -1 none
@@ -76,23 +82,24 @@ class LabelBuffer:
     def add(
         self,
         obs: np.ndarray,
-        optimal: np.ndarray,
+        policy: np.ndarray,
         values: np.ndarray,
         safe: np.ndarray | None = None,
         targets: np.ndarray | None = None,
     ) -> None:
-        """Append states; ``safe`` (n, A) bool: actions that give no return up (default: all);
-        ``targets`` (n,) the cell of the next key object on the planner's route (default: -1)."""
+        """Append states; ``policy`` (n, A): an optimal set (bool) or probabilities; ``safe``
+        (n, A) bool: actions that give no return up (default: all); ``targets`` (n,) the cell
+        of the next key object on the planner's route (default: -1)."""
         if safe is None:
-            safe = np.ones_like(optimal)
+            safe = np.ones(policy.shape, dtype=bool)
         if targets is None:
             targets = np.full(len(obs), -1, dtype=np.int16)
         for start in range(0, len(obs), len(self.obs)):  # a batch larger than the ring wraps
             o, m, v, s, g = (
-                x[start : start + len(self.obs)] for x in (obs, optimal, values, safe, targets)
+                x[start : start + len(self.obs)] for x in (obs, policy, values, safe, targets)
             )
             idx = (self._next + np.arange(len(o))) % len(self.obs)
-            self.obs[idx], self.optimal[idx], self.values[idx], self.safe[idx] = o, m, v, s
+            self.obs[idx], self.policy[idx], self.values[idx], self.safe[idx] = o, m, v, s
             self.targets[idx] = g
             self._next = int((self._next + len(o)) % len(self.obs))
             self.size = min(self.size + len(o), len(self.obs))
@@ -100,11 +107,11 @@ class LabelBuffer:
     def sample(
         self, n: int, rng: np.random.Generator
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``n`` states drawn uniformly: obs, optimal sets, values, safe sets, target cells."""
+        """``n`` states drawn uniformly: obs, action targets, values, safe sets, target cells."""
         idx = rng.integers(0, self.size, n)
         return (
             torch.from_numpy(self.obs[idx]),
-            torch.from_numpy(self.optimal[idx]),
+            torch.from_numpy(self.policy[idx]),
             torch.from_numpy(self.values[idx]),
             torch.from_numpy(self.safe[idx]),
             torch.from_numpy(self.targets[idx].astype(np.int64)),
@@ -114,6 +121,12 @@ class LabelBuffer:
 def imitation_loss(logits: torch.Tensor, optimal: torch.Tensor) -> torch.Tensor:
     """Mean of ``-log sum_{a in optimal} softmax(logits)_a`` over the batch; (B, A) and (B, A) bool."""
     return optimal_set_nll(logits, optimal).mean()
+
+
+def distill_loss(logits: torch.Tensor, probs: torch.Tensor) -> torch.Tensor:
+    """Mean KL(probs || softmax(logits)) over the batch: the teacher's probabilities (B, A)."""
+    logq = torch.log(probs.clamp_min(1e-8))
+    return (probs * (logq - torch.log_softmax(logits, dim=-1))).sum(-1).mean()
 
 
 def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -172,7 +185,9 @@ def imitation_update(
     )
     try:
         for _ in range(config.imitate.dagger_steps):
-            totals += _imitation_step(model, optimizer, buffer, config, rng, device, generator, seen)
+            totals += _imitation_step(
+                model, optimizer, buffer, config, rng, device, generator, seen
+            )
     finally:
         if hook is not None:
             hook.remove()
@@ -190,18 +205,23 @@ def _imitation_step(
     seen: list[torch.Tensor],
 ) -> list[float]:
     """One minibatch's gradient step: policy, safe, attention and value losses."""
-    obs, optimal, values, safe, targets = buffer.sample(config.imitate.dagger_batch, rng)
+    obs, policy, values, safe, targets = buffer.sample(config.imitate.dagger_batch, rng)
     if config.imitate.augment:  # the level turned or mirrored; the return still to earn is the same
-        obs, sets, targets = augment_with_targets(
-            obs, torch.stack((optimal, safe), dim=-1), targets, generator
+        obs, moved, targets = augment_with_targets(
+            obs, torch.stack((policy, safe.float()), dim=-1), targets, generator
         )
-        optimal, safe = sets.unbind(-1)
-    obs, optimal, values = obs.to(device), optimal.to(device), values.to(device)
+        policy, safe = moved[..., 0], moved[..., 1] > 0
+    obs, policy, values = obs.to(device), policy.to(device), values.to(device)
     seen.clear()
     logits, value = model(obs)
-    policy_loss = imitation_loss(logits, optimal)
+    if config.imitate.teacher:
+        policy_loss = distill_loss(logits, policy)
+    else:
+        policy_loss = imitation_loss(logits, policy > 0)
     if config.imitate.safe_coef:
-        policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(logits, safe.to(device))
+        policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(
+            logits, safe.to(device)
+        )
     if config.imitate.attend_coef:  # head 0's second argument on the next object's cell
         nll = attention_target_nll(seen[-1][:, 0], targets.to(device))
         policy_loss = policy_loss + config.imitate.attend_coef * nll
@@ -231,6 +251,15 @@ def planner_for(env_name: str) -> Any:
     return Planner()
 
 
+def _teacher(ctx: LearnerContext, venv: Any, device: torch.device) -> Teacher | None:
+    """The run's teacher (``ImitationConfig.teacher``), None when the planner labels."""
+    spec = ctx.train_config.imitate.teacher
+    if not spec:
+        return None
+    shape = tuple(int(v) for v in venv.single_observation_space.shape)
+    return load_teacher(spec, ctx.env_name, shape, int(venv.single_action_space.n), device)
+
+
 def imitation_learner(ctx: LearnerContext) -> None:
     """The DAgger learner process: labelled rollouts and updates until ``ctx.stop`` is set.
 
@@ -248,12 +277,13 @@ def imitation_learner(ctx: LearnerContext) -> None:
         local, local_opt = private_copy(ctx.shared, ctx.optimizer, config, dev)
         venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
         obs, _ = venv.reset(seed=ctx.env_seed)
-        planner = planner_for(ctx.env_name)
+        attend = config.imitate.attend_coef > 0  # next contacts only where the loss reads them
+        teacher = _teacher(ctx, venv, dev)
+        planner = planner_for(ctx.env_name) if teacher is None or attend else None
         tracker = EpisodeTracker(venv.num_envs)
         n_actions = int(venv.single_action_space.n)
         buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype, n_actions)
         safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
-        attend = config.imitate.attend_coef > 0  # next contacts only where the loss reads them
         frames = ctx.frames0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:
@@ -261,18 +291,25 @@ def imitation_learner(ctx: LearnerContext) -> None:
             beta = expert_share(frames, config.imitate.dagger_beta_frames)
             steps = 0
             for _ in range(config.n_steps):
-                optimal, values, regret = planner.labels(venv, regret=safe_loss)
+                if teacher is None:
+                    policy, values, regret = planner.labels(venv, regret=safe_loss)
+                    expert = planner_choice(policy, rng)
+                else:
+                    (policy, values), regret = teacher.labels(obs), None
+                    expert = teacher_choice(policy, rng)
                 targets = planner.next_contacts(venv) if attend else None
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
-                expert = planner_choice(optimal, rng)
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end
                 safe = None if regret is None else regret[real] <= 0
                 buffer.add(
-                    obs[real], optimal[real], values[real], safe,
+                    obs[real],
+                    policy[real],
+                    values[real],
+                    safe,
                     None if targets is None else targets[real],
                 )
                 obs, reward, terminated, truncated, info = venv.step(actions)

@@ -45,7 +45,7 @@ SETTINGS: tuple[tuple[str, type, str], ...] = (
     ),
     ("--algo a3c", A3CConfig, "train"),
     ("--algo ppo", PPOConfig, "train"),
-    ("--algo imitate (DAgger from the env's optimal planner: RGW, Minigrid DoorKey)", ImitationConfig, "train"),
+    ("--algo imitate (DAgger from a planner or a teacher)", ImitationConfig, "train"),
     ("model (default: Table 4 and the preset's switches)", ModelConfig, "model"),
 )
 """(argument group title, config class, train | model) of the settings' flags, in help order"""
@@ -204,7 +204,8 @@ class TrainCommand(EnvOptions, Out, Quiet):
     on bw2); any env of its family with its observation shape; frames count afresh"""
     algo: Literal["a3c", "ppo", "imitate"] | None = None
     """learner: a3c (asynchronous workers, default), ppo (one synchronous learner) or imitate
-    (DAgger from the env's optimal planner: RGW and Minigrid's DoorKey levels)"""
+    (DAgger from the env's optimal planner, RGW and Minigrid's DoorKey levels, or from a trained
+    agent: --set teacher=CHECKPOINT)"""
     preset: Literal["default", "thesis"] = option("default", shown="")
     """settings to start from: default (what learns best here) or thesis (Table 4 exactly)"""
     settings: list[str] = option(factory=list, flag="--set", metavar="NAME=VALUE")

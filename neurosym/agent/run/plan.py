@@ -310,6 +310,8 @@ def _check_learner(plan: RunPlan) -> None:
             "torchrun trains the synchronous learner: pass --algo ppo "
             "(A3C's workers share one machine's memory)"
         )
+    if plan.train_config.algo == "imitate" and plan.train_config.imitate.teacher:
+        _check_teacher(plan)
     attend = plan.train_config.algo == "imitate" and plan.train_config.imitate.attend_coef > 0
     # a module whose recordings have attends/8 has the two attended arguments the loss teaches
     if attend and (plan.family != "rgw" or not module_has(plan.model_config.module, "attends")):
@@ -317,3 +319,17 @@ def _check_learner(plan: RunPlan) -> None:
             f"attend_coef teaches PrediNet head 0 the RGW planner's next object; this run "
             f"is {plan.model_config.module} on {plan.family} (leave it at 0)"
         )
+
+
+def _check_teacher(plan: RunPlan) -> None:
+    """Refuse a teacher that cannot label this run's states, and the safe set it has none of."""
+    from neurosym.agent.learners.teacher import load_teacher
+
+    imitate = plan.train_config.imitate
+    if imitate.safe_coef > 0:
+        raise ConfigError(
+            "safe_coef reads the planner's regrets, which a teacher does not give "
+            "(leave --safe-coef at 0 with --set teacher=...)"
+        )
+    config = plan.model_config
+    load_teacher(imitate.teacher, plan.env_name, config.obs_shape, config.n_actions)
