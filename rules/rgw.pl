@@ -34,7 +34,8 @@
             orders_sword_before_enemy/1,
             sword_enemy_direct/1,
             sword_enemy_via/1,
-            sword_enemy_link/1
+            sword_enemy_link/1,
+            armed_enemy_link/1
           ]).
 
 :- use_module(library(lists)).
@@ -218,6 +219,40 @@ sword_enemy_via(X) :-
 
 sword_enemy_link(Answer) :-
     kb_link_answer_([sword], [enemy], Answer).
+
+%!  armed_enemy_link(-Share) is det.
+%
+%   How often the network relates the enemy to the sword the agent carries,
+%   state by state, between taking the sword and meeting the enemy. A picked
+%   sword leaves the map (no at/5, no entity named sword): it is a plane of
+%   the agent's own cell, so a sword-enemy relation there is one between the
+%   agent and the enemy. Share is share(N, D): D counts the states from the
+%   one after the sword was picked to the one whose action first meets the
+%   enemy after it, in which the agent holds the sword (holding/3), over
+%   every episode that did both; N those at which some link (r(J) or
+%   attention(Head)) relates agent and enemy. share(0, 0) when no episode
+%   took the sword and then met the enemy.
+%
+%       ?- armed_enemy_link(S).
+%       S = share(1, 3).
+
+armed_enemy_link(share(N, D)) :-
+    findall(E-T, armed_state_(E, T), States),
+    length(States, D),
+    aggregate_all(count,
+                  ( member(E-T, States), once(kb_link_at_(E, T, agent, enemy, _)) ),
+                  N).
+
+%   armed_state_(-E, -T): state T of episode E lies after the sword was
+%   picked and up to the first meeting with the enemy after that, and the
+%   agent holds the sword there.
+armed_state_(E, T) :-
+    kb_episode_(E),
+    kb_first_event_(E, picked(sword), Tp),
+    aggregate_all(min(T1), ( event(E, T1, Ev), meets_enemy_(Ev), T1 > Tp ), Te),
+    Tp1 is Tp + 1,
+    between(Tp1, Te, T),
+    holding(E, T, sword).
 
 % ------------------------------------------------------------------ helpers
 %

@@ -88,6 +88,30 @@ test(event_indexed_on_the_episode_only, Kinds == [single(1)]) :-
 
 :- begin_tests(rgw_network).
 
+% The armed states: episode 0's 12, 1's 21 (its first meeting, at 7, was
+% before the sword), 3's 9; episode 2 never meets the enemy.
+test(armed_enemy_link_none, S == share(0, 3)) :-
+    armed_enemy_link(S).
+
+test(armed_enemy_link, [ setup(( user:assertz(holds(0, 12, r(4), enemy, agent)),
+                                 user:assertz(holds(0, 12, r(5), agent, enemy)),
+                                 user:assertz(holds(1, 7, r(4), agent, enemy)),
+                                 user:assertz(attention(3, 9, 0, agent, enemy, 0.7)) )),
+                         cleanup(( user:retract(holds(0, 12, r(4), enemy, agent)),
+                                   user:retract(holds(0, 12, r(5), agent, enemy)),
+                                   user:retract(holds(1, 7, r(4), agent, enemy)),
+                                   user:retract(attention(3, 9, 0, agent, enemy, 0.7)) )),
+                         true(S == share(2, 3)) ]) :-
+    armed_enemy_link(S).
+
+test(armed_enemy_link_needs_the_sword_in_hand,
+     [ setup(( user:assertz(holds(0, 12, r(4), enemy, agent)),
+               user:retract(holding(0, 12, sword)) )),
+       cleanup(( user:retract(holds(0, 12, r(4), enemy, agent)),
+                 user:assertz(holding(0, 12, sword)) )),
+       true(S == share(0, 2)) ]) :-
+    armed_enemy_link(S).
+
 test(orders_sword_before_enemy, Rs == [r(1)]) :-
     findall(R, orders_sword_before_enemy(R), Rs).
 
