@@ -6,7 +6,8 @@
 #   docs/results.md "Strategies learned back" does, for the agent and for the same
 #   architecture untrained (experiments/bottleneck_init.py --fresh); rgw2 zero-shot (greedy,
 #   one episode: the fixed map) and, on that episode's KB, the relations between the enemy
-#   and the agent that carries the sword (experiments/armed_link.pl).
+#   and the agent that carries the sword (armed_enemy_link/1 of rules/rgw.pl; its untrained
+#   control: experiments/armed_control.py).
 #   sh experiments/bottleneck_measure.sh CHECKPOINT OUTDIR
 set -eu
 CK=$1
@@ -27,8 +28,8 @@ for who in agent untrained; do
 done
 run eval --checkpoint "$CK" --env rgw2 --episodes 1 --json > "$OUT/rgw2.json"
 run extract --checkpoint "$CK" --env rgw2 --episodes 1 --out "$OUT/rgw2-kb" --quiet
-run query --kb "$OUT/rgw2-kb/kb.pl" --rules experiments/armed_link.pl --rules rgw \
-    'armed_link(A), sword_link(S), sword_enemy_link(L)' > "$OUT/rgw2-links.txt"
+run query --kb "$OUT/rgw2-kb/kb.pl" --rules rgw \
+    'armed_enemy_link(A), sword_enemy_link(L)' > "$OUT/rgw2-links.txt"
 grep -o '"success_rate": [0-9.]*' "$OUT/eval-sampled.json" "$OUT/eval-greedy.json" || true
 grep -o '"mean_return": [0-9.-]*' "$OUT/rgw2.json" || true
 grep -H fidelity "$OUT/agent-induce.txt" "$OUT/untrained-induce.txt" || true
