@@ -7,7 +7,7 @@
 #   architecture untrained (experiments/bottleneck_init.py --fresh); rgw2 zero-shot (greedy,
 #   one episode: the fixed map) and, on that episode's KB, the relations between the enemy
 #   and the agent that carries the sword (armed_enemy_link/1 of rules/rgw.pl; its untrained
-#   control: experiments/armed_control.py).
+#   control: experiments/link_control.py).
 #   sh experiments/bottleneck_measure.sh CHECKPOINT OUTDIR
 set -eu
 CK=$1
