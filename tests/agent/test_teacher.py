@@ -1,5 +1,5 @@
 """`--algo imitate --set teacher=CHECKPOINT`: DAgger from a trained agent -- labels, loss,
-choices, refusals, an update that fits the teacher, and a Box-World run through the CLI."""
+refusals, an update that fits the teacher, and a Box-World run through the CLI."""
 
 from __future__ import annotations
 
@@ -16,8 +16,9 @@ from neurosym.agent.agent import load_agent
 from neurosym.agent.checkpoint import read_checkpoint
 from neurosym.agent.config import TrainConfig
 from neurosym.agent.learners.imitation import LabelBuffer, distill_loss, imitation_update
-from neurosym.agent.learners.teacher import load_teacher, teacher_choice
+from neurosym.agent.learners.teacher import load_teacher
 from neurosym.agent.networks.model import ActorCritic
+from neurosym.agent.rollout import select_actions
 from neurosym.envs import make_batched
 from neurosym.errors import ConfigError
 
@@ -32,15 +33,6 @@ def test_distill_loss_is_the_kl_from_the_teachers_probabilities() -> None:
           for qs, ps in zip(probs.tolist(), p.tolist(), strict=True)]  # fmt: skip
     assert distill_loss(logits, probs).item() == pytest.approx(float(np.mean(kl)), rel=1e-5)
     assert distill_loss(torch.log(probs[:1]), probs[:1]).item() == pytest.approx(0.0, abs=1e-6)
-
-
-def test_teacher_choice_draws_from_the_probabilities() -> None:
-    rng = np.random.default_rng(0)
-    sure = np.eye(5, dtype=np.float32)
-    assert teacher_choice(sure, rng).tolist() == [0, 1, 2, 3, 4]
-    probs = np.tile(np.array([[0.5, 0.0, 0.25, 0.25]], np.float32), (20_000, 1))
-    counts = np.bincount(teacher_choice(probs, rng), minlength=4) / 20_000
-    assert counts[1] == 0.0 and counts == pytest.approx([0.5, 0.0, 0.25, 0.25], abs=0.02)
 
 
 def test_a_checkpoints_labels_are_its_policy_and_its_value_in_returns() -> None:
@@ -85,7 +77,7 @@ def test_updates_fit_the_teachers_probabilities() -> None:
     for _ in range(16):
         probs, values = teacher.labels(obs)
         buf.add(obs, probs, values)
-        obs, *_ = venv.step(teacher_choice(probs, rng))
+        obs, *_ = venv.step(select_actions(torch.from_numpy(probs).log(), False).numpy())
     torch.manual_seed(0)
     model = ActorCritic(agent.config)
     model.load_state_dict(agent.model.state_dict())

@@ -59,7 +59,7 @@ from neurosym.agent.learners.process import (
     learner_process,
     report_update,
 )
-from neurosym.agent.learners.teacher import Teacher, load_teacher, teacher_choice
+from neurosym.agent.learners.teacher import Teacher, load_teacher
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
@@ -132,6 +132,15 @@ def distill_loss(logits: torch.Tensor, probs: torch.Tensor) -> torch.Tensor:
 def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """(n,) one of each row's optimal actions (an (n, A) bool set), drawn uniformly."""
     return (rng.random(optimal.shape) * optimal).argmax(axis=1)
+
+
+def own_actions(
+    logits: torch.Tensor, greedy: np.ndarray, generator: torch.Generator | None
+) -> np.ndarray:
+    """(n,) the network's own actions: the most likely in the envs where ``greedy`` (n,) bool
+    is set, drawn from the policy in the others."""
+    sampled = select_actions(logits, greedy=False, generator=generator).numpy()
+    return np.where(greedy, logits.argmax(-1).numpy(), sampled)
 
 
 def expert_share(frames: int, beta_frames: int) -> float:
@@ -284,6 +293,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
         n_actions = int(venv.single_action_space.n)
         buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype, n_actions)
         safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
+        greedy = np.arange(venv.num_envs) < round(config.imitate.greedy_share * venv.num_envs)
         frames = ctx.frames0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:
@@ -296,11 +306,11 @@ def imitation_learner(ctx: LearnerContext) -> None:
                     expert = planner_choice(policy, rng)
                 else:
                     (policy, values), regret = teacher.labels(obs), None
-                    expert = teacher_choice(policy, rng)
+                    expert = select_actions(torch.from_numpy(policy).log(), False, generator).numpy()
                 targets = planner.next_contacts(venv) if attend else None
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
-                mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
+                mine = own_actions(logits.cpu(), greedy, generator)
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end

@@ -40,13 +40,6 @@ class Teacher:
         return probs.cpu().numpy(), values.cpu().numpy()
 
 
-def teacher_choice(probs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """(n,) an action per row drawn from the teacher's probabilities (n, A)."""
-    cum = np.cumsum(probs, axis=1)
-    draws = rng.random((len(probs), 1)) * cum[:, -1:]
-    return np.minimum((cum < draws).sum(axis=1), probs.shape[1] - 1)
-
-
 def load_teacher(
     spec: str, env: str, obs_shape: tuple[int, ...], n_actions: int, device: Any = "cpu"
 ) -> Teacher:
