@@ -508,7 +508,7 @@ class ImitationConfig:
     """share of the envs whose own actions are the network's most likely ones, not sampled
     (``--set greedy_share=S``): DAgger then labels the states greedy play reaches, its loops
     included, which sampled play leaves by chance"""
-    teacher: str = ""
+    teacher: str = field(default="", metadata={"shown": "none: the planner"})
     """a trained agent whose policy labels the states instead of the planner (a checkpoint,
     a shipped agent's name or an SB3 .zip; ``--set teacher=CHECKPOINT``): the loss is the KL
     from its action probabilities and the critic fits its value (0 for an agent without one).
