@@ -107,6 +107,32 @@ def test_the_sb3_example_trains_and_its_zip_is_extracted_and_queried(
     assert "stable-baselines3 PPO" in (out / "index.html").read_text()
 
 
+def test_an_sb3_zip_teaches_as_a_dagger_teacher(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--algo imitate --set teacher=ppo.zip: its labels are its policy's probabilities."""
+    import numpy as np
+    import torch
+
+    from neurosym.agent.agent import load_agent
+    from neurosym.agent.learners.teacher import load_teacher
+    from neurosym.envs import make_batched
+
+    model = tmp_path / "ppo.zip"
+    monkeypatch.setattr(sys, "argv", ["sb3_agent.py", "--steps", "256", "--out", str(model)])
+    runpy.run_path(str(EXAMPLES / "sb3_agent.py"), run_name="__main__")
+    agent = load_agent(str(model), play_env=ENV)
+    teacher = load_teacher(str(model), ENV, agent.config.obs_shape, agent.config.n_actions)
+    venv = make_batched(ENV, 3, seed=1)
+    obs, _ = venv.reset(seed=1)
+    probs, values = teacher.labels(obs)
+    assert probs.shape == (3, agent.config.n_actions) and values.shape == (3,)
+    assert probs.sum(1) == pytest.approx(np.ones(3), abs=1e-5)
+    with torch.no_grad():
+        logits = agent.model(torch.from_numpy(obs))[0]
+    assert probs == pytest.approx(torch.softmax(logits, -1).numpy(), abs=1e-6)
+
+
 @pytest.mark.parametrize(
     ("checkpoint", "message"),
     [
