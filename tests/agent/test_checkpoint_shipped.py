@@ -242,17 +242,19 @@ def test_the_bottleneck_predinet_names_its_next_object_in_the_facts_its_policy_r
 
 
 @pytest.mark.expensive
-def test_the_box_world_bottleneck_acts_through_facts_that_predict_its_choices() -> None:
-    """bw2's fact-bottleneck PrediNet, taught bw2-predinet's policy (--set teacher=...): its KB
-    is written at abs:0.25, the bits its policy read; on held-out levels those facts predict
-    its next object and its action well above an untrained network's on the same states
-    (shipped, 100 episodes: 0.57 and 0.80 against 0.26 and 0.28)."""
+@pytest.mark.parametrize("name", [n for n in BOTTLENECKS if n in BOXWORLD])
+def test_the_box_world_bottlenecks_act_through_facts_that_predict_their_choices(name: str) -> None:
+    """Box-World's fact-bottleneck PrediNets, each taught its level's shipped PrediNet's policy
+    (--set teacher=...): the KB is written at abs:0.25, the bits the policy read; on held-out
+    levels those facts predict its next object and its action well above an untrained
+    network's on the same states (bw2, 100 episodes: 0.57 and 0.80 against 0.26 and 0.28)."""
     from neurosym.record.extraction import extract, model_threshold
 
-    agent = load_agent(CHECKPOINTS / "bw2-predinet-bottleneck.pt")
+    agent = load_agent(CHECKPOINTS / f"{name}.pt")
     assert agent.config.relation_bits == 0.25
     assert model_threshold(agent.config) == "abs:0.25"
-    assert agent.meta["train_config"]["teacher"] == "checkpoints/bw2-predinet.pt"
+    teacher = f"checkpoints/{agent.env_name}-predinet.pt"
+    assert agent.meta["train_config"]["teacher"] == teacher
     got = extract(agent, episodes=30, seed=UNSEEN)
     assert got.faithfulness is not None
     for target in ("next_object", "action"):
