@@ -504,10 +504,6 @@ class ImitationConfig:
     """weight of a loss that PrediNet head 0's second argument attends the next key object on
     the planner's route (RGW; 0: none; ``--set attend_coef=C``): with the fact bottleneck its
     KB then names the goal its policy steers by (attends/8)"""
-    greedy_share: float = field(default=0.0, metadata=bounded("[0, 1]"))
-    """share of the envs whose own actions are the network's most likely ones, not sampled
-    (``--set greedy_share=S``): DAgger then labels the states greedy play reaches, its loops
-    included, which sampled play leaves by chance"""
     teacher: str = field(default="", metadata={"shown": "none: the planner"})
     """a trained agent whose policy labels the states instead of the planner (a checkpoint,
     a shipped agent's name or an SB3 .zip; ``--set teacher=CHECKPOINT``): the loss is the KL

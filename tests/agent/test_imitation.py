@@ -21,7 +21,6 @@ from neurosym.agent.learners.imitation import (
     expert_share,
     imitation_loss,
     imitation_update,
-    own_actions,
 )
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.envs import make_batched
@@ -72,17 +71,6 @@ def test_imitation_loss_is_cross_entropy_of_the_set() -> None:
         -torch.log(p[:, 0] + p[:, 1]).mean().item()
     )
     assert imitation_loss(logits, torch.ones(2, 4, dtype=torch.bool)).item() == pytest.approx(0.0)
-
-
-def test_own_actions_are_greedy_in_the_greedy_envs_and_sampled_in_the_others() -> None:
-    logits = torch.log(torch.tensor([[0.1, 0.6, 0.2, 0.1]] * 4000))
-    greedy = np.arange(4000) < 1000
-    acts = own_actions(logits, greedy, torch.Generator().manual_seed(0))
-    assert (acts[:1000] == 1).all()
-    counts = np.bincount(acts[1000:], minlength=4) / 3000
-    assert counts == pytest.approx([0.1, 0.6, 0.2, 0.1], abs=0.03)
-    with pytest.raises(ConfigError, match=r"^greedy_share must be a finite number in \[0, 1\], got 1.5$"):
-        TrainConfig.for_family("rgw", algo="imitate", greedy_share=1.5)
 
 
 def test_expert_share_falls_linearly_to_zero() -> None:

@@ -134,15 +134,6 @@ def planner_choice(optimal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return (rng.random(optimal.shape) * optimal).argmax(axis=1)
 
 
-def own_actions(
-    logits: torch.Tensor, greedy: np.ndarray, generator: torch.Generator | None
-) -> np.ndarray:
-    """(n,) the network's own actions: the most likely in the envs where ``greedy`` (n,) bool
-    is set, drawn from the policy in the others."""
-    sampled = select_actions(logits, greedy=False, generator=generator).numpy()
-    return np.where(greedy, logits.argmax(-1).numpy(), sampled)
-
-
 def expert_share(frames: int, beta_frames: int) -> float:
     """DAgger's beta: the chance that a step follows the planner, 1 at the start, 0 after ``beta_frames``."""
     if beta_frames <= 0:
@@ -293,7 +284,6 @@ def imitation_learner(ctx: LearnerContext) -> None:
         n_actions = int(venv.single_action_space.n)
         buffer = LabelBuffer(config.imitate.dagger_buffer, obs.shape[1:], obs.dtype, n_actions)
         safe_loss = config.imitate.safe_coef > 0  # regrets only where the loss reads them
-        greedy = np.arange(venv.num_envs) < round(config.imitate.greedy_share * venv.num_envs)
         frames = ctx.frames0
         parent = os.getppid()
         while not ctx.stop.is_set() and os.getppid() == parent:
@@ -310,7 +300,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
                 targets = planner.next_contacts(venv) if attend else None
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
-                mine = own_actions(logits.cpu(), greedy, generator)
+                mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()
                 follow = rng.random(len(mine)) < beta
                 actions = np.where(follow, expert, mine)
                 real = ~tracker.pending  # an autoreset step's observation is the last one's end
