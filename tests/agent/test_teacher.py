@@ -22,7 +22,7 @@ from neurosym.agent.rollout import select_actions
 from neurosym.envs import make_batched
 from neurosym.errors import ConfigError
 
-TEACHER = "checkpoints/bw1-predinet.pt"
+TEACHER = "bw1-predinet"  # a shipped name: found from any working directory
 
 
 def test_distill_loss_is_the_kl_from_the_teachers_probabilities() -> None:
@@ -50,8 +50,8 @@ def test_a_checkpoints_labels_are_its_policy_and_its_value_in_returns() -> None:
 
 
 def test_a_teacher_of_other_observations_is_refused_in_one_line() -> None:
-    with pytest.raises(ConfigError, match=r"^--set teacher=checkpoints/rgw1-predinet.pt: .*rgw"):
-        load_teacher("checkpoints/rgw1-predinet.pt", "bw1", (22, 14, 14), 4)
+    with pytest.raises(ConfigError, match=r"^--set teacher=rgw1-predinet: .*rgw"):
+        load_teacher("rgw1-predinet", "bw1", (22, 14, 14), 4)
     with pytest.raises(ConfigError, match=r"^--set teacher=nothing.pt: "):
         load_teacher("nothing.pt", "bw1", (22, 14, 14), 4)
     agent = load_agent(TEACHER)
