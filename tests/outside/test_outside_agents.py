@@ -85,12 +85,20 @@ def test_the_torch_example_goes_through_extract_query_intervene_and_report(tmp_p
         assert "evil.py" in (out / "index.html").read_text()  # the page names it, nothing more
 
 
+@pytest.fixture(scope="module")
+def sb3_model(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The SB3 example's model (examples/own_agent/sb3_agent.py, 256 steps), trained once."""
+    model = tmp_path_factory.mktemp("sb3") / "ppo.zip"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(sys, "argv", ["sb3_agent.py", "--steps", "256", "--out", str(model)])
+        runpy.run_path(str(EXAMPLES / "sb3_agent.py"), run_name="__main__")
+    return model
+
+
 def test_the_sb3_example_trains_and_its_zip_is_extracted_and_queried(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    sb3_model: Path, tmp_path: Path
 ) -> None:
-    model = tmp_path / "ppo.zip"
-    monkeypatch.setattr(sys, "argv", ["sb3_agent.py", "--steps", "256", "--out", str(model)])
-    runpy.run_path(str(EXAMPLES / "sb3_agent.py"), run_name="__main__")
+    model = sb3_model
     out = tmp_path / "sb3"
     assert main(["extract", "--checkpoint", str(model), "--env", ENV, "--episodes", "2", *SHORT,
                  "--out", str(out), "--quiet"]) == 0  # fmt: skip
@@ -107,9 +115,7 @@ def test_the_sb3_example_trains_and_its_zip_is_extracted_and_queried(
     assert "stable-baselines3 PPO" in (out / "index.html").read_text()
 
 
-def test_an_sb3_zip_teaches_as_a_dagger_teacher(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_an_sb3_zip_teaches_as_a_dagger_teacher(sb3_model: Path) -> None:
     """--algo imitate --set teacher=ppo.zip: its labels are its policy's probabilities."""
     import numpy as np
     import torch
@@ -118,9 +124,7 @@ def test_an_sb3_zip_teaches_as_a_dagger_teacher(
     from neurosym.agent.learners.teacher import load_teacher
     from neurosym.envs import make_batched
 
-    model = tmp_path / "ppo.zip"
-    monkeypatch.setattr(sys, "argv", ["sb3_agent.py", "--steps", "256", "--out", str(model)])
-    runpy.run_path(str(EXAMPLES / "sb3_agent.py"), run_name="__main__")
+    model = sb3_model
     agent = load_agent(str(model), play_env=ENV)
     teacher = load_teacher(str(model), ENV, agent.config.obs_shape, agent.config.n_actions)
     venv = make_batched(ENV, 3, seed=1)

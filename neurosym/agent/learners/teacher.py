@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from neurosym.errors import ConfigError
+from neurosym.errors import CheckpointError, ConfigError
 
 
 class Teacher:
@@ -46,7 +46,6 @@ def load_teacher(
     """The teacher named ``spec`` for a student on ``env`` with these observations and actions;
     ConfigError, one line, when it cannot teach it."""
     from neurosym.agent.agent import load_agent
-    from neurosym.errors import CheckpointError
 
     try:
         agent = load_agent(spec, env=env, play_env=env)
