@@ -502,8 +502,10 @@ class ImitationConfig:
     planner are symmetric), so that the network does not memorise its labelled states"""
     attend_coef: float = field(default=0.0, metadata=bounded("[0, 100]"))
     """weight of a loss that PrediNet head 0's second argument attends the next key object on
-    the planner's route (RGW; 0: none; ``--set attend_coef=C``): with the fact bottleneck its
-    KB then names the goal its policy steers by (attends/8)"""
+    the route (RGW's planner; Box-World's fewest-boxes route, where the first argument is also
+    taught the held key when that object is the lock it opens; 0: none; ``--set
+    attend_coef=C``): with the fact bottleneck its KB then names the goal its policy steers by
+    (attends/8)"""
     teacher: str = field(default="", metadata={"shown": "none: the planner"})
     """a trained agent whose policy labels the states instead of the planner (a checkpoint,
     a shipped agent's name or an SB3 .zip; ``--set teacher=CHECKPOINT``): the loss is the KL

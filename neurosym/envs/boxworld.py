@@ -372,6 +372,13 @@ class BoxWorldVectorEnv(VectorEnv):
         """(n, 14, 14) entity codes of the current states; names in ``entity_names``."""
         return self._state.entity_grid()
 
+    def solver_states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(n, 196) entity codes, (n, 196) distractor-lock flags, (n,) agent cells and (n,) held
+        key colours (-1 none) of the current states (copies): what
+        :func:`boxworld_solver.search` starts from."""
+        s = self._state
+        return s.grid.copy(), s.distractor.copy(), s.agent.copy(), s.held.astype(np.int64)
+
     def render(self) -> tuple[np.ndarray, ...] | tuple[str, ...] | None:
         grids = self.entity_grid()
         if self.render_mode == "rgb_array":

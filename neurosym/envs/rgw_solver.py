@@ -614,6 +614,13 @@ class Planner:
             [plan.next_contact(0, *state) for plan, state in self._states(venv)], dtype=np.int16
         )
 
+    def attention_targets(self, venv: object) -> np.ndarray:
+        """(n, 2) int16 cells for PrediNet head 0's two arguments (``attend_coef``): none (-1)
+        for the first, :meth:`next_contacts` for the second."""
+        targets = np.full((venv.num_envs, 2), -1, dtype=np.int16)
+        targets[:, 1] = self.next_contacts(venv)
+        return targets
+
     def _states(self, venv: object) -> list[tuple[Plan, tuple[int, int, int]]]:
         env = getattr(venv, "unwrapped", venv)
         cells, starts = env.current_levels()

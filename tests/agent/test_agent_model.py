@@ -365,3 +365,25 @@ def test_cells_xy_keys_tell_two_cells_of_one_kind_apart_and_start_as_cell_keys()
         switched.relational.key.weight[:, -2:].normal_()  # now the coordinates count
         a = switched(obs, introspect=True)[2].attention2[0].reshape(-1, 10, 10)
     assert not torch.allclose(a[:, 7, 7], a[:, 5, 1])
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [{}, {"keys": "cells"}, {"keys": "cells_xy"}, {"query": "learned"}, {"relation_bits": 0.25}],
+)
+def test_attention_logits_are_the_scores_of_the_attention_the_heads_use(kw) -> None:
+    """PrediNet.attention_logits (what the attention target's loss reads) has the recorded
+    attentions as its softmax, for every query and key mode."""
+    model = make("predinet", **kw)
+    obs = torch.randint(0, 2, (3, *RGW[0]), dtype=torch.uint8)
+    seen = []
+    hook = model.relational.register_forward_pre_hook(lambda m, args: seen.append(args))
+    with torch.no_grad():
+        _, _, intro = model(obs, introspect=True)
+        args = seen[-1]
+        scores = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
+    hook.remove()
+    H = model.relational.heads
+    a = torch.softmax(scores, dim=-1)
+    torch.testing.assert_close(a[:, :H], intro.attention1)
+    torch.testing.assert_close(a[:, H:], intro.attention2)

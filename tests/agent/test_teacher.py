@@ -91,6 +91,50 @@ def test_updates_fit_the_teachers_probabilities() -> None:
     assert last < 0.5 * first, (first, last)
 
 
+@pytest.mark.expensive
+def test_attend_coef_teaches_head_0_the_key_and_the_lock_it_opens() -> None:
+    """Box-World's route targets on the teacher's own network: after a few updates head 0's
+    second argument is on the route's next object and, where that is a lock, its first on the
+    held key; before, the network (whose attention is near one-hot elsewhere) looked there on
+    few states."""
+    from neurosym.envs.boxworld_solver import RouteTargets
+
+    agent = load_agent(TEACHER)
+    teacher = load_teacher(TEACHER, "bw1", agent.config.obs_shape, agent.config.n_actions)
+    venv = make_batched("bw1", 32, seed=6, **agent.env_kwargs)
+    obs, _ = venv.reset(seed=6)
+    route = RouteTargets()
+    buf = LabelBuffer(512, obs.shape[1:], obs.dtype, agent.config.n_actions)
+    for _ in range(16):
+        probs, values = teacher.labels(obs)
+        buf.add(obs, probs, values, targets=route.attention_targets(venv))
+        obs, *_ = venv.step(select_actions(torch.from_numpy(probs).log(), False).numpy())
+    model = ActorCritic(agent.config)
+    model.load_state_dict(agent.model.state_dict())
+    targets = buf.targets.astype(np.int64)
+    first, second = targets[:, 0] >= 0, targets[:, 1] >= 0
+    assert first.sum() > 30 and second.mean() > 0.9
+
+    def hits() -> tuple[float, float]:
+        with torch.no_grad():
+            _, _, intro = model(torch.from_numpy(buf.obs), introspect=True)
+        a1 = intro.attention1[:, 0].argmax(-1).numpy()
+        a2 = intro.attention2[:, 0].argmax(-1).numpy()
+        return (float((a1 == targets[:, 0])[first].mean()),
+                float((a2 == targets[:, 1])[second].mean()))  # fmt: skip
+
+    before = hits()
+    train = TrainConfig.for_family("boxworld", algo="imitate", teacher=TEACHER, attend_coef=1.0,
+                                   dagger_batch=256, dagger_steps=10)  # fmt: skip
+    opt = torch.optim.Adam(model.parameters(), lr=2e-3)
+    rng = np.random.default_rng(0)
+    torch.manual_seed(0)
+    for _ in range(8):
+        imitation_update(model, opt, buf, train, rng, torch.device("cpu"))
+    after = hits()
+    assert after[0] > 0.9 and after[1] > 0.8 and max(before) < 0.5, (before, after)
+
+
 def test_a_teacher_gives_no_safe_set(
     train_refused: Callable[..., subprocess.CompletedProcess[str]], tmp_path: Path
 ) -> None:
@@ -111,12 +155,14 @@ def test_train_imitates_a_teacher_on_box_world_and_resumes(
     neurosym = functools.partial(run_neurosym, timeout=180)
     out = tmp_path / "run"
     first = neurosym("train", "--env", "bw1", "--module", "predinet", "--algo", "imitate",
-                     "--set", f"teacher={TEACHER}", "--envs", "4", "--n-steps", "8",
+                     "--set", f"teacher={TEACHER}", "--set", "attend_coef=1",
+                     "--envs", "4", "--n-steps", "8",
                      "--dagger-steps", "2", "--frames", "100", "--quiet",
                      "--eval-episodes", "2", "--out", out)  # fmt: skip
     assert first.returncode == 0, first.stderr[-2000:]
     payload = read_checkpoint(out / "checkpoint.pt")
     assert payload["train_config"]["teacher"] == TEACHER
+    assert payload["train_config"]["attend_coef"] == 1.0  # Box-World's route targets
     assert f"--set teacher={TEACHER}" in payload["command"]
     metrics = (out / "metrics.csv").read_text().splitlines()
     assert len(metrics) >= 2 and float(metrics[-1].split(",")[9]) > 0  # the KL, logged

@@ -163,3 +163,49 @@ def test_solver_sees_blocked_and_unsolvable_levels():
     ).to_arrays()
     assert not search(*level_grid(leaky, 0)).solvable
     assert search(*level_grid(leaky, 0), stop_at_distractor=False).gem_after_distractor
+
+
+@pytest.mark.parametrize("name", ["bw2", "bw3"])
+def test_route_targets_lead_every_level_to_the_gem(name):
+    """Walking to the second target each step (plain BFS through empty cells) wins every level,
+    and the agent only ever walks into the object it was told: a key, then the lock that key
+    opens, and so on. The first target is the held key's cell exactly when the second is a lock
+    of the held key's colour."""
+    from neurosym.envs import make_batched
+    from neurosym.envs.boxworld_solver import HELD_CELL, RouteTargets
+
+    n = 24
+    venv = make_batched(name, n, seed=77)
+    venv.reset(seed=77)
+    env = venv.unwrapped
+    route = RouteTargets()
+    outcomes: list[str | None] = [None] * n
+    contacts = 0
+    for _ in range(400):
+        targets = route.attention_targets(venv)
+        grids, _, agents, held = env.solver_states()
+        assert targets.dtype == np.int16 and targets.shape == (n, 2)
+        live = [i for i in range(n) if outcomes[i] is None]
+        for i in live:
+            cell = int(targets[i, 1])
+            code = int(grids[i, cell])
+            assert KEY <= code < HELD or code == GEM
+            opens = LOCK <= code < HELD and code - LOCK == held[i]
+            assert targets[i, 0] == (HELD_CELL if opens else -1)
+            assert not (LOCK <= code < HELD) or opens  # a lock is named only with its key held
+        actions = np.array(
+            [walk(grids[i], int(agents[i]), [int(targets[i, 1])])[0] if targets[i, 1] >= 0 else 0
+             for i in range(n)]  # fmt: skip
+        )
+        _, _, terminated, truncated, info = venv.step(actions)
+        moved = env.solver_states()[2]
+        for i in live:
+            if terminated[i] or truncated[i]:
+                outcomes[i] = env.episode_outcome(info, i)
+            elif moved[i] != agents[i] and grids[i, moved[i]] != 0:  # walked into an object
+                assert moved[i] == targets[i, 1]
+                contacts += 1
+        if all(o is not None for o in outcomes):
+            break
+    assert outcomes == ["gem"] * n
+    assert contacts >= n  # objects walked into before the gem

@@ -21,9 +21,11 @@ miss its optimum, which the fastest-route loss weighs like any other. The
 critic is fitted to the planner's best return still to earn (times
 ``reward_scale``), so that a later RL run can start from it.
 
-With ``attend_coef`` C > 0 (RGW, PrediNet) the loss adds ``C * -log a(target)``:
+With ``attend_coef`` C > 0 (RGW and Box-World, PrediNet) the loss adds ``C * -log a(target)``:
 PrediNet head 0's second attention on the cell of the next key object on the
-planner's route (:meth:`Planner.next_contacts`). Under the fact bottleneck
+planner's route (:meth:`Planner.next_contacts`; Box-World's fewest-boxes route,
+:class:`boxworld_solver.RouteTargets`, whose first attention is also taught the held key
+when that object is the lock it opens). Under the fact bottleneck
 (``ModelConfig.relation_bits``) the policy sees only what the heads attend and
 the bits between them, so this names its current goal in its own facts
 (``attends/8`` of head 0, argument 2), as a concept-bottleneck model is taught
@@ -36,7 +38,8 @@ sampled actions are the expert's. Any family, Box-World too.
 
 Started and reporting as every learner (:mod:`neurosym.agent.learners.process`);
 one process, no torchrun. The planners: RGW's (:mod:`neurosym.envs.rgw_solver`) and
-Minigrid DoorKey's (:mod:`neurosym.envs.minigrid_solver`); Box-World has none here.
+Minigrid DoorKey's (:mod:`neurosym.envs.minigrid_solver`); Box-World has none here (a
+teacher labels it; its route search gives only the attention targets).
 """
 
 from __future__ import annotations
@@ -75,7 +78,7 @@ class LabelBuffer:
         self.policy = np.zeros((capacity, n_actions), dtype=np.float32)
         self.safe = np.ones((capacity, n_actions), dtype=bool)
         self.values = np.zeros(capacity, dtype=np.float32)
-        self.targets = np.full(capacity, -1, dtype=np.int16)  # next contact's cell, -1 none
+        self.targets = np.full((capacity, 2), -1, dtype=np.int16)  # head 0's cells, -1 none
         self.size = 0
         self._next = 0
 
@@ -88,12 +91,12 @@ class LabelBuffer:
         targets: np.ndarray | None = None,
     ) -> None:
         """Append states; ``policy`` (n, A): an optimal set (bool) or probabilities; ``safe``
-        (n, A) bool: actions that give no return up (default: all); ``targets`` (n,) the cell
-        of the next key object on the planner's route (default: -1)."""
+        (n, A) bool: actions that give no return up (default: all); ``targets`` (n, 2) the
+        cells head 0's two arguments are taught (``attention_targets``; default: -1, none)."""
         if safe is None:
             safe = np.ones(policy.shape, dtype=bool)
         if targets is None:
-            targets = np.full(len(obs), -1, dtype=np.int16)
+            targets = np.full((len(obs), 2), -1, dtype=np.int16)
         for start in range(0, len(obs), len(self.obs)):  # a batch larger than the ring wraps
             o, m, v, s, g = (
                 x[start : start + len(self.obs)] for x in (obs, policy, values, safe, targets)
@@ -141,28 +144,29 @@ def expert_share(frames: int, beta_frames: int) -> float:
     return max(0.0, 1.0 - frames / beta_frames)
 
 
-def attention_target_nll(attention: torch.Tensor, targets: torch.Tensor) -> torch.Tensor:
-    """Mean of ``-log attention[b, targets[b]]`` over the rows with a target; (B, N), (B,) long
-    with -1 for none (0 when no row has one)."""
+def attention_target_nll(logits: torch.Tensor, targets: torch.Tensor) -> torch.Tensor:
+    """Mean of ``-log softmax(logits)[b, targets[b]]`` over the rows with a target; (B, N)
+    attention scores, (B,) long with -1 for none (0 when no row has one)."""
     has = targets >= 0
     if not has.any():
-        return attention.sum() * 0.0
-    picked = attention[has].gather(1, targets[has, None]).squeeze(1)
-    return -torch.log(picked.clamp_min(1e-8)).mean()
+        return logits.sum() * 0.0
+    logp = torch.log_softmax(logits[has], dim=-1)
+    return -logp.gather(1, targets[has, None]).mean()
 
 
 def augment_with_targets(
     obs: torch.Tensor, sets: torch.Tensor, targets: torch.Tensor, generator: torch.Generator | None
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """:func:`augment_batch` that moves each row's target cell (-1: none) with its level: the
-    cell rides along as one more observation plane."""
+    """:func:`augment_batch` that moves each row's target cells ((B, K), -1: none) with its
+    level: each column rides along as one more observation plane."""
     B, C, H, W = obs.shape
-    plane = torch.zeros(B, 1, H * W, dtype=obs.dtype)
-    has = targets >= 0
-    plane[has, 0, targets[has]] = 1
-    turned, sets = augment_batch(torch.cat([obs, plane.view(B, 1, H, W)], dim=1), sets, generator)
-    flat = turned[:, C].reshape(B, -1)
-    return turned[:, :C].contiguous(), sets, torch.where(has, flat.argmax(1), -1)
+    K = targets.shape[1]
+    planes = torch.zeros(B, K, H * W, dtype=obs.dtype)
+    rows, cols = (targets >= 0).nonzero(as_tuple=True)
+    planes[rows, cols, targets[rows, cols]] = 1
+    turned, sets = augment_batch(torch.cat([obs, planes.view(B, K, H, W)], dim=1), sets, generator)
+    flat = turned[:, C:].reshape(B, K, -1)
+    return turned[:, :C].contiguous(), sets, torch.where(targets >= 0, flat.argmax(-1), -1)
 
 
 def imitation_update(
@@ -177,9 +181,9 @@ def imitation_update(
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
     attend = config.imitate.attend_coef
-    seen: list[torch.Tensor] = []
+    seen: list[tuple[Any, ...]] = []  # the PrediNet's inputs (entities, ..., cells)
     hook = (
-        model.relational.hook_attention2.register_forward_hook(lambda m, i, out: seen.append(out))
+        model.relational.register_forward_pre_hook(lambda m, args: seen.append(args))
         if attend
         else None
     )
@@ -202,7 +206,7 @@ def _imitation_step(
     rng: np.random.Generator,
     device: torch.device,
     generator: torch.Generator | None,
-    seen: list[torch.Tensor],
+    seen: list[tuple[Any, ...]],
 ) -> list[float]:
     """One minibatch's gradient step: policy, safe, attention and value losses."""
     obs, policy, values, safe, targets = buffer.sample(config.imitate.dagger_batch, rng)
@@ -222,8 +226,13 @@ def _imitation_step(
         policy_loss = policy_loss + config.imitate.safe_coef * imitation_loss(
             logits, safe.to(device)
         )
-    if config.imitate.attend_coef:  # head 0's second argument on the next object's cell
-        nll = attention_target_nll(seen[-1][:, 0], targets.to(device))
+    if config.imitate.attend_coef:  # head 0's arguments on the route's cells
+        args = seen[-1]  # (entities, introspect[, queries, cells])
+        scores = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
+        targets = targets.to(device)
+        heads = model.relational.heads
+        nll = attention_target_nll(scores[:, 0], targets[:, 0])
+        nll = nll + attention_target_nll(scores[:, heads], targets[:, 1])
         policy_loss = policy_loss + config.imitate.attend_coef * nll
     value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
     loss = policy_loss + config.value_coef * value_loss
@@ -239,10 +248,16 @@ def _imitation_step(
 
 
 def planner_for(env_name: str) -> Any:
-    """The optimal planner of an env's family (RGW's, or Minigrid DoorKey's)."""
+    """The optimal planner of an env's family (RGW's, or Minigrid DoorKey's); Box-World's
+    route search, which gives attention targets only."""
     from neurosym.envs.registration import env_family
 
-    if env_family(env_name) == "minigrid":
+    family = env_family(env_name)
+    if family == "boxworld":
+        from neurosym.envs.boxworld_solver import RouteTargets
+
+        return RouteTargets()
+    if family == "minigrid":
         from neurosym.envs.minigrid_solver import DoorKeyPlanner as MinigridPlanner
 
         return MinigridPlanner()
@@ -277,7 +292,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
         local, local_opt = private_copy(ctx.shared, ctx.optimizer, config, dev)
         venv = make_batched(ctx.env_name, config.envs, seed=ctx.env_seed, **ctx.env_kwargs)
         obs, _ = venv.reset(seed=ctx.env_seed)
-        attend = config.imitate.attend_coef > 0  # next contacts only where the loss reads them
+        attend = config.imitate.attend_coef > 0  # route targets only where the loss reads them
         teacher = _teacher(ctx, venv, dev)
         planner = planner_for(ctx.env_name) if teacher is None or attend else None
         tracker = EpisodeTracker(venv.num_envs)
@@ -297,7 +312,7 @@ def imitation_learner(ctx: LearnerContext) -> None:
                 else:
                     (policy, values), regret = teacher.labels(obs), None
                     expert = select_actions(torch.from_numpy(policy).log(), False, generator).numpy()
-                targets = planner.next_contacts(venv) if attend else None
+                targets = planner.attention_targets(venv) if attend else None
                 with torch.no_grad():
                     logits, _ = local(torch.from_numpy(obs).to(dev))
                 mine = select_actions(logits.cpu(), greedy=False, generator=generator).numpy()

@@ -251,20 +251,30 @@ class PrediNet(nn.Module):
                 recording.parts.append(q)
         return a, e
 
-    def _cell_attention(
-        self, L: torch.Tensor, cells: torch.Tensor
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Attention whose keys are the cells' observations: a (B, 2H, N), e = a L (B, 2H, F)."""
+    def attention_logits(self, L: torch.Tensor, cells: torch.Tensor | None = None) -> torch.Tensor:
+        """(B, 2H, N) the attention's scores before the softmax (the heads' first arguments, then
+        their second), by plain autograd for every query and key mode. A loss on where a head
+        looks reads these (``log_softmax``): a saturated softmax's probabilities carry no gradient
+        to the cells it ignores."""
         B, N, F = L.shape
         if self.query_mode == "learned":
             q = self.queries.view(1, -1, self.key_size).expand(B, -1, -1)  # (B, 2H, D)
         else:
             w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
             q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, self.key_size)  # (B, 2H, D)
-        if self.keys == "cells_xy":  # what each cell holds and where it is
-            cells = torch.cat([cells, L[..., -2:]], dim=-1)
-        scores = (q @ self.key.weight) @ cells.transpose(1, 2)  # (B, 2H, N)
-        a = torch.softmax(scores * self.scale, dim=-1)
+        if self.keys == "entities":
+            keys = L
+        elif cells is None:
+            raise ValueError("PrediNet with keys='cells' needs the cells' observations")
+        else:  # cells_xy: what each cell holds and where it is
+            keys = torch.cat([cells, L[..., -2:]], dim=-1) if self.keys == "cells_xy" else cells
+        return (q @ self.key.weight) @ keys.transpose(1, 2) * self.scale  # (B, 2H, N)
+
+    def _cell_attention(
+        self, L: torch.Tensor, cells: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Attention whose keys are the cells' observations: a (B, 2H, N), e = a L (B, 2H, F)."""
+        a = torch.softmax(self.attention_logits(L, cells), dim=-1)
         return a, a @ L
 
     def forward(

@@ -304,7 +304,7 @@ def _new(
 
 def _check_learner(plan: RunPlan) -> None:
     """Refuse a learner that cannot run distributed under torchrun, and an attention target
-    without the PrediNet and RGW planner it needs."""
+    without the PrediNet and the route (RGW's planner, Box-World's search) it needs."""
     if plan.world.distributed and plan.train_config.algo != "ppo":
         raise ConfigError(
             "torchrun trains the synchronous learner: pass --algo ppo "
@@ -314,10 +314,11 @@ def _check_learner(plan: RunPlan) -> None:
         _check_teacher(plan)
     attend = plan.train_config.algo == "imitate" and plan.train_config.imitate.attend_coef > 0
     # a module whose recordings have attends/8 has the two attended arguments the loss teaches
-    if attend and (plan.family != "rgw" or not module_has(plan.model_config.module, "attends")):
+    routed = plan.family in ("rgw", "boxworld")
+    if attend and (not routed or not module_has(plan.model_config.module, "attends")):
         raise ConfigError(
-            f"attend_coef teaches PrediNet head 0 the RGW planner's next object; this run "
-            f"is {plan.model_config.module} on {plan.family} (leave it at 0)"
+            f"attend_coef teaches PrediNet head 0 the next object on an RGW or Box-World route; "
+            f"this run is {plan.model_config.module} on {plan.family} (leave it at 0)"
         )
 
 
