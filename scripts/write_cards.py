@@ -90,7 +90,12 @@ CARDS: dict[str, tuple[str, str, str, dict[str, Any]]] = {
     "bw1-predinet": ("thesis agent", "bw1", "", bw(300, 289)),
     "bw2-predinet": ("thesis agent; relates the agent to locks", "bw2", "", bw(300, 293)),
     "bw3-predinet": ("thesis agent", "bw3", "", bw(297, 259)),
-    "bw2-predinet-bottleneck": ("fact bottleneck: best relater", "bw2", "", bw(300, 297)),
+    "bw2-predinet-bottleneck": (
+        "fact bottleneck: best relater (held key - lock)", "bw2", "", bw(300, 292)
+    ),
+    "bw3-predinet-bottleneck": (
+        "fact bottleneck: best relater (held key - lock)", "bw3", "", bw(300, 260)
+    ),
     "bw1-mhdpa": ("thesis agent", "bw1", "", bw(300, 284)),
     "bw2-mhdpa": ("thesis agent", "bw2", "", bw(293, 226)),
     "bw3-mhdpa": ("thesis agent", "bw3", "", bw(300, 257)),
