@@ -382,8 +382,12 @@ def test_attention_logits_are_the_scores_of_the_attention_the_heads_use(kw) -> N
         _, _, intro = model(obs, introspect=True)
         args = seen[-1]
         scores = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
+        head0 = model.relational.attention_logits(
+            args[0], args[3] if len(args) > 3 else None, rows=[0, model.relational.heads]
+        )
     hook.remove()
     H = model.relational.heads
     a = torch.softmax(scores, dim=-1)
     torch.testing.assert_close(a[:, :H], intro.attention1)
     torch.testing.assert_close(a[:, H:], intro.attention2)
+    torch.testing.assert_close(head0, scores[:, [0, H]])  # the rows alone: the same scores

@@ -228,11 +228,13 @@ def _imitation_step(
         )
     if config.imitate.attend_coef:  # head 0's arguments on the route's cells
         args = seen[-1]  # (entities, introspect[, queries, cells])
-        scores = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
+        head0 = [0, model.relational.heads]  # head 0's first and second argument: 2 of 2H queries
+        scores = model.relational.attention_logits(
+            args[0], args[3] if len(args) > 3 else None, rows=head0
+        )
         targets = targets.to(device)
-        heads = model.relational.heads
         nll = attention_target_nll(scores[:, 0], targets[:, 0])
-        nll = nll + attention_target_nll(scores[:, heads], targets[:, 1])
+        nll = nll + attention_target_nll(scores[:, 1], targets[:, 1])
         policy_loss = policy_loss + config.imitate.attend_coef * nll
     value_loss = 0.5 * (value - values * config.reward_scale).pow(2).mean()
     loss = policy_loss + config.value_coef * value_loss

@@ -251,17 +251,23 @@ class PrediNet(nn.Module):
                 recording.parts.append(q)
         return a, e
 
-    def attention_logits(self, L: torch.Tensor, cells: torch.Tensor | None = None) -> torch.Tensor:
+    def attention_logits(
+        self, L: torch.Tensor, cells: torch.Tensor | None = None, rows: list[int] | None = None
+    ) -> torch.Tensor:
         """(B, 2H, N) the attention's scores before the softmax (the heads' first arguments, then
-        their second), by plain autograd for every query and key mode. A loss on where a head
+        their second), by plain autograd for every query and key mode; ``rows`` picks some of the
+        2H (B, len(rows), N), so that only their queries are projected. A loss on where a head
         looks reads these (``log_softmax``): a saturated softmax's probabilities carry no gradient
         to the cells it ignores."""
         B, N, F = L.shape
+        D = self.key_size
         if self.query_mode == "learned":
-            q = self.queries.view(1, -1, self.key_size).expand(B, -1, -1)  # (B, 2H, D)
+            q = self.queries.view(-1, D)  # (2H, D)
+            q = (q if rows is None else q[rows]).expand(B, -1, -1)  # (B, 2H, D)
         else:
-            w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
-            q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, self.key_size)  # (B, 2H, D)
+            w_q = torch.cat([self.query1.weight, self.query2.weight]).view(-1, D, N * F)
+            w_q = (w_q if rows is None else w_q[rows]).reshape(-1, N * F)  # (2H D, N F)
+            q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, D)  # (B, 2H, D)
         if self.keys == "entities":
             keys = L
         elif cells is None:
