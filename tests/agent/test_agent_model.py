@@ -182,11 +182,13 @@ def test_gradients_reach_every_parameter() -> None:
 
 
 def _reference_attention(L, w_q, w_k, scale):
-    """PrediNet's attention as plain autograd computes it (the hand-written backward's oracle)."""
+    """PrediNet's attention as plain autograd computes it (the hand-written backward's oracle):
+    a, e and the scores."""
     B, N, F = L.shape
     q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, w_k.shape[0])
-    a = torch.softmax(((q @ w_k) * scale) @ L.transpose(1, 2), dim=-1)
-    return a, a @ L
+    scores = ((q @ w_k) * scale) @ L.transpose(1, 2)
+    a = torch.softmax(scores, dim=-1)
+    return a, a @ L, scores
 
 
 def test_predinet_attention_backward_matches_autograd() -> None:
@@ -197,18 +199,22 @@ def test_predinet_attention_backward_matches_autograd() -> None:
     L = torch.randn(B, N, F, dtype=torch.float64, generator=g, requires_grad=True)
     w_q = torch.randn(2 * H * D, N * F, dtype=torch.float64, generator=g, requires_grad=True)
     w_k = torch.randn(D, F, dtype=torch.float64, generator=g, requires_grad=True)
-    assert torch.autograd.gradcheck(lambda *x: PrediNetAttention.apply(*x, 0.7)[:2], (L, w_q, w_k))
-    # and equal to autograd's own gradients, for a loss on e alone and on a and e
-    for use_a in (False, True):
+    mine = lambda *x: PrediNetAttention.apply(*x, 0.7)  # noqa: E731
+    assert torch.autograd.gradcheck(lambda *x: mine(*x)[:2], (L, w_q, w_k))
+    assert torch.autograd.gradcheck(lambda *x: (mine(*x)[1], mine(*x)[3]), (L, w_q, w_k))
+    # and equal to autograd's own gradients, for a loss on e alone, on a and e, on the scores
+    for use in ("e", "a", "scores"):
         grads = []
-        for fn in (lambda *x: PrediNetAttention.apply(*x, 0.7)[:2], _reference_attention):
-            a, e = fn(L, w_q, w_k, 0.7) if fn is _reference_attention else fn(L, w_q, w_k)
+        for fn in (mine, _reference_attention):
+            a, e, *rest = fn(L, w_q, w_k, 0.7) if fn is _reference_attention else fn(L, w_q, w_k)
             loss = (e * torch.linspace(-1, 1, e.numel(), dtype=e.dtype).view_as(e)).sum()
-            if use_a:
+            if use == "a":
                 loss = loss + (a[:, :, 0] ** 2).sum()
+            if use == "scores":
+                loss = loss - torch.log_softmax(rest[-1], -1)[:, :, 1].sum()
             grads.append(torch.autograd.grad(loss, (L, w_q, w_k)))
-        for mine, ref in zip(*grads, strict=True):
-            torch.testing.assert_close(mine, ref)
+        for got, ref in zip(*grads, strict=True):
+            torch.testing.assert_close(got, ref)
 
 
 def test_recorded_queries_give_the_same_update_and_go_stale_with_the_weights() -> None:
@@ -260,6 +266,8 @@ def test_learned_queries_are_one_vector_for_every_scene() -> None:
     w_k = torch.randn(4, 5, dtype=torch.float64, generator=g, requires_grad=True)
     mine = lambda L, q, w_k: PrediNetAttention.apply(L, None, w_k, 0.7, None, q)[:2]  # noqa: E731
     assert torch.autograd.gradcheck(mine, (L, q, w_k))
+    scores = lambda L, q, w_k: PrediNetAttention.apply(L, None, w_k, 0.7, None, q)[3]  # noqa: E731
+    assert torch.autograd.gradcheck(scores, (L, q, w_k))
     a, e = mine(L, q, w_k)
     ref = torch.softmax(((q.view(1, -1, 4) @ w_k) * 0.7) @ L.transpose(1, 2), dim=-1)
     torch.testing.assert_close(a, ref)
@@ -371,23 +379,25 @@ def test_cells_xy_keys_tell_two_cells_of_one_kind_apart_and_start_as_cell_keys()
     "kw",
     [{}, {"keys": "cells"}, {"keys": "cells_xy"}, {"query": "learned"}, {"relation_bits": 0.25}],
 )
-def test_attention_logits_are_the_scores_of_the_attention_the_heads_use(kw) -> None:
-    """PrediNet.attention_logits (what the attention target's loss reads) has the recorded
-    attentions as its softmax, for every query and key mode."""
+def test_scores_are_those_of_the_attention_the_heads_use(kw) -> None:
+    """The hook point ``scores`` (what the attention target's loss reads) has the recorded
+    attentions as its softmax and equals PrediNet.attention_logits, for every query and key
+    mode (the hand-written attention's and autograd's)."""
+    from neurosym.agent.networks.hooks import cache
+
     model = make("predinet", **kw)
     obs = torch.randint(0, 2, (3, *RGW[0]), dtype=torch.uint8)
     seen = []
     hook = model.relational.register_forward_pre_hook(lambda m, args: seen.append(args))
-    with torch.no_grad():
+    with torch.no_grad(), cache(model.relational, ["scores"]) as values:
         _, _, intro = model(obs, introspect=True)
         args = seen[-1]
-        scores = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
-        head0 = model.relational.attention_logits(
-            args[0], args[3] if len(args) > 3 else None, rows=[0, model.relational.heads]
-        )
+        logits = model.relational.attention_logits(args[0], args[3] if len(args) > 3 else None)
     hook.remove()
     H = model.relational.heads
+    scores = values["scores"]
+    assert scores.shape == (3, 2 * H, RGW[0][1] * RGW[0][2])
     a = torch.softmax(scores, dim=-1)
     torch.testing.assert_close(a[:, :H], intro.attention1)
     torch.testing.assert_close(a[:, H:], intro.attention2)
-    torch.testing.assert_close(head0, scores[:, [0, H]])  # the rows alone: the same scores
+    torch.testing.assert_close(logits, scores)

@@ -63,6 +63,7 @@ from neurosym.agent.learners.process import (
     report_update,
 )
 from neurosym.agent.learners.teacher import Teacher, load_teacher
+from neurosym.agent.networks.hooks import cache
 from neurosym.agent.networks.model import ActorCritic
 from neurosym.agent.rollout import EpisodeTracker, Finished, select_actions
 
@@ -180,21 +181,13 @@ def imitation_update(
 ) -> LossStats:
     """``dagger_steps`` minibatches of ``dagger_batch`` labelled states from the buffer."""
     totals = np.zeros(4)
-    attend = config.imitate.attend_coef
-    seen: list[tuple[Any, ...]] = []  # the PrediNet's inputs (entities, ..., cells)
-    hook = (
-        model.relational.register_forward_pre_hook(lambda m, args: seen.append(args))
-        if attend
-        else None
-    )
-    try:
+    # the attention target's loss reads the scores the forward computed (the hook point)
+    names = ["scores"] if config.imitate.attend_coef else []
+    with cache(model.relational, names) as seen:
         for _ in range(config.imitate.dagger_steps):
             totals += _imitation_step(
                 model, optimizer, buffer, config, rng, device, generator, seen
             )
-    finally:
-        if hook is not None:
-            hook.remove()
     return LossStats(*(totals / config.imitate.dagger_steps).tolist())
 
 
@@ -206,7 +199,7 @@ def _imitation_step(
     rng: np.random.Generator,
     device: torch.device,
     generator: torch.Generator | None,
-    seen: list[tuple[Any, ...]],
+    seen: dict[str, torch.Tensor],
 ) -> list[float]:
     """One minibatch's gradient step: policy, safe, attention and value losses."""
     obs, policy, values, safe, targets = buffer.sample(config.imitate.dagger_batch, rng)
@@ -216,7 +209,6 @@ def _imitation_step(
         )
         policy, safe = moved[..., 0], moved[..., 1] > 0
     obs, policy, values = obs.to(device), policy.to(device), values.to(device)
-    seen.clear()
     logits, value = model(obs)
     if config.imitate.teacher:
         policy_loss = distill_loss(logits, policy)
@@ -227,11 +219,7 @@ def _imitation_step(
             logits, safe.to(device)
         )
     if config.imitate.attend_coef:  # head 0's arguments on the route's cells
-        args = seen[-1]  # (entities, introspect[, queries, cells])
-        head0 = [0, model.relational.heads]  # head 0's first and second argument: 2 of 2H queries
-        scores = model.relational.attention_logits(
-            args[0], args[3] if len(args) > 3 else None, rows=head0
-        )
+        scores = seen["scores"][:, [0, model.relational.heads]]  # head 0's first and second
         targets = targets.to(device)
         nll = attention_target_nll(scores[:, 0], targets[:, 0])
         nll = nll + attention_target_nll(scores[:, 1], targets[:, 1])

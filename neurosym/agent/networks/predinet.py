@@ -94,7 +94,8 @@ class QueryRecord(NamedTuple):
 
 class PrediNetAttention(torch.autograd.Function):
     """(L, W_Q1|W_Q2, W_K, scale[, known first rows of Q]) -> attentions a (B, 2H, N), attended
-    entities e (B, 2H, F) and the queries Q (B, 2H D; no gradient flows back through this output).
+    entities e (B, 2H, F), the queries Q (B, 2H D; no gradient flows back through this output)
+    and the scores s (B, 2H, N) before the softmax (a loss on where a head looks reads them).
 
     The same function as autograd's ``q = flat(L) W_Q^T; s = scale (q W_K) L^T;
     a = softmax(s); e = a L``, with a hand-written backward: L is used three
@@ -119,17 +120,18 @@ class PrediNetAttention(torch.autograd.Function):
             q = torch.cat([q_head, flat[q_head.shape[0] :] @ w_q.t()])
         q = q.view(B, -1, D)  # (B, 2H, D)
         qk = (q @ w_k) * scale  # (B, 2H, F)
-        a = torch.softmax(qk @ L.transpose(1, 2), dim=-1)  # (B, 2H, N)
+        s = qk @ L.transpose(1, 2)  # (B, 2H, N)
+        a = torch.softmax(s, dim=-1)
         e = a @ L  # (B, 2H, F)
         ctx.save_for_backward(L, w_q, w_k, q, qk, a)
         ctx.scale = scale
         ctx.learned = q_learned is not None
         q_flat = q.view(B, -1)
         ctx.mark_non_differentiable(q_flat)
-        return a, e, q_flat
+        return a, e, q_flat, s
 
     @staticmethod
-    def backward(ctx, g_a, g_e, _g_q):  # type: ignore[override]
+    def backward(ctx, g_a, g_e, _g_q, g_scores):  # type: ignore[override]
         L, w_q, w_k, q, qk, a = ctx.saved_tensors
         B, N, F = L.shape
         if g_e is None:
@@ -138,6 +140,8 @@ class PrediNetAttention(torch.autograd.Function):
         if g_a is not None:
             g_at = g_at + g_a
         g_s = a * (g_at - (g_at * a).sum(-1, keepdim=True))  # softmax backward
+        if g_scores is not None:  # a loss read the scores themselves
+            g_s = g_s + g_scores
         g_qk = g_s @ L  # (B, 2H, F)
         # e = a L and s = qk L^T: L's two gradients in one product
         g_l = torch.cat([a, g_s], 1).transpose(1, 2) @ torch.cat([g_e, qk], 1)  # (B, N, F)
@@ -195,10 +199,12 @@ class PrediNet(nn.Module):
         else:
             self.out = nn.Linear(heads * (relations + 4), output_size)
         self.scale = attention_gain / math.sqrt(key_size)
-        # hook points (neurosym.agent.networks.hooks): the attention maps a1, a2 (B, H, N) and
-        # the positions (B, H, 2) are read-only in effect (E1, E2 are computed with them inside
-        # the attention); a value put in place of D^h (B, H, J) or of R^h (B, H, J + 4, what
-        # ``out`` reads) is what the rest of the forward uses
+        # hook points (neurosym.agent.networks.hooks): the scores before the softmax (B, 2H, N),
+        # the attention maps a1, a2 (B, H, N) and the positions (B, H, 2) are read-only in
+        # effect (E1, E2 are computed with them inside the attention); a value put in place of
+        # D^h (B, H, J) or of R^h (B, H, J + 4, what ``out`` reads) is what the rest of the
+        # forward uses
+        self.hook_scores = HookPoint()
         self.hook_attention1, self.hook_attention2 = HookPoint(), HookPoint()
         self.hook_relations = HookPoint()
         self.hook_positions1, self.hook_positions2 = HookPoint(), HookPoint()
@@ -231,14 +237,15 @@ class PrediNet(nn.Module):
 
     def _scene_attention(
         self, L: torch.Tensor, queries: QueryRecord | None
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Attention with queries from flat(L), reusing a valid record and feeding an open one."""
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Attention with queries from flat(L), reusing a valid record and feeding an open one:
+        a, e and the scores."""
         q_head = None
         if queries is not None and queries.parts and queries.key == self.weights_key():
             q_head = torch.cat(queries.parts) if len(queries.parts) > 1 else queries.parts[0]
             if q_head.shape[0] > L.shape[0]:
                 q_head = None
-        a, e, q = PrediNetAttention.apply(
+        a, e, q, scores = PrediNetAttention.apply(
             L,
             torch.cat([self.query1.weight, self.query2.weight]),
             self.key.weight,
@@ -249,24 +256,20 @@ class PrediNet(nn.Module):
         if recording is not None and not torch.is_grad_enabled():
             if recording.key == self.weights_key():
                 recording.parts.append(q)
-        return a, e
+        return a, e, scores
 
-    def attention_logits(
-        self, L: torch.Tensor, cells: torch.Tensor | None = None, rows: list[int] | None = None
-    ) -> torch.Tensor:
+    def attention_logits(self, L: torch.Tensor, cells: torch.Tensor | None = None) -> torch.Tensor:
         """(B, 2H, N) the attention's scores before the softmax (the heads' first arguments, then
-        their second), by plain autograd for every query and key mode; ``rows`` picks some of the
-        2H (B, len(rows), N), so that only their queries are projected. A loss on where a head
-        looks reads these (``log_softmax``): a saturated softmax's probabilities carry no gradient
-        to the cells it ignores."""
+        their second), by plain autograd for every query and key mode: what the cell keys'
+        attention computes, and what the hook point ``scores`` passes on in every mode. A loss
+        on where a head looks reads these (``log_softmax``): a saturated softmax's probabilities
+        carry no gradient to the cells it ignores."""
         B, N, F = L.shape
         D = self.key_size
         if self.query_mode == "learned":
-            q = self.queries.view(-1, D)  # (2H, D)
-            q = (q if rows is None else q[rows]).expand(B, -1, -1)  # (B, 2H, D)
+            q = self.queries.view(-1, D).expand(B, -1, -1)  # (B, 2H, D)
         else:
-            w_q = torch.cat([self.query1.weight, self.query2.weight]).view(-1, D, N * F)
-            w_q = (w_q if rows is None else w_q[rows]).reshape(-1, N * F)  # (2H D, N F)
+            w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
             q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, D)  # (B, 2H, D)
         if self.keys == "entities":
             keys = L
@@ -278,10 +281,12 @@ class PrediNet(nn.Module):
 
     def _cell_attention(
         self, L: torch.Tensor, cells: torch.Tensor
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Attention whose keys are the cells' observations: a (B, 2H, N), e = a L (B, 2H, F)."""
-        a = torch.softmax(self.attention_logits(L, cells), dim=-1)
-        return a, a @ L
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Attention whose keys are the cells' observations: a (B, 2H, N), e = a L (B, 2H, F)
+        and the scores."""
+        scores = self.attention_logits(L, cells)
+        a = torch.softmax(scores, dim=-1)
+        return a, a @ L, scores
 
     def forward(
         self,
@@ -307,13 +312,14 @@ class PrediNet(nn.Module):
         if self.keys != "entities":
             if cells is None:
                 raise ValueError("PrediNet with keys='cells' needs the cells' observations")
-            a, e = self._cell_attention(L, cells)
+            a, e, scores = self._cell_attention(L, cells)
         elif self.query_mode == "learned":  # nothing to record or reuse: the queries are weights
-            a, e, _ = PrediNetAttention.apply(
+            a, e, _, scores = PrediNetAttention.apply(
                 L, None, self.key.weight, self.scale, None, self.queries
             )
         else:
-            a, e = self._scene_attention(L, queries)
+            a, e, scores = self._scene_attention(L, queries)
+        self.hook_scores(scores)  # (B, 2H, N)
         e1, e2 = e[:, :H], e[:, H:]  # (B, H, F)
         self.hook_attention1(a[:, :H])  # (B, H, N)
         self.hook_attention2(a[:, H:])
