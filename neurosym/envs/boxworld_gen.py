@@ -51,6 +51,8 @@ SIZE = 12
 """Interior side length; the observation adds a one-cell border on each side."""
 GRID = SIZE + 2
 CELLS = GRID * GRID
+HELD_CELL = 0
+"""the top-left border cell (row-major), where the held key is drawn"""
 
 MAX_OBJECTS = 15
 """Most objects (loose key + boxes) a generated level may hold: beyond this the

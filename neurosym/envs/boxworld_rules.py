@@ -54,7 +54,7 @@ from neurosym.envs.boxworld_entities import (
     WALL,
     object_id,
 )
-from neurosym.envs.boxworld_gen import CELLS, GRID, LevelArrays, base_grid
+from neurosym.envs.boxworld_gen import CELLS, GRID, HELD_CELL, LevelArrays, base_grid
 
 # Action -> change of the flat cell index: 0 up, 1 right, 2 down, 3 left.
 DELTA = np.array([-GRID, 1, GRID, -1], dtype=np.int64)
@@ -118,8 +118,8 @@ class BoxWorldState:
         m, s = levels.cells.shape
         assert m == len(rows) and s == self.slots, (m, len(rows), s, self.slots)
         real = levels.cells >= 0
-        # Padding writes go to cell 0 (border) with values that leave it as it is.
-        cells = np.where(real, levels.cells, 0).astype(np.int64)  # (m, S)
+        # Padding writes go to the held key's border cell with values that leave it as it is.
+        cells = np.where(real, levels.cells, HELD_CELL).astype(np.int64)  # (m, S)
         grid = np.tile(_BASE_GRID, (m, 1))  # (m, CELLS)
         grid.reshape(-1)[(np.arange(m) * CELLS)[:, None] + cells] = np.where(
             real, levels.codes, WALL
@@ -192,15 +192,15 @@ class BoxWorldState:
             box = taken[opens[taken]]
             alive[self._alive_base[box] + slot_of_cell[at[box] - 1]] = False
 
-        # Redraw the cells that changed. Cell 0 (the held key) is written last, so it
-        # also absorbs the writes of environments that emptied no box content.
+        # Redraw the cells that changed. The held key's cell is written last, so it also
+        # absorbs the writes of environments that emptied no box content.
         new = np.where(moves, target, old)
-        emptied = np.where(opens, target - 1, 0)
+        emptied = np.where(opens, target - 1, HELD_CELL)
         grid[base + emptied] = EMPTY
         grid[base + old] = EMPTY
         grid[base + new] = AGENT
         held_code = np.where(self.held >= 0, HELD + self.held.astype(np.int16), WALL)
-        self.grid[:, 0] = held_code  # strided write
+        self.grid[:, HELD_CELL] = held_code  # strided write
         changed = np.concatenate([old, emptied, new])  # (3n,) cells to repaint
         codes = grid[self._base3 + changed]
         if self.obs_mode == "rgb":
@@ -211,7 +211,7 @@ class BoxWorldState:
             obs[paint + 2 * CELLS] = _BLUE[codes]
         else:  # (3n, P) rows of planes; the later writes of a cell win, as above
             self.obs[self._rows3, :, changed] = ONEHOT[codes]
-        self.obs[:, :, 0] = self._lut[held_code]  # the held key's cell, a strided write
+        self.obs[:, :, HELD_CELL] = self._lut[held_code]  # a strided write
         self.agent = new
         return reward, terminated, truncated
 

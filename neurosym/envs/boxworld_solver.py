@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from neurosym.envs.boxworld_entities import AGENT, EMPTY, GEM, HELD, KEY, LOCK
-from neurosym.envs.boxworld_gen import CELLS, GRID, LevelArrays, base_grid
+from neurosym.envs.boxworld_gen import CELLS, GRID, HELD_CELL, LevelArrays, base_grid
 from neurosym.envs.boxworld_rules import DELTA
 
 _STEPS = tuple(int(d) for d in DELTA)  # up, right, down, left as flat-index offsets
@@ -243,10 +243,6 @@ def nearest_interaction(grid: np.ndarray, agent: int, held: int) -> int | None:
                 first[nxt] = start_action
                 queue.append(nxt)
     return None
-
-
-HELD_CELL = 0
-"""the top-left border cell, where the held key is drawn"""
 
 
 class RouteTargets:

@@ -172,7 +172,8 @@ def test_route_targets_lead_every_level_to_the_gem(name):
     opens, and so on. The first target is the held key's cell exactly when the second is a lock
     of the held key's colour."""
     from neurosym.envs import make_batched
-    from neurosym.envs.boxworld_solver import HELD_CELL, RouteTargets
+    from neurosym.envs.boxworld_gen import HELD_CELL
+    from neurosym.envs.boxworld_solver import RouteTargets
 
     n = 24
     venv = make_batched(name, n, seed=77)
