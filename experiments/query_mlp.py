@@ -1,18 +1,16 @@
-"""Can head 0 tell a route through a teleport if its query is not linear in the scene?
+"""A PrediNet checkpoint with MLP queries (``query="scene_mlp"``) that plays as its source.
 
-PrediNet's queries are a linear read-out of the flattened entities (W_Q flat(L)). The RGW
-fact bottleneck's head 0 misses the next object mostly where the route goes through a
-teleport (it names the object past it), a choice between two route lengths. This study adds
-a residual MLP to the queries, Q = W_Q flat(L) + MLP(flat(L)), its last layer zero so that
-the network starts exactly where its source was, and trains on as before:
+    python experiments/query_mlp.py SOURCE.pt OUT.pt
+    neurosym train --init-from OUT.pt --algo imitate ...    # then train on
 
-    python experiments/query_mlp.py init SOURCE.pt INIT.pt          # the source plus the MLP
-    python experiments/query_mlp.py train --init-from INIT.pt ...   # any neurosym command
-
-Every other command runs ``neurosym`` with the MLP in every PrediNet with scene queries and
-cell keys (the RGW bottleneck's; the entity keys' attention does not read these scores), so the
-run's checkpoints (which hold the MLP's weights) load, play, extract and induce only
-through this script; the checkpoint's config does not record the change.
+PrediNet's scene queries are a linear read-out of the flattened entities (W_Q flat(L)). The
+RGW fact bottleneck's head 0 misses the next object mostly where the route goes through a
+teleport (it names the object past it), a choice between two route lengths that is not
+linear in the scene. ``scene_mlp`` adds a one-layer MLP of flat(L) to the queries; this
+script writes SOURCE's checkpoint with that query, the MLP's output layer zero (so the
+network starts exactly where SOURCE was) and no optimizer state. A source that already holds
+the MLP's weights (``relational.query_mlp.*``: a run of this study made before the option
+was the library's, which recorded query "scene") keeps them.
 """
 
 from __future__ import annotations
@@ -20,65 +18,36 @@ from __future__ import annotations
 import sys
 
 import torch
-from torch import nn
 
-from neurosym.agent.networks import predinet
-from neurosym.cli import main
+from neurosym.agent.networks.predinet import PrediNet
 
-HIDDEN = 256
-"""the MLP's hidden width"""
-
-_init = predinet.PrediNet.__init__
-_logits = predinet.PrediNet.attention_logits
+PREFIX = "relational.query_mlp."
 
 
-def query_mlp(flat: int, out: int) -> nn.Sequential:
-    """flat(L) -> all 2H queries, its last layer zero (adds nothing until trained)."""
-    mlp = nn.Sequential(nn.Linear(flat, HIDDEN), nn.ReLU(), nn.Linear(HIDDEN, out))
-    nn.init.zeros_(mlp[2].weight)
-    nn.init.zeros_(mlp[2].bias)
-    return mlp
-
-
-def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
-    _init(self, *args, **kwargs)
-    if self.query_mode == "scene":
-        self.query_mlp = query_mlp(self.query1.weight.shape[1], 2 * self.heads * self.key_size)
-
-
-def attention_logits(self, L, cells=None):  # type: ignore[no-untyped-def]
-    """The library's scores plus the MLP's share of each query, (q_mlp W_K) keys^T * scale."""
-    scores = _logits(self, L, cells)
-    if self.query_mode != "scene":
-        return scores
-    B, N, F = L.shape
-    q = self.query_mlp(L.reshape(B, N * F)).view(B, 2 * self.heads, self.key_size)
-    if self.keys == "entities":
-        keys = L
-    elif self.keys == "cells_xy":
-        keys = torch.cat([cells, L[..., -2:]], dim=-1)
-    else:
-        keys = cells
-    return scores + (q @ self.key.weight) @ keys.transpose(1, 2) * self.scale
-
-
-def add_mlp(source: str, out: str) -> None:
-    """Write ``source``'s checkpoint with the MLP's weights added (its last layer zero)."""
+def with_mlp_queries(source: str, out: str) -> None:
+    """Write ``source`` with query "scene_mlp" (its MLP's weights added when it has none)."""
     ck = torch.load(source, map_location="cpu", weights_only=False)
-    state = ck["state_dict"]
-    mlp = query_mlp(state["relational.query1.weight"].shape[1], 2 * state["relational.query1.weight"].shape[0])
-    dtype = state["relational.query1.weight"].dtype
-    for name, value in mlp.state_dict().items():
-        state[f"relational.query_mlp.{name}"] = value.to(dtype)
+    config, state = ck["model_config"], ck["state_dict"]
+    if config.get("keys", "entities") == "entities":
+        sys.exit(f"{source}: MLP queries need cell keys (keys cells or cells_xy); it has entity keys")
+    if config.get("query", "scene") not in ("scene", "scene_mlp"):
+        sys.exit(f"{source}: its query is {config['query']!r}; MLP queries add to scene queries")
+    if not any(name.startswith(PREFIX) for name in state):
+        w_q = state["relational.query1.weight"]  # (H D, N F)
+        n_entities = config["obs_shape"][1] * config["obs_shape"][2]
+        fresh = PrediNet(
+            n_entities, w_q.shape[1] // n_entities, config["heads"], config["key_size"],
+            config["relations"], config["output_size"], query="scene_mlp", keys=config["keys"],
+            cell_size=config["obs_shape"][0],
+        )  # fmt: skip
+        for name, value in fresh.query_mlp.state_dict().items():
+            state[PREFIX + name] = value.to(w_q.dtype)
+    config["query"] = "scene_mlp"
     ck.pop("optimizer", None)
     torch.save(ck, out)
 
 
-predinet.PrediNet.__init__ = __init__
-predinet.PrediNet.attention_logits = attention_logits
-
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["init"]:
-        add_mlp(sys.argv[2], sys.argv[3])
-        sys.exit(0)
-    sys.exit(main(sys.argv[1:]))
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    with_mlp_queries(sys.argv[1], sys.argv[2])

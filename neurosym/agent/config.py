@@ -55,7 +55,7 @@ imitates a trained agent (``--set teacher=CHECKPOINT``)"""
 OPTIMIZERS = ("adam", "rmsprop")
 PPO_ADVANTAGES = ("minibatch", "running")
 INITS = ("orthogonal", "torch")
-QUERIES = ("scene", "learned")
+QUERIES = ("scene", "learned", "scene_mlp")
 KEYS = ("entities", "cells", "cells_xy")
 
 
@@ -341,7 +341,8 @@ class ModelConfig:
     """PrediNet's queries: "scene" (Q = flat(L) W_Q, docs/design.md and the thesis) or "learned" (a
     learned Q1, Q2 per head, the same for every scene: attention by what and where an entity
     is, not by the rest of the scene). "learned" also drops the query projection, most of a
-    Box-World forward's arithmetic."""
+    Box-World forward's arithmetic. "scene_mlp" (cell keys only) adds a one-layer MLP of the
+    scene to the scene queries, zero at the start (the RGW fact bottleneck's)."""
     keys: str = field(default="entities", metadata=flag(choices=KEYS))
     """what PrediNet's attention compares its queries with: the encoder's entities (docs/design.md,
     the thesis) or each cell's own observation (cells). With cell keys a head singles out a cell
@@ -394,6 +395,11 @@ class ModelConfig:
                     f"{name} {value!r} is PrediNet's; {self.module}'s {plural} come from each "
                     f"entity (use {name} {default!r})"
                 )
+        if self.query == "scene_mlp" and self.keys == "entities":
+            raise ConfigError(
+                "query 'scene_mlp' needs cell keys (keys cells or cells_xy): the entity keys' "
+                "attention is computed for linear queries (use query 'scene')"
+            )
         if self.relation_bits is not None and self.module != "predinet":
             raise ConfigError(
                 f"relation_bits is PrediNet's (the policy reads its thresholded relations); "

@@ -377,7 +377,14 @@ def test_cells_xy_keys_tell_two_cells_of_one_kind_apart_and_start_as_cell_keys()
 
 @pytest.mark.parametrize(
     "kw",
-    [{}, {"keys": "cells"}, {"keys": "cells_xy"}, {"query": "learned"}, {"relation_bits": 0.25}],
+    [
+        {},
+        {"keys": "cells"},
+        {"keys": "cells_xy"},
+        {"query": "learned"},
+        {"relation_bits": 0.25},
+        {"keys": "cells_xy", "query": "scene_mlp"},
+    ],
 )
 def test_scores_are_those_of_the_attention_the_heads_use(kw) -> None:
     """The hook point ``scores`` (what the attention target's loss reads) has the recorded
@@ -401,3 +408,25 @@ def test_scores_are_those_of_the_attention_the_heads_use(kw) -> None:
     torch.testing.assert_close(a[:, :H], intro.attention1)
     torch.testing.assert_close(a[:, H:], intro.attention2)
     torch.testing.assert_close(logits, scores)
+
+
+def test_mlp_queries_start_as_the_scene_queries_and_need_cell_keys() -> None:
+    """query "scene_mlp": flat(L) W_Q plus an MLP whose output layer starts at zero, so a fresh
+    network with the same other weights attends as the scene queries do; trained, it moves the
+    attention. Entity keys are refused in one line."""
+    from neurosym.errors import ConfigError
+
+    torch.manual_seed(0)
+    linear = make("predinet", keys="cells_xy")
+    mlp = make("predinet", keys="cells_xy", query="scene_mlp")
+    missing = mlp.load_state_dict(linear.state_dict(), strict=False).missing_keys
+    assert sorted(missing) == [f"relational.query_mlp.{n}" for n in ("0.bias", "0.weight", "2.bias", "2.weight")]
+    obs = torch.randint(0, 2, (4, *RGW[0]), dtype=torch.uint8)
+    with torch.no_grad():
+        a, b = linear(obs, introspect=True)[2], mlp(obs, introspect=True)[2]
+        torch.testing.assert_close(b.attention2, a.attention2)
+        mlp.relational.query_mlp[2].weight.normal_()
+        c = mlp(obs, introspect=True)[2]
+    assert not torch.allclose(c.attention2, a.attention2)
+    with pytest.raises(ConfigError, match="query 'scene_mlp' needs cell keys"):
+        make("predinet", query="scene_mlp")

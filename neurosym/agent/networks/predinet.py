@@ -31,6 +31,12 @@ Choices made here (docs/design.md leaves them open):
   and the attention can saturate on fixed cells. A learned query moves by
   about lr per step. It cannot make which lock a head attends to depend on
   the colour of the held key, which bw2/bw3's chains may need.
+* ``query="scene_mlp"`` (with cell keys): Q = flat(L) W_Q + MLP(flat(L)), one ReLU layer
+  of :data:`QUERY_HIDDEN` units whose output layer starts at zero (the same queries as
+  "scene" until trained). Why: the scene query is linear in the scene, and choosing between
+  a route through a teleport and one around it (which object the agent meets next) is not;
+  the RGW fact bottleneck's head 0 named the teleport on its route more often with it
+  (docs/results.md, "The fact bottleneck").
 * ``keys="cells"`` (ModelConfig.keys; "entities", K = L W_K, is the default):
   K = c W_K with c the (B, N, C) cells' own observation vectors, so a head
   addresses a cell by what it holds; the attended entities are still L's.
@@ -83,6 +89,9 @@ from torch import nn
 
 from neurosym.agent.networks.hooks import HookPoint, introspected
 from neurosym.agent.networks.introspection import PrediNetIntrospection
+
+QUERY_HIDDEN = 256
+"""hidden units of the MLP queries (``query="scene_mlp"``)"""
 
 
 class QueryRecord(NamedTuple):
@@ -175,6 +184,7 @@ class PrediNet(nn.Module):
         super().__init__()
         assert entity_size > 2, "entities need features besides the 2 coordinates"
         assert keys == "entities" or cell_size > 0, "cell keys need the cells' size"
+        assert query != "scene_mlp" or keys != "entities", "MLP queries need cell keys"
         self.heads, self.key_size, self.relations = heads, key_size, relations
         self.query_mode = query
         self.keys = keys
@@ -191,6 +201,14 @@ class PrediNet(nn.Module):
             self.query2 = nn.Linear(
                 n_entities * entity_size, heads * key_size, bias=False
             )  # W_Q2^h
+        if query == "scene_mlp":
+            self.query_mlp = nn.Sequential(
+                nn.Linear(n_entities * entity_size, QUERY_HIDDEN),
+                nn.ReLU(),
+                nn.Linear(QUERY_HIDDEN, 2 * heads * key_size),
+            )
+            nn.init.zeros_(self.query_mlp[2].weight)  # adds nothing until trained
+            nn.init.zeros_(self.query_mlp[2].bias)
         self.embed = nn.Linear(entity_size - 2, relations, bias=False)  # W_S, shared
         self.relation_bits = bits_threshold(relation_bits)
         if self.relation_bits is not None:
@@ -269,8 +287,11 @@ class PrediNet(nn.Module):
         if self.query_mode == "learned":
             q = self.queries.view(-1, D).expand(B, -1, -1)  # (B, 2H, D)
         else:
+            flat = L.reshape(B, N * F)
             w_q = torch.cat([self.query1.weight, self.query2.weight])  # (2H D, N F)
-            q = (L.reshape(B, N * F) @ w_q.t()).view(B, -1, D)  # (B, 2H, D)
+            q = (flat @ w_q.t()).view(B, -1, D)  # (B, 2H, D)
+            if self.query_mode == "scene_mlp":
+                q = q + self.query_mlp(flat).view(B, -1, D)
         if self.keys == "entities":
             keys = L
         elif cells is None:
