@@ -15,6 +15,7 @@ was the library's, which recorded query "scene") keeps them.
 
 from __future__ import annotations
 
+import shlex
 import sys
 
 import torch
@@ -42,6 +43,8 @@ def with_mlp_queries(source: str, out: str) -> None:
         )  # fmt: skip
         for name, value in fresh.query_mlp.state_dict().items():
             state[PREFIX + name] = value.to(w_q.dtype)
+        this = " ".join(shlex.quote(a) for a in ["python", "experiments/query_mlp.py", source, out])
+        ck["command"] = " && ".join(filter(None, [ck.get("command"), this]))  # history, then this
     config["query"] = "scene_mlp"
     ck.pop("optimizer", None)
     torch.save(ck, out)

@@ -217,11 +217,11 @@ def test_shipped_agent_takes_the_optimal_route(name: str) -> None:
 def test_the_bottleneck_predinet_names_its_next_object_in_the_facts_its_policy_reads(
     tmp_path: Path,
 ) -> None:
-    """The fact-bottleneck agent (relation_bits 0.25, cell keys with coordinates): its KB is
-    written at abs:0.25, the bits its policy read; head 0's second argument is the object the
-    agent meets next on most labelled states of held-out levels (greedy); on rgw2, never
-    trained on, its sampled policy reaches the terminal (20 of 20, mean 10.38 of the optimal
-    10.7, when shipped; greedily it loops after the sword)."""
+    """The fact-bottleneck agent (relation_bits 0.25, cell keys with coordinates, MLP queries):
+    its KB is written at abs:0.25, the bits its policy read; head 0's second argument is the
+    object the agent meets next on most labelled states of held-out levels (greedy); on rgw2,
+    never trained on, its sampled policy reaches the terminal (20 of 20, mean 10.66 of the
+    optimal 10.7, when shipped; greedily 10.7)."""
     from neurosym.agent.evaluation import evaluate
     from neurosym.facts.tables import extract_facts
     from neurosym.induce.strategy_data import labels, load_trace
@@ -231,6 +231,7 @@ def test_the_bottleneck_predinet_names_its_next_object_in_the_facts_its_policy_r
     path = CHECKPOINTS / "rgw-random-predinet-bottleneck.pt"
     agent = load_agent(path)
     assert agent.config.relation_bits == 0.25 and agent.config.keys == "cells_xy"
+    assert agent.config.query == "scene_mlp"
     assert model_threshold(agent.config) == "abs:0.25"
     assert "--attend-coef" in agent.meta["command"]
     rec = record(agent, episodes=10, seed=UNSEEN, greedy=True, env_kwargs=default_levels(agent))

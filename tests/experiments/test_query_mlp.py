@@ -16,7 +16,7 @@ _spec = importlib.util.spec_from_file_location("query_mlp", ROOT / "experiments"
 query_mlp = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(query_mlp)
 
-SOURCE = ROOT / "checkpoints" / "rgw-random-predinet-bottleneck.pt"
+SOURCE = ROOT / "checkpoints" / "rgw-random-predinet-cellkeys.pt"  # cell keys, scene queries
 
 
 def test_the_added_mlp_acts_as_its_source_until_trained(tmp_path: Path) -> None:
