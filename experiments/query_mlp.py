@@ -15,12 +15,15 @@ was the library's, which recorded query "scene") keeps them.
 
 from __future__ import annotations
 
+import io
 import shlex
 import sys
 
 import torch
 
-from neurosym.agent.networks.predinet import PrediNet
+from neurosym.agent.config import ModelConfig
+from neurosym.agent.networks.model import ActorCritic
+from neurosym.atomic import write_bytes_atomic
 
 PREFIX = "relational.query_mlp."
 
@@ -34,20 +37,16 @@ def with_mlp_queries(source: str, out: str) -> None:
     if config.get("query", "scene") not in ("scene", "scene_mlp"):
         sys.exit(f"{source}: its query is {config['query']!r}; MLP queries add to scene queries")
     if not any(name.startswith(PREFIX) for name in state):
-        w_q = state["relational.query1.weight"]  # (H D, N F)
-        n_entities = config["obs_shape"][1] * config["obs_shape"][2]
-        fresh = PrediNet(
-            n_entities, w_q.shape[1] // n_entities, config["heads"], config["key_size"],
-            config["relations"], config["output_size"], query="scene_mlp", keys=config["keys"],
-            cell_size=config["obs_shape"][0],
-        )  # fmt: skip
-        for name, value in fresh.query_mlp.state_dict().items():
-            state[PREFIX + name] = value.to(w_q.dtype)
+        fresh = ActorCritic(ModelConfig.from_dict({**config, "query": "scene_mlp"})).state_dict()
+        dtype = state["relational.query1.weight"].dtype
+        state.update({k: v.to(dtype) for k, v in fresh.items() if k.startswith(PREFIX)})
         this = " ".join(shlex.quote(a) for a in ["python", "experiments/query_mlp.py", source, out])
         ck["command"] = " && ".join(filter(None, [ck.get("command"), this]))  # history, then this
     config["query"] = "scene_mlp"
     ck.pop("optimizer", None)
-    torch.save(ck, out)
+    buf = io.BytesIO()
+    torch.save(ck, buf)
+    write_bytes_atomic(out, buf.getvalue())
 
 
 if __name__ == "__main__":
