@@ -11,13 +11,12 @@ chain with this script's command added.
 
 from __future__ import annotations
 
-import io
 import shlex
 import sys
 
 import torch
 
-from neurosym.atomic import write_bytes_atomic
+from neurosym.agent.checkpoint import chain_command, write_payload
 
 
 def average_checkpoints(out: str, paths: list[str]) -> None:
@@ -36,13 +35,11 @@ def average_checkpoints(out: str, paths: list[str]) -> None:
             state[name] = mean.to(value.dtype)
         else:
             state[name] = value
-    this = " ".join(shlex.quote(a) for a in ["python", "experiments/average_weights.py", out, *paths])
-    last["command"] = " && ".join(filter(None, [last.get("command"), this]))
+    this = shlex.join(["python", "experiments/average_weights.py", out, *paths])
+    last["command"] = chain_command(last.get("command"), this)
     last["state_dict"] = state
     last.pop("optimizer", None)
-    buf = io.BytesIO()
-    torch.save(last, buf)
-    write_bytes_atomic(out, buf.getvalue())
+    write_payload(out, last)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import torch
 
-from neurosym.agent.checkpoint import read_checkpoint, save_checkpoint
+from neurosym.agent.checkpoint import chain_command, read_checkpoint, save_checkpoint
 from neurosym.agent.networks.model import ActorCritic
 
 
@@ -62,19 +62,9 @@ def main() -> None:
         env_name=source["env"],
         env_kwargs=env_kwargs,
         train_config=None,
-        command=" && ".join(
-            filter(
-                None,
-                [
-                    None
-                    if args.fresh
-                    else source.get("command"),  # the source's history, then this
-                    "python "
-                    + " ".join(
-                        shlex.quote(a) for a in ["experiments/bottleneck_init.py", *sys.argv[1:]]
-                    ),
-                ],
-            )
+        command=chain_command(
+            None if args.fresh else source.get("command"),
+            shlex.join(["python", "experiments/bottleneck_init.py", *sys.argv[1:]]),
         ),
     )
     print(f"wrote {args.out}: relation_bits={config.relation_bits}, {how}")

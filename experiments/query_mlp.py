@@ -15,15 +15,14 @@ was the library's, which recorded query "scene") keeps them.
 
 from __future__ import annotations
 
-import io
 import shlex
 import sys
 
 import torch
 
+from neurosym.agent.checkpoint import chain_command, write_payload
 from neurosym.agent.config import ModelConfig
 from neurosym.agent.networks.model import ActorCritic
-from neurosym.atomic import write_bytes_atomic
 
 PREFIX = "relational.query_mlp."
 
@@ -40,13 +39,11 @@ def with_mlp_queries(source: str, out: str) -> None:
         fresh = ActorCritic(ModelConfig.from_dict({**config, "query": "scene_mlp"})).state_dict()
         dtype = state["relational.query1.weight"].dtype
         state.update({k: v.to(dtype) for k, v in fresh.items() if k.startswith(PREFIX)})
-        this = " ".join(shlex.quote(a) for a in ["python", "experiments/query_mlp.py", source, out])
-        ck["command"] = " && ".join(filter(None, [ck.get("command"), this]))  # history, then this
+        this = shlex.join(["python", "experiments/query_mlp.py", source, out])
+        ck["command"] = chain_command(ck.get("command"), this)
     config["query"] = "scene_mlp"
     ck.pop("optimizer", None)
-    buf = io.BytesIO()
-    torch.save(ck, buf)
-    write_bytes_atomic(out, buf.getvalue())
+    write_payload(out, ck)
 
 
 if __name__ == "__main__":

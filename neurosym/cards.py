@@ -18,7 +18,6 @@ other entry are written back as they were read.
 
 from __future__ import annotations
 
-import io
 import os
 import shlex
 from pathlib import Path
@@ -106,17 +105,14 @@ def write_card(path: str | os.PathLike[str], card: dict[str, Any]) -> Path:
     """Store ``card`` in the checkpoint at ``path``, atomically; the weights are not touched."""
     import torch
 
-    from neurosym.agent.checkpoint import read_checkpoint
-    from neurosym.atomic import write_bytes_atomic
+    from neurosym.agent.checkpoint import read_checkpoint, write_payload
     from neurosym.shipped import checkpoint_file
 
     path = checkpoint_file(path)
     read_checkpoint(path)  # refuses anything that is not a readable neurosym checkpoint
     payload = torch.load(path, map_location="cpu", weights_only=True)
     payload["card"] = check_card(card, f"the card for {path}")
-    buf = io.BytesIO()
-    torch.save(payload, buf)
-    return write_bytes_atomic(path, buf.getvalue())
+    return write_payload(path, payload)
 
 
 def learner(meta: dict[str, Any]) -> str:

@@ -132,11 +132,18 @@ def save_checkpoint(
         "created": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
         "command": command,
     }
-    return _write_payload(path, payload)
+    return write_payload(path, payload)
 
 
-def _write_payload(path: Path, payload: dict[str, Any]) -> Path:
-    """Check that ``payload`` holds only tensors and plain values, then write it atomically."""
+def chain_command(history: str | None, step: str) -> str:
+    """A checkpoint's ``command``: every command that made it, in order, ``step`` the last."""
+    return f"{history} && {step}" if history else step
+
+
+def write_payload(path: str | os.PathLike[str], payload: dict[str, Any]) -> Path:
+    """Check that ``payload`` (a checkpoint's entries) holds only tensors and plain values,
+    then write it atomically."""
+    path = Path(path)
     _check_plain(payload, "checkpoint")
     make_folder(path.parent)
     # Serialised in memory first: torch reports a failed file write as a
@@ -491,8 +498,8 @@ def compact_checkpoint(
     out["weights_dtype"] = dtype
     out.pop("card", None)  # its figures were measured on the weights before
     step = shlex.join(["neurosym", "compact", str(src), "--out", str(dst), "--dtype", dtype])
-    out["command"] = f"{payload['command']} && {step}" if payload.get("command") else step
-    _write_payload(dst, out)
+    out["command"] = chain_command(payload.get("command"), step)
+    write_payload(dst, out)
     return {"bytes_before": before, "bytes_after": dst.stat().st_size, "max_change": largest}
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from neurosym.agent.checkpoint import read_checkpoint
+from neurosym.agent.checkpoint import chain_command, read_checkpoint
 from neurosym.agent.config import ModelConfig, TrainConfig, preset_env_kwargs
 from neurosym.agent.learners import distributed
 from neurosym.agent.networks.adapters import module_has
@@ -126,8 +126,8 @@ def resolve_run(
     else:
         plan = _new(env, module, out, given_train, given_model, env_kwargs, options, preset, algo,
                     init_from)  # fmt: skip
-    if plan.source is not None and plan.source.get("command") and command:
-        command = f"{plan.source['command']} && {command}"  # every command that made it, in order
+    if plan.source is not None and command:
+        command = chain_command(plan.source.get("command"), command)
     plan.command, plan.world = command, world
     _check_learner(plan)
     plan.device = distributed.resolve_device(
